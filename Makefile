@@ -1,0 +1,37 @@
+# sanguis top-level driver. The README's two commands are `make demo` and `make test`.
+BUILD ?= build
+JOBS ?= $(shell nproc)
+CASE ?= cases/dem/dam-break-spheres.toml
+OUT ?= output/demo
+
+.PHONY: deps build demo test bench bench-deps validate-dem format clean
+
+deps:
+	bash scripts/install-deps.sh
+
+$(BUILD)/build.ninja:
+	cmake -S . -B $(BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Release
+
+build: deps $(BUILD)/build.ninja
+	cmake --build $(BUILD) -j $(JOBS)
+
+demo: build
+	$(BUILD)/app/sanguis run $(CASE) --output $(OUT)
+
+test: build
+	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
+
+bench-deps:
+	bash scripts/install-deps.sh --bench
+
+bench: bench-deps build
+	bash bench/dem_spheres_vs_lammps.sh
+
+validate-dem: build
+	/usr/bin/python3 validation/dem/run_all.py --build $(BUILD)
+
+format:
+	find src app tests bench -name '*.hpp' -o -name '*.cpp' | xargs clang-format -i
+
+clean:
+	rm -rf $(BUILD)
