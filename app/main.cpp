@@ -1,0 +1,204 @@
+// The sanguis executable: parse the command line, run, report. Errors map to
+// exit codes: 0 success, 1 simulation failure (blow-up), 2 bad input.
+#include <CLI/CLI.hpp>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <numbers>
+#include <sstream>
+
+#include "benchmarks.hpp"
+#include "core/error.hpp"
+#include "core/version.hpp"
+#include "dem/dem_case.hpp"
+#include "dem/dem_run.hpp"
+#include "dem/parameter_procedure.hpp"
+
+namespace {
+
+using namespace sanguis;
+
+struct ParamsOptions {
+  double radius = 1e-3;
+  double density = 2500.0;
+  double en = 0.45;
+  double et = 0.3;
+  double overlap_ratio = 0.005;
+  double velocity = 2.62;
+  double friction = 0.5;
+  double rolling_pp = 0.0;
+  double rolling_pw = -1.0;  // < 0: same as particle-particle
+  std::string damping_model = "thesis";
+  bool json = false;
+};
+
+void print_params(const ParamsOptions& o) {
+  const double mass = 4.0 / 3.0 * std::numbers::pi * std::pow(o.radius, 3) * o.density;
+  const dem::NormalDampingModel model = dem::parse_normal_damping_model(o.damping_model);
+  struct Row {
+    const char* name;
+    dem::ProcedureResult r;
+  };
+  const auto derive = [&](double reduced_mass, double reduced_radius, double rolling) {
+    dem::ProcedureInput in;
+    in.reduced_mass = reduced_mass;
+    in.reduced_radius = reduced_radius;
+    in.inertia_factor = 2.5;
+    in.normal_restitution = o.en;
+    in.tangential_restitution = o.et;
+    in.max_overlap = o.overlap_ratio * o.radius;
+    in.max_impact_velocity = o.velocity;
+    in.friction = o.friction;
+    in.rolling_friction = rolling;
+    in.damping_model = model;
+    return dem::derive_contact_parameters(in);
+  };
+  const Row rows[2] = {
+      {"particle-particle", derive(0.5 * mass, 0.5 * o.radius, o.rolling_pp)},
+      {"particle-wall", derive(mass, o.radius, o.rolling_pw < 0 ? o.rolling_pp : o.rolling_pw)}};
+
+  if (o.json) {
+    std::ostringstream j;
+    j.precision(10);
+    j << "{\"inputs\":{\"radius_m\":" << o.radius << ",\"density_kg_m3\":" << o.density
+      << ",\"normal_restitution\":" << o.en << ",\"tangential_restitution\":" << o.et
+      << ",\"max_overlap_ratio\":" << o.overlap_ratio << ",\"max_impact_velocity_m_s\":"
+      << o.velocity << ",\"normal_damping_model\":\"" << o.damping_model << "\"}";
+    for (const Row& row : rows) {
+      const auto& p = row.r.parameters;
+      j << ",\"" << row.name << "\":{\"kn_N_m\":" << p.normal_stiffness
+        << ",\"eta_n_N_s_m\":" << p.normal_damping << ",\"kt_N_m\":" << p.tangential_stiffness
+        << ",\"eta_t_N_s_m\":" << p.tangential_damping
+        << ",\"gamma_t_1_s\":" << row.r.tangential_damping_rate << ",\"mu_c\":" << p.friction
+        << ",\"kr_N_m_rad\":" << p.rolling_stiffness
+        << ",\"eta_r_N_m_s_rad\":" << p.rolling_damping << ",\"mu_r\":" << p.rolling_friction
+        << ",\"contact_time_s\":" << row.r.contact_time
+        << ",\"recommended_time_step_s\":" << row.r.recommended_time_step
+        << ",\"damping_ratio\":" << row.r.damping_ratio
+        << ",\"effective_restitution\":" << row.r.effective_restitution << "}";
+    }
+    j << "}";
+    std::cout << j.str() << "\n";
+    return;
+  }
+  std::printf("Contact parameters by the procedure of thesis §2.4 (eq. 2.16-2.28)\n");
+  std::printf("  inputs: R = %g m, rho = %g kg/m3 (m = %.6g kg), en = %g, et = %g,\n", o.radius,
+              o.density, mass, o.en, o.et);
+  std::printf("          delta_max = %g R, v_max = %g m/s, mu_c = %g, damping model '%s'\n\n",
+              o.overlap_ratio, o.velocity, o.friction, o.damping_model.c_str());
+  std::printf("%-32s %16s %16s\n", "", rows[0].name, rows[1].name);
+  const auto line = [&](const char* label, auto get) {
+    std::printf("%-32s %16.6g %16.6g\n", label, get(rows[0].r), get(rows[1].r));
+  };
+  line("kn [N/m]          eq. 2.21", [](const auto& r) { return r.parameters.normal_stiffness; });
+  line("eta_n [N s/m]     eq. 2.22", [](const auto& r) { return r.parameters.normal_damping; });
+  line("kt [N/m]          eq. 2.23", [](const auto& r) { return r.parameters.tangential_stiffness; });
+  line("eta_t [N s/m]     eq. 2.24", [](const auto& r) { return r.parameters.tangential_damping; });
+  line("gamma_t [1/s]     eta_t/2m_ij", [](const auto& r) { return r.tangential_damping_rate; });
+  line("kr [N m/rad]      eq. 2.28", [](const auto& r) { return r.parameters.rolling_stiffness; });
+  line("eta_r [N m s/rad] eq. 2.28", [](const auto& r) { return r.parameters.rolling_damping; });
+  line("Tc [s]            eq. 2.17", [](const auto& r) { return r.contact_time; });
+  line("dt = Tc/20 [s]", [](const auto& r) { return r.recommended_time_step; });
+  line("damping ratio gamma_n/omega_0", [](const auto& r) { return r.damping_ratio; });
+  line("rebound ratio with max(.,0)", [](const auto& r) { return r.effective_restitution; });
+  std::printf("\nThe last line is the restitution the clamped law of eq. 2.5 really gives; use\n"
+              "--damping-model exact_restitution to make it equal en.\n");
+}
+
+int run_command(const std::string& case_file, const std::string& output, bool restart,
+                bool quiet) {
+  const dem::DemCase c = dem::load_dem_case(case_file);
+  dem::RunOptions options;
+  options.output_dir = output.empty() ? std::filesystem::path("output") / c.name : std::filesystem::path(output);
+  options.restart = restart;
+  options.quiet = quiet;
+  if (std::filesystem::exists(options.output_dir) &&
+      !std::filesystem::is_directory(options.output_dir)) {
+    throw InputError(options.output_dir.string(), "--output", "exists and is not a directory");
+  }
+  dem::run_dem_case(c, options, std::cout);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"sanguis: cell-resolved biological fluids and granular flows (DEM)"};
+  app.set_version_flag("--version", std::string("sanguis ") + sanguis::kVersion);
+  app.require_subcommand(1);
+
+  std::string case_file, output;
+  bool restart = false, quiet = false;
+  auto* run = app.add_subcommand("run", "run a case file");
+  run->add_option("case", case_file, "case file (TOML)")->required();
+  run->add_option("--output,-o", output, "output directory (default: output/<case name>)");
+  run->add_flag("--restart", restart, "continue from OUTPUT/checkpoint.bin");
+  run->add_flag("--quiet,-q", quiet, "no progress line");
+
+  ParamsOptions po;
+  auto* params = app.add_subcommand("params", "contact parameters by the procedure of §2.4");
+  params->add_option("--radius", po.radius, "particle radius [m]")->capture_default_str();
+  params->add_option("--density", po.density, "density [kg/m3]")->capture_default_str();
+  params->add_option("--en", po.en, "normal restitution coefficient")->capture_default_str();
+  params->add_option("--et", po.et, "tangential restitution coefficient")->capture_default_str();
+  params->add_option("--max-overlap-ratio", po.overlap_ratio, "delta_max / R")
+      ->capture_default_str();
+  params->add_option("--max-velocity", po.velocity, "maximum impact velocity v_max [m/s]")
+      ->capture_default_str();
+  params->add_option("--friction", po.friction, "Coulomb friction mu_c")->capture_default_str();
+  params->add_option("--rolling-friction", po.rolling_pp, "rolling friction mu_r (pairs)")
+      ->capture_default_str();
+  params->add_option("--rolling-friction-wall", po.rolling_pw,
+                     "rolling friction mu_r with walls (default: as pairs)");
+  params->add_option("--damping-model", po.damping_model, "thesis | exact_restitution")
+      ->capture_default_str();
+  params->add_flag("--json", po.json, "machine-readable output");
+
+  bench::BenchOptions bo;
+  std::string bench_name;
+  auto* bench_cmd = app.add_subcommand("bench", "throughput benchmarks (one JSON line)");
+  bench_cmd->add_option("name", bench_name, "benchmark: dem-spheres")->required();
+  bench_cmd->add_option("--particles", bo.particles, "number of particles")->capture_default_str();
+  bench_cmd->add_option("--steps", bo.steps, "number of time steps")->capture_default_str();
+  bench_cmd->add_option("--threads", bo.threads, "threads")->capture_default_str();
+  bench_cmd->add_option("--seed", bo.seed, "random seed")->capture_default_str();
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+
+  try {
+    if (*run) return run_command(case_file, output, restart, quiet);
+    if (*params) {
+      print_params(po);
+      return 0;
+    }
+    if (*bench_cmd) {
+      if (bench_name != "dem-spheres") {
+        throw InputError("", "bench", "unknown benchmark '" + bench_name + "' (dem-spheres)");
+      }
+      if (bo.threads != 1) {
+        std::cerr << "sanguis bench: note: the solver is single-threaded for now; "
+                     "--threads is recorded only\n";
+      }
+      std::cout << bench::run_dem_spheres(bo) << std::endl;
+      return 0;
+    }
+  } catch (const InputError& e) {
+    std::cerr << "sanguis: error: " << e.what() << "\n";
+    return 2;
+  } catch (const SimulationError& e) {
+    std::cerr << "sanguis: simulation stopped: " << e.what() << "\n";
+    return 1;
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "sanguis: error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "sanguis: error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,21 @@
+#pragma once
+// Throughput benchmarks behind `sanguis bench NAME`. Each builds its case in code
+// (documented in bench/README.md), times the time loop only (set-up excluded, as
+// LAMMPS reports its loop time) and returns one JSON line.
+#include <cstdint>
+#include <string>
+
+namespace sanguis::bench {
+
+struct BenchOptions {
+  std::int64_t particles = 32000;
+  std::int64_t steps = 2000;
+  int threads = 1;
+  std::uint64_t seed = 4928459;
+};
+
+// dem-spheres: 32,000 spheres on a tilted chute, Table 2.1 contact parameters,
+// matched to LAMMPS gran/hooke/history (bench/lammps/in.dem-spheres).
+std::string run_dem_spheres(const BenchOptions& options);
+
+}  // namespace sanguis::bench

@@ -1,0 +1,57 @@
+#include "core/progress.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <ostream>
+
+namespace sanguis {
+
+ProgressReporter::ProgressReporter(std::ostream& out, bool interactive, double log_interval_s)
+    : out_(out),
+      interactive_(interactive),
+      log_interval_(interactive ? 0.5 : log_interval_s),
+      start_(std::chrono::steady_clock::now()),
+      last_print_(start_) {}
+
+double ProgressReporter::elapsed_seconds() const {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+}
+
+std::string ProgressReporter::format_duration(double seconds) {
+  if (!std::isfinite(seconds) || seconds < 0) return "?";
+  char buf[64];
+  const auto s = static_cast<long long>(std::llround(seconds));
+  if (s < 60) {
+    std::snprintf(buf, sizeof buf, "%llds", s);
+  } else if (s < 3600) {
+    std::snprintf(buf, sizeof buf, "%lldm%02llds", s / 60, s % 60);
+  } else {
+    std::snprintf(buf, sizeof buf, "%lldh%02lldm", s / 3600, (s % 3600) / 60);
+  }
+  return buf;
+}
+
+void ProgressReporter::update(double fraction, const std::string& status, double work_units) {
+  const auto now = std::chrono::steady_clock::now();
+  if (std::chrono::duration<double>(now - last_print_).count() < log_interval_) return;
+  last_print_ = now;
+  const double elapsed = elapsed_seconds();
+  const double eta = fraction > 0 ? elapsed * (1.0 - fraction) / fraction : -1.0;
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "[%5.1f%%] %s  elapsed %s  ETA %s  %.3g /s", 100.0 * fraction,
+                status.c_str(), format_duration(elapsed).c_str(), format_duration(eta).c_str(),
+                elapsed > 0 ? work_units / elapsed : 0.0);
+  if (interactive_) {
+    out_ << '\r' << buf << "\x1b[K" << std::flush;
+  } else {
+    out_ << buf << '\n' << std::flush;
+  }
+  printed_ = true;
+}
+
+void ProgressReporter::finish(const std::string& status) {
+  if (interactive_ && printed_) out_ << '\r' << "\x1b[K";
+  out_ << status << '\n' << std::flush;
+}
+
+}  // namespace sanguis

@@ -1,0 +1,30 @@
+#pragma once
+// Progress line with ETA for long runs. On a terminal it rewrites one line; in a
+// log (CI, nohup) it prints a new line at most every `log_interval` seconds.
+#include <chrono>
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+
+namespace sanguis {
+
+class ProgressReporter {
+ public:
+  ProgressReporter(std::ostream& out, bool interactive, double log_interval_s = 10.0);
+
+  // `fraction` in [0, 1]; `work_units` is cumulative work (e.g. particle-steps) for a rate.
+  void update(double fraction, const std::string& status, double work_units);
+  void finish(const std::string& status);
+
+  double elapsed_seconds() const;
+  static std::string format_duration(double seconds);
+
+ private:
+  std::ostream& out_;
+  bool interactive_;
+  double log_interval_;
+  std::chrono::steady_clock::time_point start_, last_print_;
+  bool printed_ = false;
+};
+
+}  // namespace sanguis

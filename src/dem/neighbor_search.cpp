@@ -1,0 +1,141 @@
+#include "dem/neighbor_search.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace sanguis::dem {
+
+NeighborSearch::NeighborSearch(const Domain& domain, double skin, double max_radius)
+    : domain_(domain), skin_(skin), max_radius_(max_radius) {
+  const double cutoff = 2.0 * max_radius + skin;
+  const Vec3 length = domain.length();
+  for (int k = 0; k < 3; ++k) {
+    const auto ku = static_cast<std::size_t>(k);
+    const auto n = static_cast<std::int64_t>(std::floor(length[k] / cutoff));
+    // Bound the grid so that a huge, sparse domain does not allocate billions of cells.
+    cells_[ku] = std::clamp<std::int64_t>(n, 1, 1024);
+    if (domain.periodic[ku] && cells_[ku] < 3) {
+      throw std::invalid_argument("periodic length along axis " + std::to_string(k) +
+                                  " must be at least 3 cut-offs (3 x (2 R_max + skin) = " +
+                                  std::to_string(3 * cutoff) + " m)");
+    }
+    cell_size_[k] = length[k] / static_cast<double>(cells_[ku]);
+  }
+}
+
+bool NeighborSearch::needs_rebuild(const ParticleStore& particles) const {
+  const std::size_t n = particles.size();
+  if (reference_.size() != n) return true;
+  const double limit2 = 0.25 * skin_ * skin_;
+  const Vec3* x = particles.position.data();
+  const Vec3* r = reference_.data();
+  for (std::size_t i = 0; i < n; ++i) {
+    if (norm2(x[i] - r[i]) > limit2) return true;
+  }
+  return false;
+}
+
+std::int64_t NeighborSearch::cell_of(const Vec3& x) const {
+  std::int64_t index[3];
+  for (int k = 0; k < 3; ++k) {
+    const auto ku = static_cast<std::size_t>(k);
+    double c = std::floor((x[k] - domain_.min[k]) / cell_size_[k]);
+    // Outside a closed domain: clamp into the boundary cell (safe, see README).
+    c = std::clamp(c, 0.0, static_cast<double>(cells_[ku] - 1));
+    index[k] = static_cast<std::int64_t>(c);
+  }
+  return (index[2] * cells_[1] + index[1]) * cells_[0] + index[0];
+}
+
+void NeighborSearch::bin(const ParticleStore& particles) {
+  const std::size_t n_cells = static_cast<std::size_t>(cells_[0] * cells_[1] * cells_[2]);
+  cell_start_.assign(n_cells + 1, 0);
+  std::vector<std::uint32_t> cell_index(particles.size());
+  for (std::size_t i = 0; i < particles.size(); ++i) {
+    cell_index[i] = static_cast<std::uint32_t>(cell_of(particles.position[i]));
+    ++cell_start_[cell_index[i] + 1];
+  }
+  for (std::size_t c = 0; c < n_cells; ++c) cell_start_[c + 1] += cell_start_[c];
+  cell_members_.resize(particles.size());
+  std::vector<std::uint32_t> fill(cell_start_.begin(), cell_start_.end() - 1);
+  for (std::size_t i = 0; i < particles.size(); ++i) {
+    cell_members_[fill[cell_index[i]]++] = static_cast<std::uint32_t>(i);
+  }
+}
+
+void NeighborSearch::rebuild(ParticleStore& particles, const std::vector<Obstacle>& obstacles,
+                             double time, ContactList& pairs, ContactList& walls) {
+  const std::size_t n = particles.size();
+  for (auto& x : particles.position) domain_.wrap(x);
+  bin(particles);
+
+  // Particle pairs: each particle looks at the 27 surrounding cells and keeps j > i,
+  // so each pair appears once, and the list comes out sorted by (i, j).
+  scratch_.clear();
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 xi = particles.position[i];
+    const double ri = particles.radius[i];
+    std::int64_t ci[3];
+    for (int k = 0; k < 3; ++k) {
+      const auto ku = static_cast<std::size_t>(k);
+      ci[k] = std::clamp<std::int64_t>(
+          static_cast<std::int64_t>(std::floor((xi[k] - domain_.min[k]) / cell_size_[k])), 0,
+          cells_[ku] - 1);
+    }
+    candidates_.clear();
+    for (int dz = -1; dz <= 1; ++dz) {
+      std::int64_t cz = ci[2] + dz;
+      if (cz < 0 || cz >= cells_[2]) {
+        if (!domain_.periodic[2]) continue;
+        cz = (cz + cells_[2]) % cells_[2];
+      }
+      for (int dy = -1; dy <= 1; ++dy) {
+        std::int64_t cy = ci[1] + dy;
+        if (cy < 0 || cy >= cells_[1]) {
+          if (!domain_.periodic[1]) continue;
+          cy = (cy + cells_[1]) % cells_[1];
+        }
+        for (int dx = -1; dx <= 1; ++dx) {
+          std::int64_t cx = ci[0] + dx;
+          if (cx < 0 || cx >= cells_[0]) {
+            if (!domain_.periodic[0]) continue;
+            cx = (cx + cells_[0]) % cells_[0];
+          }
+          const auto c = static_cast<std::size_t>((cz * cells_[1] + cy) * cells_[0] + cx);
+          for (std::uint32_t m = cell_start_[c]; m < cell_start_[c + 1]; ++m) {
+            const std::uint32_t j = cell_members_[m];
+            if (j <= i) continue;
+            const double cut = ri + particles.radius[j] + skin_;
+            const Vec3 d = domain_.minimum_image(particles.position[j] - xi);
+            if (norm2(d) < cut * cut) candidates_.push_back(j);
+          }
+        }
+      }
+    }
+    std::sort(candidates_.begin(), candidates_.end());
+    for (std::uint32_t j : candidates_) scratch_.push(static_cast<std::uint32_t>(i), j, {});
+  }
+  carry_history(pairs, scratch_);
+  std::swap(pairs, scratch_);
+
+  // Particle-obstacle pairs, sorted by (particle, obstacle).
+  scratch_.clear();
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t o = 0; o < obstacles.size(); ++o) {
+      if (!obstacles[o].active(time)) continue;
+      const SphereObstacleGap gap =
+          sphere_gap(obstacles[o], particles.position[i], particles.radius[i]);
+      if (gap.overlap > -skin_) {
+        scratch_.push(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(o), {});
+      }
+    }
+  }
+  carry_history(walls, scratch_);
+  std::swap(walls, scratch_);
+
+  reference_ = particles.position;
+  ++rebuilds_;
+}
+
+}  // namespace sanguis::dem

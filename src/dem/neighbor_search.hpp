@@ -1,0 +1,52 @@
+#pragma once
+// Broad phase (thesis app. A.1): a linked-cell grid whose cells are at least one
+// cut-off (largest diameter + skin) wide, building Verlet lists of particle pairs
+// and particle-obstacle pairs within cut-off + skin. Lists are rebuilt only when
+// some particle has moved more than half the skin since the last build.
+#include <cstdint>
+#include <vector>
+
+#include "dem/contact_list.hpp"
+#include "dem/domain.hpp"
+#include "dem/obstacles.hpp"
+#include "dem/particle_store.hpp"
+
+namespace sanguis::dem {
+
+class NeighborSearch {
+ public:
+  NeighborSearch() = default;
+  NeighborSearch(const Domain& domain, double skin, double max_radius);
+
+  // True when the lists may miss a contact: max displacement > skin / 2.
+  bool needs_rebuild(const ParticleStore& particles) const;
+
+  // Wraps periodic positions, bins particles and rebuilds both lists, carrying the
+  // contact histories over. Obstacles inactive at `time` get no entries.
+  void rebuild(ParticleStore& particles, const std::vector<Obstacle>& obstacles, double time,
+               ContactList& pairs, ContactList& walls);
+
+  std::int64_t rebuild_count() const { return rebuilds_; }
+  double skin() const { return skin_; }
+  const std::vector<Vec3>& reference_positions() const { return reference_; }
+  std::vector<Vec3>& reference_positions() { return reference_; }
+  std::int64_t& rebuild_counter() { return rebuilds_; }
+
+ private:
+  void bin(const ParticleStore& particles);
+  std::int64_t cell_of(const Vec3& x) const;
+
+  Domain domain_;
+  double skin_ = 0.0;
+  double max_radius_ = 0.0;
+  std::array<std::int64_t, 3> cells_{1, 1, 1};
+  Vec3 cell_size_;
+  std::vector<std::uint32_t> cell_start_;   // CSR offsets, size n_cells + 1
+  std::vector<std::uint32_t> cell_members_; // particle indices sorted by cell
+  std::vector<Vec3> reference_;             // positions at the last rebuild
+  std::int64_t rebuilds_ = 0;
+  ContactList scratch_;
+  std::vector<std::uint32_t> candidates_;
+};
+
+}  // namespace sanguis::dem

@@ -1,0 +1,90 @@
+#pragma once
+// Fixed obstacles for spheres: infinite planes and finite axis-aligned boxes
+// (a closed container is a set of them). Each may be removed at a given time
+// (the dam-break gate of §3.2.1 when lifted instantly). Narrow phase against a
+// sphere is analytic.
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <variant>
+
+#include "core/vec3.hpp"
+
+namespace sanguis::dem {
+
+struct PlaneShape {
+  Vec3 point;   // any point of the plane [m]
+  Vec3 normal;  // unit normal, pointing to the side where particles live
+};
+
+struct AxisAlignedBoxShape {
+  Vec3 min, max;  // corners [m]
+};
+
+struct Obstacle {
+  std::string name;
+  std::int32_t material = 0;
+  std::variant<PlaneShape, AxisAlignedBoxShape> shape;
+  double remove_at = std::numeric_limits<double>::infinity();  // [s]
+
+  bool active(double time) const { return time < remove_at; }
+};
+
+// Contact of a sphere with an obstacle: overlap (> 0 in contact) and unit normal
+// from the sphere towards the obstacle.
+struct SphereObstacleGap {
+  double overlap = 0.0;
+  Vec3 normal;
+};
+
+inline SphereObstacleGap sphere_gap(const PlaneShape& plane, const Vec3& centre, double radius) {
+  const double height = dot(centre - plane.point, plane.normal);
+  return {radius - height, -plane.normal};
+}
+
+inline SphereObstacleGap sphere_gap(const AxisAlignedBoxShape& box, const Vec3& centre,
+                                    double radius) {
+  Vec3 closest;
+  bool inside = true;
+  for (int k = 0; k < 3; ++k) {
+    double c = centre[k];
+    if (c < box.min[k]) {
+      c = box.min[k];
+      inside = false;
+    } else if (c > box.max[k]) {
+      c = box.max[k];
+      inside = false;
+    }
+    closest[k] = c;
+  }
+  if (!inside) {
+    const Vec3 d = closest - centre;
+    const double dist = norm(d);
+    return {radius - dist, d / dist};
+  }
+  // Centre inside the box: push out through the nearest face.
+  double best = std::numeric_limits<double>::infinity();
+  SphereObstacleGap gap;
+  for (int k = 0; k < 3; ++k) {
+    const double to_min = centre[k] - box.min[k];
+    const double to_max = box.max[k] - centre[k];
+    if (to_min < best) {
+      best = to_min;
+      gap.normal = Vec3{};
+      gap.normal[k] = 1.0;  // obstacle lies on the +k side of the outward -k face
+    }
+    if (to_max < best) {
+      best = to_max;
+      gap.normal = Vec3{};
+      gap.normal[k] = -1.0;
+    }
+  }
+  gap.overlap = radius + best;
+  return gap;
+}
+
+inline SphereObstacleGap sphere_gap(const Obstacle& o, const Vec3& centre, double radius) {
+  return std::visit([&](const auto& shape) { return sphere_gap(shape, centre, radius); }, o.shape);
+}
+
+}  // namespace sanguis::dem

@@ -1,0 +1,336 @@
+#include "dem/simulation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+#include <type_traits>
+
+#include "core/error.hpp"
+#include "core/io/atomic_file.hpp"
+
+namespace sanguis::dem {
+
+DemSimulation::DemSimulation(DemSetup setup)
+    : setup_(std::move(setup)), integrator_(setup_.integrator) {
+  ParticleStore& p = setup_.particles;
+  if (!(setup_.time_step > 0.0)) throw std::invalid_argument("time step must be > 0");
+  double r_max = 0.0, r_min = std::numeric_limits<double>::infinity();
+  for (double r : p.radius) {
+    r_max = std::max(r_max, r);
+    r_min = std::min(r_min, r);
+  }
+  if (p.size() == 0) r_max = r_min = 1.0;
+  if (setup_.skin <= 0.0) setup_.skin = 0.2 * r_min;  // 10% of the smallest diameter
+  const std::size_t n_materials = setup_.contacts.materials();
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (static_cast<std::size_t>(p.material[i]) >= n_materials) {
+      throw std::invalid_argument("particle material index out of range");
+    }
+  }
+  search_ = NeighborSearch(setup_.domain, setup_.skin, r_max);
+  search_.rebuild(p, setup_.obstacles, time(), pairs_, walls_);
+  compute_forces();
+}
+
+void DemSimulation::refresh_forces() {
+  search_.rebuild(setup_.particles, setup_.obstacles, time(), pairs_, walls_);
+  compute_forces();
+}
+
+void DemSimulation::step() {
+  const double dt = setup_.time_step;
+  ParticleStore& p = setup_.particles;
+  integrator_.advance(p, setup_.gravity, dt);
+  ++step_;
+  if (search_.needs_rebuild(p)) search_.rebuild(p, setup_.obstacles, time(), pairs_, walls_);
+  compute_forces();
+  integrator_.finish(p, setup_.gravity, dt);
+  if (step_ % 64 == 0) check_state();
+}
+
+void DemSimulation::run_until(double t) {
+  while (time() < t - 0.5 * setup_.time_step) step();
+}
+
+void DemSimulation::compute_forces() {
+  ParticleStore& p = setup_.particles;
+  const std::size_t n = p.size();
+  const double dt = setup_.time_step;
+  const double now = time();
+  std::fill(p.force.begin(), p.force.end(), Vec3{});
+  std::fill(p.torque.begin(), p.torque.end(), Vec3{});
+  std::fill(p.coordination.begin(), p.coordination.end(), 0);
+
+  const Vec3* x = p.position.data();
+  const Vec3* v = p.velocity.data();
+  const Vec3* w = p.angular_velocity.data();
+  const double* rad = p.radius.data();
+  const std::int32_t* mat = p.material.data();
+  Vec3* f = p.force.data();
+  Vec3* tq = p.torque.data();
+  std::int32_t* coord = p.coordination.data();
+  const Domain& domain = setup_.domain;
+  const bool periodic = domain.periodic[0] || domain.periodic[1] || domain.periodic[2];
+
+  double worst = 0.0;
+  std::int64_t touching = 0;
+  const std::size_t n_pairs = pairs_.size();
+  for (std::size_t k = 0; k < n_pairs; ++k) {
+    const std::uint32_t i = pairs_.first[k];
+    const std::uint32_t j = pairs_.second[k];
+    ContactHistory& h = pairs_.history[k];
+    Vec3 d = x[j] - x[i];
+    if (periodic) d = domain.minimum_image(d);
+    const double sum_r = rad[i] + rad[j];
+    const double dist2 = norm2(d);
+    if (dist2 > sum_r * sum_r) {
+      if (h.normal.x != 0.0 || h.normal.y != 0.0 || h.normal.z != 0.0) h = ContactHistory{};
+      continue;
+    }
+    const double dist = std::sqrt(dist2);
+    const Vec3 normal = dist > 0.0 ? d / dist : Vec3{0.0, 0.0, 1.0};
+    ContactKinematics c;
+    c.normal = normal;
+    c.overlap = sum_r - dist;
+    const Vec3 arm_i = (rad[i] - 0.5 * c.overlap) * normal;   // contact point - x_i
+    const Vec3 arm_j = -(rad[j] - 0.5 * c.overlap) * normal;  // contact point - x_j
+    c.relative_velocity = (v[i] + cross(w[i], arm_i)) - (v[j] + cross(w[j], arm_j));
+    c.relative_angular_velocity = w[i] - w[j];
+    c.reduced_radius = rad[i] * rad[j] / sum_r;
+    const ContactResponse r = evaluate_contact(
+        setup_.contacts.get(static_cast<std::size_t>(mat[i]), static_cast<std::size_t>(mat[j])),
+        c, h, dt);
+    f[i] += r.force;
+    f[j] -= r.force;
+    tq[i] += cross(arm_i, r.force) + r.rolling_torque;
+    tq[j] -= cross(arm_j, r.force) + r.rolling_torque;
+    ++coord[i];
+    ++coord[j];
+    ++touching;
+    worst = std::max(worst, c.overlap / std::min(rad[i], rad[j]));
+  }
+  touching_pairs_ = touching;
+
+  touching = 0;
+  const std::size_t n_walls = walls_.size();
+  for (std::size_t k = 0; k < n_walls; ++k) {
+    const std::uint32_t i = walls_.first[k];
+    const Obstacle& obstacle = setup_.obstacles[walls_.second[k]];
+    ContactHistory& h = walls_.history[k];
+    const SphereObstacleGap gap = obstacle.active(now) ? sphere_gap(obstacle, x[i], rad[i])
+                                                       : SphereObstacleGap{-1.0, {}};
+    if (gap.overlap < 0.0) {
+      if (h.normal.x != 0.0 || h.normal.y != 0.0 || h.normal.z != 0.0) h = ContactHistory{};
+      continue;
+    }
+    ContactKinematics c;
+    c.normal = gap.normal;
+    c.overlap = gap.overlap;
+    const Vec3 arm_i = (rad[i] - 0.5 * c.overlap) * gap.normal;
+    c.relative_velocity = v[i] + cross(w[i], arm_i);  // obstacles are fixed
+    c.relative_angular_velocity = w[i];
+    c.reduced_radius = rad[i];
+    const ContactResponse r = evaluate_contact(
+        setup_.contacts.get(static_cast<std::size_t>(mat[i]),
+                            static_cast<std::size_t>(obstacle.material)),
+        c, h, dt);
+    f[i] += r.force;
+    tq[i] += cross(arm_i, r.force) + r.rolling_torque;
+    ++coord[i];
+    ++touching;
+    worst = std::max(worst, c.overlap / rad[i]);
+  }
+  touching_walls_ = touching;
+  max_overlap_ratio_ = worst;
+  (void)n;
+
+  if (!(worst <= setup_.max_overlap_ratio)) {
+    std::ostringstream msg;
+    msg << "step " << step_ << " (t = " << now << " s): overlap of " << worst
+        << " x radius exceeds the bound " << setup_.max_overlap_ratio
+        << "; the time step is too large for the contact stiffness, or particles were "
+           "created overlapping";
+    throw SimulationError(msg.str());
+  }
+}
+
+void DemSimulation::check_state() const {
+  const ParticleStore& p = setup_.particles;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const Vec3& x = p.position[i];
+    const Vec3& v = p.velocity[i];
+    if (!std::isfinite(x.x + x.y + x.z + v.x + v.y + v.z)) {
+      std::ostringstream msg;
+      msg << "step " << step_ << " (t = " << time() << " s): particle " << p.id[i]
+          << " has a non-finite position or velocity (numerical blow-up)";
+      throw SimulationError(msg.str());
+    }
+  }
+}
+
+DemDiagnostics DemSimulation::diagnostics() const {
+  const ParticleStore& p = setup_.particles;
+  DemDiagnostics d;
+  d.time = time();
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const double v2 = norm2(p.velocity[i]);
+    const double w2 = norm2(p.angular_velocity[i]);
+    d.kinetic_energy_translational += 0.5 * p.mass[i] * v2;
+    d.kinetic_energy_rotational += 0.5 * w2 / p.inverse_inertia[i];
+    const double speed = std::sqrt(v2);
+    d.mean_velocity += speed;
+    d.max_velocity = std::max(d.max_velocity, speed);
+    d.mean_angular_velocity += std::sqrt(w2);
+  }
+  if (p.size() > 0) {
+    d.mean_velocity /= static_cast<double>(p.size());
+    d.mean_angular_velocity /= static_cast<double>(p.size());
+  }
+  d.particle_contacts = touching_pairs_;
+  d.wall_contacts = touching_walls_;
+  d.max_overlap_ratio = max_overlap_ratio_;
+  return d;
+}
+
+// ---------------------------------------------------------------- checkpoints
+
+namespace {
+
+constexpr char kMagic[16] = "SANGUIS-DEM-CK1";
+
+template <typename T>
+void put(std::ostream& out, const T& value) {
+  static_assert(std::is_trivially_copyable_v<T>);
+  out.write(reinterpret_cast<const char*>(&value), sizeof(T));
+}
+
+template <typename T>
+void put(std::ostream& out, const std::vector<T>& values) {
+  static_assert(std::is_trivially_copyable_v<T>);
+  put<std::uint64_t>(out, values.size());
+  out.write(reinterpret_cast<const char*>(values.data()),
+            static_cast<std::streamsize>(values.size() * sizeof(T)));
+}
+
+template <typename T>
+void get(std::istream& in, T& value) {
+  in.read(reinterpret_cast<char*>(&value), sizeof(T));
+  if (!in) throw std::runtime_error("checkpoint is truncated");
+}
+
+template <typename T>
+void get(std::istream& in, std::vector<T>& values) {
+  std::uint64_t n = 0;
+  get(in, n);
+  if (n > (std::uint64_t{1} << 40)) throw std::runtime_error("checkpoint is corrupt");
+  values.resize(n);
+  in.read(reinterpret_cast<char*>(values.data()), static_cast<std::streamsize>(n * sizeof(T)));
+  if (!in) throw std::runtime_error("checkpoint is truncated");
+}
+
+void put_list(std::ostream& out, const ContactList& list) {
+  put(out, list.first);
+  put(out, list.second);
+  put(out, list.history);
+}
+
+void get_list(std::istream& in, ContactList& list) {
+  get(in, list.first);
+  get(in, list.second);
+  get(in, list.history);
+  if (list.second.size() != list.first.size() || list.history.size() != list.first.size()) {
+    throw std::runtime_error("checkpoint contact list is inconsistent");
+  }
+}
+
+template <typename F>
+void for_each_particle_array(ParticleStore& p, F&& f) {
+  f(p.id);
+  f(p.material);
+  f(p.radius);
+  f(p.mass);
+  f(p.inverse_mass);
+  f(p.inverse_inertia);
+  f(p.position);
+  f(p.velocity);
+  f(p.angular_velocity);
+  f(p.force);
+  f(p.torque);
+  f(p.coordination);
+}
+
+}  // namespace
+
+void DemSimulation::save_checkpoint(const std::filesystem::path& file) const {
+  io::write_file_atomically(file, [&](std::ostream& out) {
+    out.write(kMagic, sizeof(kMagic));
+    put(out, setup_.time_step);
+    put(out, static_cast<std::int32_t>(setup_.integrator));
+    put(out, step_);
+    auto& p = const_cast<ParticleStore&>(setup_.particles);
+    for_each_particle_array(p, [&](auto& array) { put(out, array); });
+    const MultistepHistory& h = integrator_.history();
+    put(out, static_cast<std::int32_t>(h.depth));
+    for (int k = 0; k < 2; ++k) {
+      put(out, h.velocity[k]);
+      put(out, h.acceleration[k]);
+      put(out, h.angular_velocity[k]);
+      put(out, h.angular_acceleration[k]);
+    }
+    auto& search = const_cast<NeighborSearch&>(search_);
+    put(out, search.reference_positions());
+    put(out, search.rebuild_counter());
+    put_list(out, pairs_);
+    put_list(out, walls_);
+    put(out, max_overlap_ratio_);
+    put(out, touching_pairs_);
+    put(out, touching_walls_);
+  });
+}
+
+void DemSimulation::load_checkpoint(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw InputError(file.string(), "", "cannot open checkpoint");
+  try {
+    char magic[sizeof(kMagic)] = {};
+    in.read(magic, sizeof(magic));
+    if (!in || std::memcmp(magic, kMagic, sizeof(kMagic)) != 0) {
+      throw std::runtime_error("not a sanguis DEM checkpoint");
+    }
+    double dt = 0.0;
+    std::int32_t kind = 0;
+    get(in, dt);
+    get(in, kind);
+    if (dt != setup_.time_step || kind != static_cast<std::int32_t>(setup_.integrator)) {
+      throw std::runtime_error(
+          "checkpoint was written with another time step or integrator than this case");
+    }
+    get(in, step_);
+    for_each_particle_array(setup_.particles, [&](auto& array) { get(in, array); });
+    MultistepHistory& h = integrator_.history();
+    std::int32_t depth = 0;
+    get(in, depth);
+    h.depth = depth;
+    for (int k = 0; k < 2; ++k) {
+      get(in, h.velocity[k]);
+      get(in, h.acceleration[k]);
+      get(in, h.angular_velocity[k]);
+      get(in, h.angular_acceleration[k]);
+    }
+    get(in, search_.reference_positions());
+    get(in, search_.rebuild_counter());
+    get_list(in, pairs_);
+    get_list(in, walls_);
+    get(in, max_overlap_ratio_);
+    get(in, touching_pairs_);
+    get(in, touching_walls_);
+  } catch (const std::runtime_error& e) {
+    throw InputError(file.string(), "", e.what());
+  }
+}
+
+}  // namespace sanguis::dem

@@ -1,0 +1,108 @@
+#pragma once
+// One DEM system and its time loop (thesis Fig. 2.1): broad phase (when the
+// Verlet lists are stale), contact forces with memory, integration.
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "dem/contact_list.hpp"
+#include "dem/contact_parameters.hpp"
+#include "dem/domain.hpp"
+#include "dem/neighbor_search.hpp"
+#include "dem/obstacles.hpp"
+#include "dem/particle_store.hpp"
+#include "dem/time_integrator.hpp"
+
+namespace sanguis::dem {
+
+// Contact parameters for every ordered pair of materials (symmetric).
+class ContactTable {
+ public:
+  ContactTable() = default;
+  explicit ContactTable(std::size_t materials)
+      : n_(materials), table_(materials * materials), defined_(materials * materials, false) {}
+  void set(std::size_t a, std::size_t b, const ContactParameters& p) {
+    table_[a * n_ + b] = p;
+    table_[b * n_ + a] = p;
+    defined_[a * n_ + b] = defined_[b * n_ + a] = true;
+  }
+  const ContactParameters& get(std::size_t a, std::size_t b) const { return table_[a * n_ + b]; }
+  bool defined(std::size_t a, std::size_t b) const { return defined_[a * n_ + b]; }
+  std::size_t materials() const { return n_; }
+
+ private:
+  std::size_t n_ = 0;
+  std::vector<ContactParameters> table_;
+  std::vector<bool> defined_;
+};
+
+struct DemSetup {
+  Domain domain;
+  Vec3 gravity;                        // [m/s^2]
+  double time_step = 0.0;              // [s]
+  IntegratorKind integrator = IntegratorKind::kLeapfrog;
+  double skin = 0.0;                   // Verlet skin [m]; 0 -> 0.1 x smallest diameter
+  double max_overlap_ratio = 0.5;      // overlap / R beyond which the run stops as unstable
+  std::vector<std::string> material_names;
+  ContactTable contacts;
+  std::vector<Obstacle> obstacles;
+  ParticleStore particles;
+};
+
+struct DemDiagnostics {
+  double time = 0.0;
+  double kinetic_energy_translational = 0.0;  // [J]
+  double kinetic_energy_rotational = 0.0;     // [J]
+  double mean_velocity = 0.0;                 // mean |v| [m/s]
+  double max_velocity = 0.0;                  // [m/s]
+  double mean_angular_velocity = 0.0;         // mean |omega| [rad/s]
+  std::int64_t particle_contacts = 0;         // touching particle pairs
+  std::int64_t wall_contacts = 0;             // touching particle-obstacle pairs
+  double max_overlap_ratio = 0.0;             // max overlap / smaller radius
+};
+
+class DemSimulation {
+ public:
+  explicit DemSimulation(DemSetup setup);
+
+  // Advances one time step.
+  void step();
+  // Advances until time() >= t (within half a step).
+  void run_until(double t);
+
+  double time() const { return static_cast<double>(step_) * setup_.time_step; }
+  std::int64_t step_index() const { return step_; }
+  double time_step() const { return setup_.time_step; }
+  const DemSetup& setup() const { return setup_; }
+  const ParticleStore& particles() const { return setup_.particles; }
+  ParticleStore& particles() { return setup_.particles; }
+  const ContactList& particle_contacts() const { return pairs_; }
+  const ContactList& wall_contacts() const { return walls_; }
+  TimeIntegrator& integrator() { return integrator_; }
+  const NeighborSearch& neighbor_search() const { return search_; }
+
+  DemDiagnostics diagnostics() const;
+
+  // Bit-for-bit restart: everything that influences later steps is saved.
+  void save_checkpoint(const std::filesystem::path& file) const;
+  // Loads a checkpoint written by a simulation built from the same setup.
+  void load_checkpoint(const std::filesystem::path& file);
+
+  // Recomputes forces at the current state (after the state was edited by hand).
+  void refresh_forces();
+
+ private:
+  void compute_forces();
+  void check_state() const;
+
+  DemSetup setup_;
+  TimeIntegrator integrator_;
+  NeighborSearch search_;
+  ContactList pairs_, walls_;
+  std::int64_t step_ = 0;
+  double max_overlap_ratio_ = 0.0;
+  std::int64_t touching_pairs_ = 0, touching_walls_ = 0;
+};
+
+}  // namespace sanguis::dem
