@@ -74,13 +74,23 @@ void TimeIntegrator::advance(ParticleStore& p, const Vec3& gravity, double dt) {
         w[i] += (dt * inv_i[i]) * t[i];
       }
       break;
-    case IntegratorKind::kLeapfrog:  // eq. 2.31, kick-drift half
+    case IntegratorKind::kLeapfrog: {  // eq. 2.31, kick-drift half
+      half_velocity_.resize(n);
+      half_angular_velocity_.resize(n);
       for (std::size_t i = 0; i < n; ++i) {
-        v[i] += (0.5 * dt) * (inv_m[i] * f[i] + gravity);
-        w[i] += (0.5 * dt * inv_i[i]) * t[i];
-        x[i] += dt * v[i];
+        const Vec3 kick = (0.5 * dt) * (inv_m[i] * f[i] + gravity);
+        const Vec3 spin = (0.5 * dt * inv_i[i]) * t[i];
+        half_velocity_[i] = v[i] + kick;
+        half_angular_velocity_[i] = w[i] + spin;
+        x[i] += dt * half_velocity_[i];
+        // The forces at x_{n+1} see the predicted v_{n+1} = v_n + dt a_n rather than
+        // v_{n+1/2}: with velocity-dependent (damping) forces this keeps the scheme
+        // second order (the half-step velocity makes it first order, see Fig. 2.5 report).
+        v[i] = half_velocity_[i] + kick;
+        w[i] = half_angular_velocity_[i] + spin;
       }
       break;
+    }
     case IntegratorKind::kAdamsBashforth2:
     case IntegratorKind::kAdamsBashforth3: {  // eq. 2.32 and its third-order sibling
       MultistepHistory& h = history_;
@@ -118,8 +128,9 @@ void TimeIntegrator::finish(ParticleStore& p, const Vec3& gravity, double dt) {
   if (kind_ != IntegratorKind::kLeapfrog) return;
   const std::size_t n = p.size();
   for (std::size_t i = 0; i < n; ++i) {  // final half kick with a_{n+1}
-    p.velocity[i] += (0.5 * dt) * (p.inverse_mass[i] * p.force[i] + gravity);
-    p.angular_velocity[i] += (0.5 * dt * p.inverse_inertia[i]) * p.torque[i];
+    p.velocity[i] = half_velocity_[i] + (0.5 * dt) * (p.inverse_mass[i] * p.force[i] + gravity);
+    p.angular_velocity[i] =
+        half_angular_velocity_[i] + (0.5 * dt * p.inverse_inertia[i]) * p.torque[i];
   }
 }
 

@@ -13,7 +13,8 @@
 // x_{n+1} = x_n + dt v_{n+1/2}, v_{n+1} = v_{n+1/2} + dt/2 a_{n+1}. Its positions are
 // those of eq. 2.31 (with the Euler half-step start the thesis describes) and its
 // velocities are synchronised with the positions, so outputs need no interpolation.
-// Forces at x_{n+1} see the half-step velocity v_{n+1/2}.
+// Forces at x_{n+1} see the predicted velocity v_n + dt a_n, not v_{n+1/2}: with
+// damping forces the half-step velocity would make the scheme first order.
 #include <array>
 #include <string>
 #include <vector>
@@ -50,6 +51,8 @@ class TimeIntegrator {
  private:
   IntegratorKind kind_;
   MultistepHistory history_;
+  // Leapfrog: v_{n+1/2} between advance() and finish() (not state: rebuilt every step).
+  std::vector<Vec3> half_velocity_, half_angular_velocity_;
 };
 
 }  // namespace sanguis::dem
