@@ -63,17 +63,17 @@ void print_params(const ParamsOptions& o) {
     j.precision(10);
     j << "{\"inputs\":{\"radius_m\":" << o.radius << ",\"density_kg_m3\":" << o.density
       << ",\"normal_restitution\":" << o.en << ",\"tangential_restitution\":" << o.et
-      << ",\"max_overlap_ratio\":" << o.overlap_ratio << ",\"max_impact_velocity_m_s\":"
-      << o.velocity << ",\"normal_damping_model\":\"" << o.damping_model << "\"}";
+      << ",\"max_overlap_ratio\":" << o.overlap_ratio
+      << ",\"max_impact_velocity_m_s\":" << o.velocity << ",\"normal_damping_model\":\""
+      << o.damping_model << "\"}";
     for (const Row& row : rows) {
       const auto& p = row.r.parameters;
       j << ",\"" << row.name << "\":{\"kn_N_m\":" << p.normal_stiffness
         << ",\"eta_n_N_s_m\":" << p.normal_damping << ",\"kt_N_m\":" << p.tangential_stiffness
         << ",\"eta_t_N_s_m\":" << p.tangential_damping
         << ",\"gamma_t_1_s\":" << row.r.tangential_damping_rate << ",\"mu_c\":" << p.friction
-        << ",\"kr_N_m_rad\":" << p.rolling_stiffness
-        << ",\"eta_r_N_m_s_rad\":" << p.rolling_damping << ",\"mu_r\":" << p.rolling_friction
-        << ",\"contact_time_s\":" << row.r.contact_time
+        << ",\"kr_N_m_rad\":" << p.rolling_stiffness << ",\"eta_r_N_m_s_rad\":" << p.rolling_damping
+        << ",\"mu_r\":" << p.rolling_friction << ",\"contact_time_s\":" << row.r.contact_time
         << ",\"recommended_time_step_s\":" << row.r.recommended_time_step
         << ",\"damping_ratio\":" << row.r.damping_ratio
         << ",\"effective_restitution\":" << row.r.effective_restitution << "}";
@@ -93,7 +93,8 @@ void print_params(const ParamsOptions& o) {
   };
   line("kn [N/m]          eq. 2.21", [](const auto& r) { return r.parameters.normal_stiffness; });
   line("eta_n [N s/m]     eq. 2.22", [](const auto& r) { return r.parameters.normal_damping; });
-  line("kt [N/m]          eq. 2.23", [](const auto& r) { return r.parameters.tangential_stiffness; });
+  line("kt [N/m]          eq. 2.23",
+       [](const auto& r) { return r.parameters.tangential_stiffness; });
   line("eta_t [N s/m]     eq. 2.24", [](const auto& r) { return r.parameters.tangential_damping; });
   line("gamma_t [1/s]     eta_t/2m_ij", [](const auto& r) { return r.tangential_damping_rate; });
   line("kr [N m/rad]      eq. 2.28", [](const auto& r) { return r.parameters.rolling_stiffness; });
@@ -102,15 +103,16 @@ void print_params(const ParamsOptions& o) {
   line("dt = Tc/20 [s]", [](const auto& r) { return r.recommended_time_step; });
   line("damping ratio gamma_n/omega_0", [](const auto& r) { return r.damping_ratio; });
   line("rebound ratio with max(.,0)", [](const auto& r) { return r.effective_restitution; });
-  std::printf("\nThe last line is the restitution the clamped law of eq. 2.5 really gives; use\n"
-              "--damping-model exact_restitution to make it equal en.\n");
+  std::printf(
+      "\nThe last line is the restitution the clamped law of eq. 2.5 really gives; use\n"
+      "--damping-model exact_restitution to make it equal en.\n");
 }
 
-int run_command(const std::string& case_file, const std::string& output, bool restart,
-                bool quiet) {
+int run_command(const std::string& case_file, const std::string& output, bool restart, bool quiet) {
   const dem::DemCase c = dem::load_dem_case(case_file);
   dem::RunOptions options;
-  options.output_dir = output.empty() ? std::filesystem::path("output") / c.name : std::filesystem::path(output);
+  options.output_dir =
+      output.empty() ? std::filesystem::path("output") / c.name : std::filesystem::path(output);
   options.restart = restart;
   options.quiet = quiet;
   if (std::filesystem::exists(options.output_dir) &&

@@ -37,7 +37,8 @@ dem::DemSetup dem_spheres_setup(const BenchOptions& o) {
   const double kn = 7.34e5, kt = 2.26e5, en = 0.45, et = 0.3;
   const double m_pair = 0.5 * mass;
   const double omega0 = std::sqrt(kn / m_pair);
-  const double eta_n = -2.0 * m_pair * omega0 * std::log(en) / std::sqrt(kPi * kPi + std::log(en) * std::log(en));
+  const double eta_n =
+      -2.0 * m_pair * omega0 * std::log(en) / std::sqrt(kPi * kPi + std::log(en) * std::log(en));
   const double eta_t = eta_n / 3.5 * std::log(et) / std::log(en);
   dem::ContactParameters pair;
   pair.normal_stiffness = kn;
@@ -74,11 +75,13 @@ dem::DemSetup dem_spheres_setup(const BenchOptions& o) {
 }  // namespace
 
 std::string run_dem_spheres(const BenchOptions& o) {
-  if (o.particles <= 0 || o.steps <= 0) throw std::invalid_argument("particles and steps must be > 0");
+  if (o.particles <= 0 || o.steps <= 0)
+    throw std::invalid_argument("particles and steps must be > 0");
   dem::DemSimulation sim(dem_spheres_setup(o));
   const auto start = std::chrono::steady_clock::now();
   for (std::int64_t s = 0; s < o.steps; ++s) sim.step();
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::ostringstream json;
   json.precision(6);
   json << "{\"benchmark\":\"dem-spheres\",\"code\":\"sanguis\",\"particles\":" << o.particles

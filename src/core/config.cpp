@@ -1,7 +1,7 @@
 #include "core/config.hpp"
 
-#include <sstream>
 #include <toml++/toml.h>
+#include <sstream>
 
 namespace sanguis {
 
@@ -15,13 +15,20 @@ namespace {
 
 std::string type_name(const toml::node& n) {
   switch (n.type()) {
-    case toml::node_type::table: return "a table";
-    case toml::node_type::array: return "an array";
-    case toml::node_type::string: return "a string";
-    case toml::node_type::integer: return "an integer";
-    case toml::node_type::floating_point: return "a number";
-    case toml::node_type::boolean: return "a boolean";
-    default: return "a date/time";
+    case toml::node_type::table:
+      return "a table";
+    case toml::node_type::array:
+      return "an array";
+    case toml::node_type::string:
+      return "a string";
+    case toml::node_type::integer:
+      return "an integer";
+    case toml::node_type::floating_point:
+      return "a number";
+    case toml::node_type::boolean:
+      return "a boolean";
+    default:
+      return "a date/time";
   }
 }
 
@@ -91,11 +98,17 @@ void ConfigTable::fail(const std::string& key, const std::string& reason) const 
   throw InputError(source_, path_of(key), reason);
 }
 
-const toml::node* ConfigTable::lookup(const std::string& key) const { return node_->get(key); }
+const toml::node* ConfigTable::lookup(const std::string& key) const {
+  return node_->get(key);
+}
 
-void ConfigTable::mark(const std::string& key) const { shared_->used.insert(path_of(key)); }
+void ConfigTable::mark(const std::string& key) const {
+  shared_->used.insert(path_of(key));
+}
 
-bool ConfigTable::has(const std::string& key) const { return lookup(key) != nullptr; }
+bool ConfigTable::has(const std::string& key) const {
+  return lookup(key) != nullptr;
+}
 
 const toml::node& ConfigTable::require(const std::string& key) const {
   const toml::node* n = lookup(key);
@@ -275,7 +288,8 @@ namespace {
 void collect_unknown(const toml::table& t, const std::string& prefix,
                      const std::set<std::string>& used, std::vector<std::string>& unknown) {
   for (const auto& [k, v] : t) {
-    const std::string path = prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str());
+    const std::string path =
+        prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str());
     if (!used.count(path)) {
       unknown.push_back(path);
       continue;

@@ -28,16 +28,16 @@ struct ContactHistory {
 };
 
 struct ContactKinematics {
-  Vec3 normal;                       // unit, first -> second
-  double overlap = 0.0;              // dn > 0 in contact [m]
-  Vec3 relative_velocity;            // at the contact point, first minus second [m/s]
-  Vec3 relative_angular_velocity;    // omega_first - omega_second [rad/s]
-  double reduced_radius = 0.0;       // R_ij [m], eq. 2.13
+  Vec3 normal;                     // unit, first -> second
+  double overlap = 0.0;            // dn > 0 in contact [m]
+  Vec3 relative_velocity;          // at the contact point, first minus second [m/s]
+  Vec3 relative_angular_velocity;  // omega_first - omega_second [rad/s]
+  double reduced_radius = 0.0;     // R_ij [m], eq. 2.13
 };
 
 struct ContactResponse {
-  Vec3 force;             // on the first body [N]
-  Vec3 rolling_torque;    // on the first body [N m], in addition to the moment of `force`
+  Vec3 force;                 // on the first body [N]
+  Vec3 rolling_torque;        // on the first body [N m], in addition to the moment of `force`
   double normal_force = 0.0;  // |Fn| [N]
 };
 
@@ -58,7 +58,8 @@ inline ContactResponse evaluate_contact(const ContactParameters& p, const Contac
   const double normal_speed = dot(c.relative_velocity, n);  // d(dn)/dt
 
   // eq. 2.5: viscoelastic, never attractive.
-  const double fn = std::fmax(p.normal_stiffness * c.overlap + p.normal_damping * normal_speed, 0.0);
+  const double fn =
+      std::fmax(p.normal_stiffness * c.overlap + p.normal_damping * normal_speed, 0.0);
   out.normal_force = fn;
   out.force = -fn * n;
 
@@ -66,8 +67,7 @@ inline ContactResponse evaluate_contact(const ContactParameters& p, const Contac
 
   // eq. 2.6-2.8: tangential spring-dashpot with cumulative displacement.
   const Vec3 vt = c.relative_velocity - normal_speed * n;
-  Vec3 delta = continuing ? rotate_into_new_plane(h.tangential_displacement, h.normal, n)
-                          : Vec3{};
+  Vec3 delta = continuing ? rotate_into_new_plane(h.tangential_displacement, h.normal, n) : Vec3{};
   delta += dt * vt;
   Vec3 ft = -p.tangential_stiffness * delta - p.tangential_damping * vt;
   const double ft_norm = norm(ft);
@@ -94,7 +94,7 @@ inline ContactResponse evaluate_contact(const ContactParameters& p, const Contac
       out.rolling_torque = mk - p.rolling_damping * c.relative_angular_velocity;  // eq. 2.11
     } else {
       mk = mk_norm > 0.0 ? (m_max / mk_norm) * mk : Vec3{};  // eq. 2.10 saturated, eq. 2.12
-      out.rolling_torque = mk;  // Md = 0 while saturated (eq. 2.11)
+      out.rolling_torque = mk;                               // Md = 0 while saturated (eq. 2.11)
     }
     h.rolling_spring_torque = mk;
   }

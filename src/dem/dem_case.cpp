@@ -40,7 +40,9 @@ struct ParticleGroup {
   double velocity_noise = 0.0;
 };
 
-double sphere_mass(double r, double density) { return 4.0 / 3.0 * kPi * r * r * r * density; }
+double sphere_mass(double r, double density) {
+  return 4.0 / 3.0 * kPi * r * r * r * density;
+}
 
 std::size_t material_index(const ConfigTable& t, const std::string& key,
                            const std::vector<MaterialSpec>& materials) {
@@ -158,8 +160,8 @@ double contact_time(const ContactParameters& p, double reduced_mass) {
 }
 
 ResolvedInteraction parse_interaction(const ConfigTable& t,
-                                      const std::vector<MaterialSpec>& materials,
-                                      std::size_t& a, std::size_t& b) {
+                                      const std::vector<MaterialSpec>& materials, std::size_t& a,
+                                      std::size_t& b) {
   const std::vector<std::string> names = t.get_string_list("materials");
   if (names.size() != 2) t.fail("materials", "must name exactly two materials");
   auto find = [&](const std::string& n) {
@@ -172,8 +174,9 @@ ResolvedInteraction parse_interaction(const ConfigTable& t,
   const MaterialSpec& ma = materials[a];
   const MaterialSpec& mb = materials[b];
   if (!ma.used_by_particles && !mb.used_by_particles) {
-    t.fail("materials", "no particle uses either material; interactions between obstacles are "
-                        "not computed");
+    t.fail("materials",
+           "no particle uses either material; interactions between obstacles are "
+           "not computed");
   }
   if (!ma.used_by_particles) std::swap(a, b);  // particle material first
   const MaterialSpec& mp = materials[a];
@@ -236,6 +239,13 @@ ResolvedInteraction parse_interaction(const ConfigTable& t,
     p.rolling_stiffness = t.get_non_negative("rolling_stiffness_N_m_rad", 0.0);
     p.rolling_damping = t.get_non_negative("rolling_damping_N_m_s_rad", 0.0);
   }
+  // Without memory the tangential and rolling springs (kt dt and kr dtheta of eq. 2.6 and
+  // 2.10) are dropped, leaving dashpots with Coulomb limits: the model of Fig. 2.6's dotted line.
+  out.memory = t.get_bool("memory", true);
+  if (!out.memory) {
+    out.parameters.tangential_stiffness = 0.0;
+    out.parameters.rolling_stiffness = 0.0;
+  }
   out.contact_time = contact_time(out.parameters, reduced_mass_min);
   return out;
 }
@@ -255,9 +265,8 @@ DemCase load_dem_case(const ConfigTable& cfg, const std::filesystem::path& sourc
   const ConfigTable sim = cfg.table("simulation");
   c.name = sim.get_string("name", source.stem().string());
   c.stop.end_time = sim.get_positive("end_time_s");
-  s.integrator = parse_integrator(
-      sim.get_choice("integrator", {"euler", "leapfrog", "adams_bashforth_2", "adams_bashforth_3"},
-                     "leapfrog"));
+  s.integrator = parse_integrator(sim.get_choice(
+      "integrator", {"euler", "leapfrog", "adams_bashforth_2", "adams_bashforth_3"}, "leapfrog"));
   const std::int64_t seed = sim.get_int("seed", 1);
   if (seed < 0) sim.fail("seed", "must be >= 0");
   c.seed = static_cast<std::uint64_t>(seed);
@@ -295,7 +304,8 @@ DemCase load_dem_case(const ConfigTable& cfg, const std::filesystem::path& sourc
     s.obstacles.push_back(parse_obstacle(obstacle_tables[k], materials, k));
   }
   std::vector<ParticleGroup> groups;
-  for (const ConfigTable& t : cfg.table_array("particles")) groups.push_back(parse_group(t, materials));
+  for (const ConfigTable& t : cfg.table_array("particles"))
+    groups.push_back(parse_group(t, materials));
   if (groups.empty()) cfg.fail("particles", "at least one [[particles]] group is required");
   for (const auto& m : materials) {
     if (m.used_by_particles && m.used_by_obstacles) {
@@ -324,8 +334,8 @@ DemCase load_dem_case(const ConfigTable& cfg, const std::filesystem::path& sourc
     for (std::size_t b = 0; b < materials.size(); ++b) {
       if (!(materials[b].used_by_particles || materials[b].used_by_obstacles)) continue;
       if (!s.contacts.defined(a, b)) {
-        cfg.fail("interaction", "no [[interaction]] for materials ['" + materials[a].name +
-                                    "', '" + materials[b].name + "']");
+        cfg.fail("interaction", "no [[interaction]] for materials ['" + materials[a].name + "', '" +
+                                    materials[b].name + "']");
       }
     }
   }
@@ -448,8 +458,8 @@ std::string describe(const DemCase& c) {
     << ")\n";
   o << "time step       " << s.time_step << " s  = Tc / " << c.smallest_contact_time / s.time_step
     << "  (smallest contact time Tc = " << c.smallest_contact_time << " s)\n";
-  o << "end time        " << c.stop.end_time << " s  (" << std::llround(c.stop.end_time / s.time_step)
-    << " steps)\n";
+  o << "end time        " << c.stop.end_time << " s  ("
+    << std::llround(c.stop.end_time / s.time_step) << " steps)\n";
   o << "gravity         [" << s.gravity.x << ", " << s.gravity.y << ", " << s.gravity.z
     << "] m/s^2\n";
   o << "domain          [" << s.domain.min.x << ", " << s.domain.min.y << ", " << s.domain.min.z
@@ -459,7 +469,8 @@ std::string describe(const DemCase& c) {
   o << "seed            " << c.seed << "\n";
   for (const auto& r : c.interactions) {
     const ContactParameters& p = r.parameters;
-    o << "interaction     " << r.first << " - " << r.second << (r.wall ? " (wall)" : "") << "\n";
+    o << "interaction     " << r.first << " - " << r.second << (r.wall ? " (wall)" : "")
+      << (r.memory ? "" : "  WITHOUT MEMORY (kt = kr = 0)") << "\n";
     o << "  kn = " << p.normal_stiffness << " N/m, eta_n = " << p.normal_damping
       << " N s/m, kt = " << p.tangential_stiffness << " N/m, eta_t = " << p.tangential_damping
       << " N s/m, mu_c = " << p.friction << "\n";
@@ -468,8 +479,7 @@ std::string describe(const DemCase& c) {
     if (r.procedure) {
       o << "  from §2.4: damping ratio " << r.procedure->damping_ratio
         << ", gamma_t = " << r.procedure->tangential_damping_rate
-        << " 1/s, rebound ratio of the clamped law " << r.procedure->effective_restitution
-        << "\n";
+        << " 1/s, rebound ratio of the clamped law " << r.procedure->effective_restitution << "\n";
     }
   }
   return o.str();

@@ -22,18 +22,19 @@ struct OutputSettings {
 };
 
 struct StopSettings {
-  double end_time = 0.0;                            // [s]
-  std::optional<double> mean_velocity_below;        // settle criterion [m/s]
-  double settle_check_after = 0.0;                  // [s] no settle check before this time
+  double end_time = 0.0;                      // [s]
+  std::optional<double> mean_velocity_below;  // settle criterion [m/s]
+  double settle_check_after = 0.0;            // [s] no settle check before this time
 };
 
 // One resolved interaction, for the run log and `sanguis params`.
 struct ResolvedInteraction {
   std::string first, second;
   bool wall = false;
+  bool memory = true;  // false: kt = kr = 0
   ContactParameters parameters;
-  double reduced_mass = 0.0;     // of the check (smallest particles) [kg]
-  double contact_time = 0.0;     // Tc (eq. 2.17) for the smallest particles [s]
+  double reduced_mass = 0.0;                 // of the check (smallest particles) [kg]
+  double contact_time = 0.0;                 // Tc (eq. 2.17) for the smallest particles [s]
   std::optional<ProcedureResult> procedure;  // when derived by §2.4
 };
 

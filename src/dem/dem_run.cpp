@@ -18,10 +18,15 @@ namespace sanguis::dem {
 
 namespace {
 
-const std::vector<std::string> kDiagnosticColumns = {
-    "time_s",          "kinetic_energy_translational_J", "kinetic_energy_rotational_J",
-    "mean_velocity_m_s", "max_velocity_m_s",             "mean_angular_velocity_rad_s",
-    "particle_contacts", "wall_contacts",                "max_overlap_over_radius"};
+const std::vector<std::string> kDiagnosticColumns = {"time_s",
+                                                     "kinetic_energy_translational_J",
+                                                     "kinetic_energy_rotational_J",
+                                                     "mean_velocity_m_s",
+                                                     "max_velocity_m_s",
+                                                     "mean_angular_velocity_rad_s",
+                                                     "particle_contacts",
+                                                     "wall_contacts",
+                                                     "max_overlap_over_radius"};
 
 std::vector<double> diagnostic_row(const DemDiagnostics& d) {
   return {d.time,

@@ -11,9 +11,9 @@ namespace sanguis::dem {
 
 struct RunOptions {
   std::filesystem::path output_dir;
-  bool restart = false;      // continue from output_dir/checkpoint.bin
-  bool quiet = false;        // no progress line
-  double stop_at = -1.0;     // stop (with a checkpoint) at this time instead of end_time; < 0: off
+  bool restart = false;   // continue from output_dir/checkpoint.bin
+  bool quiet = false;     // no progress line
+  double stop_at = -1.0;  // stop (with a checkpoint) at this time instead of end_time; < 0: off
 };
 
 struct RunSummary {

@@ -41,7 +41,8 @@ class SphereHash {
           const std::uint64_t k = key(wrapped({c[0] + dx, c[1] + dy, c[2] + dz}));
           // With fewer than 3 cells along a periodic axis two offsets hit one cell.
           bool duplicate = false;
-          for (int s = 0; s < n_seen; ++s) duplicate |= seen[static_cast<std::size_t>(s)] == static_cast<std::int64_t>(k);
+          for (int s = 0; s < n_seen; ++s)
+            duplicate |= seen[static_cast<std::size_t>(s)] == static_cast<std::int64_t>(k);
           if (duplicate) continue;
           seen[static_cast<std::size_t>(n_seen++)] = static_cast<std::int64_t>(k);
           auto it = cells_.find(k);
@@ -92,8 +93,8 @@ bool overlaps_obstacle(const Vec3& x, double r, const std::vector<Obstacle>& obs
 std::vector<SphereSeed> random_spheres(std::size_t count, double r_min, double r_max,
                                        const Vec3& region_min, const Vec3& region_max,
                                        const std::vector<SphereSeed>& existing,
-                                       const std::vector<Obstacle>& obstacles,
-                                       const Domain& domain, std::mt19937_64& rng) {
+                                       const std::vector<Obstacle>& obstacles, const Domain& domain,
+                                       std::mt19937_64& rng) {
   for (int k = 0; k < 3; ++k) {
     if (region_max[k] - region_min[k] < 2.0 * r_max) {
       throw std::runtime_error("region is thinner than one particle diameter");
@@ -117,7 +118,8 @@ std::vector<SphereSeed> random_spheres(std::size_t count, double r_min, double r
     SphereSeed s;
     s.radius = r_min + (r_max - r_min) * unit(rng);
     for (int k = 0; k < 3; ++k) {
-      s.position[k] = region_min[k] + s.radius + (region_max[k] - region_min[k] - 2 * s.radius) * unit(rng);
+      s.position[k] =
+          region_min[k] + s.radius + (region_max[k] - region_min[k] - 2 * s.radius) * unit(rng);
     }
     const bool blocked = hash.any_near(s.position, [&](std::size_t j) {
       const Vec3 d = domain.minimum_image(all[j].position - s.position);
@@ -138,7 +140,8 @@ std::vector<Vec3> lattice_sites(const Vec3& region_min, const Vec3& region_max, 
   std::array<std::int64_t, 3> n{};
   for (int k = 0; k < 3; ++k) {
     const double room = region_max[k] - region_min[k] - 2.0 * radius;
-    n[static_cast<std::size_t>(k)] = room < 0 ? 0 : static_cast<std::int64_t>(std::floor(room / spacing + 1e-9)) + 1;
+    n[static_cast<std::size_t>(k)] =
+        room < 0 ? 0 : static_cast<std::int64_t>(std::floor(room / spacing + 1e-9)) + 1;
   }
   for (std::int64_t iz = 0; iz < n[2]; ++iz)
     for (std::int64_t iy = 0; iy < n[1]; ++iy)
@@ -173,7 +176,8 @@ std::optional<std::string> find_overlap(const std::vector<SphereSeed>& spheres,
     });
     hash.add(s, i);
     for (const Obstacle& o : obstacles) {
-      if (!found && o.active(0.0) && sphere_gap(o, s.position, s.radius).overlap > tolerance * s.radius) {
+      if (!found && o.active(0.0) &&
+          sphere_gap(o, s.position, s.radius).overlap > tolerance * s.radius) {
         found = "particle " + std::to_string(i) + " overlaps obstacle '" + o.name + "'";
       }
     }

@@ -26,8 +26,8 @@ struct SphereSeed {
 std::vector<SphereSeed> random_spheres(std::size_t count, double r_min, double r_max,
                                        const Vec3& region_min, const Vec3& region_max,
                                        const std::vector<SphereSeed>& existing,
-                                       const std::vector<Obstacle>& obstacles,
-                                       const Domain& domain, std::mt19937_64& rng);
+                                       const std::vector<Obstacle>& obstacles, const Domain& domain,
+                                       std::mt19937_64& rng);
 
 // Simple cubic lattice of the given spacing starting at region_min + r, filling x
 // first, then y, then z, at most `max_count` sites (0: no limit).

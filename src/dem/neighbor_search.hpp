@@ -41,9 +41,9 @@ class NeighborSearch {
   double max_radius_ = 0.0;
   std::array<std::int64_t, 3> cells_{1, 1, 1};
   Vec3 cell_size_;
-  std::vector<std::uint32_t> cell_start_;   // CSR offsets, size n_cells + 1
-  std::vector<std::uint32_t> cell_members_; // particle indices sorted by cell
-  std::vector<Vec3> reference_;             // positions at the last rebuild
+  std::vector<std::uint32_t> cell_start_;    // CSR offsets, size n_cells + 1
+  std::vector<std::uint32_t> cell_members_;  // particle indices sorted by cell
+  std::vector<Vec3> reference_;              // positions at the last rebuild
   std::int64_t rebuilds_ = 0;
   ContactList scratch_;
   std::vector<std::uint32_t> candidates_;

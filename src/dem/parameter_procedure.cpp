@@ -44,8 +44,8 @@ OverdampedRoots overdamped_roots(double d) {
 NormalDampingModel parse_normal_damping_model(const std::string& name) {
   if (name == "thesis") return NormalDampingModel::kThesis;
   if (name == "exact_restitution") return NormalDampingModel::kExactRestitution;
-  throw std::invalid_argument("normal damping model must be 'thesis' or 'exact_restitution', got '" +
-                              name + "'");
+  throw std::invalid_argument(
+      "normal damping model must be 'thesis' or 'exact_restitution', got '" + name + "'");
 }
 
 const char* to_string(NormalDampingModel model) {
@@ -143,8 +143,8 @@ ProcedureResult derive_contact_parameters(const ProcedureInput& in) {
 
   // Step 4 (eq. 2.23-2.24, Pournin).
   const double inertia = 1.0 + in.inertia_factor;
-  p.tangential_stiffness = p.normal_stiffness / inertia * (kPi * kPi + log_et * log_et) /
-                           (kPi * kPi + log_en * log_en);
+  p.tangential_stiffness =
+      p.normal_stiffness / inertia * (kPi * kPi + log_et * log_et) / (kPi * kPi + log_en * log_en);
   if (in.normal_restitution < 1.0) {
     p.tangential_damping = p.normal_damping / inertia * log_et / log_en;
   } else {
@@ -166,8 +166,7 @@ ProcedureResult derive_contact_parameters(const ProcedureInput& in) {
   out.effective_restitution = clamped_restitution(d);
   out.tangential_damping_rate = p.tangential_damping / (2.0 * m);
   // 20 steps per contact (Kruggel-Emden); the clamped duration when overdamped (no Tc).
-  out.recommended_time_step =
-      (d < 1.0 ? out.contact_time : out.clamped_contact_duration) / 20.0;
+  out.recommended_time_step = (d < 1.0 ? out.contact_time : out.clamped_contact_duration) / 20.0;
   return out;
 }
 

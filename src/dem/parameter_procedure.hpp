@@ -20,30 +20,31 @@ namespace sanguis::dem {
 
 enum class NormalDampingModel { kThesis, kExactRestitution };
 
-NormalDampingModel parse_normal_damping_model(const std::string& name);  // "thesis"|"exact_restitution"
+NormalDampingModel parse_normal_damping_model(
+    const std::string& name);  // "thesis"|"exact_restitution"
 const char* to_string(NormalDampingModel model);
 
 struct ProcedureInput {
-  double reduced_mass = 0.0;       // m_ij = m_i m_j / (m_i + m_j); m_i for a wall [kg]
-  double reduced_radius = 0.0;     // R_ij = R_i R_j / (R_i + R_j); R_i for a wall [m]
-  double inertia_factor = 2.5;     // m_ij (R_i^2/I_i + R_j^2/I_j) of eq. 2.23; 2.5 for spheres
-  double normal_restitution = 0.5;       // en in (0, 1]
-  double tangential_restitution = 0.5;   // et in (0, 1]
-  double max_overlap = 0.0;              // delta_max [m]
-  double max_impact_velocity = 0.0;      // v_max [m/s]
-  double friction = 0.5;                 // mu_c
-  double rolling_friction = 0.0;         // mu_r
+  double reduced_mass = 0.0;            // m_ij = m_i m_j / (m_i + m_j); m_i for a wall [kg]
+  double reduced_radius = 0.0;          // R_ij = R_i R_j / (R_i + R_j); R_i for a wall [m]
+  double inertia_factor = 2.5;          // m_ij (R_i^2/I_i + R_j^2/I_j) of eq. 2.23; 2.5 for spheres
+  double normal_restitution = 0.5;      // en in (0, 1]
+  double tangential_restitution = 0.5;  // et in (0, 1]
+  double max_overlap = 0.0;             // delta_max [m]
+  double max_impact_velocity = 0.0;     // v_max [m/s]
+  double friction = 0.5;                // mu_c
+  double rolling_friction = 0.0;        // mu_r
   NormalDampingModel damping_model = NormalDampingModel::kThesis;
 };
 
 struct ProcedureResult {
   ContactParameters parameters;
-  double damping_ratio = 0.0;           // gamma_n / omega_0
-  double contact_time = 0.0;            // Tc of eq. 2.17 (pi / omega; infinite if overdamped)
+  double damping_ratio = 0.0;             // gamma_n / omega_0
+  double contact_time = 0.0;              // Tc of eq. 2.17 (pi / omega; infinite if overdamped)
   double clamped_contact_duration = 0.0;  // duration of an impact under the max(.,0) law
-  double effective_restitution = 0.0;   // rebound ratio of the max(.,0) law
-  double tangential_damping_rate = 0.0; // gamma_t = eta_t / (2 m_ij) [1/s] (Table 2.1)
-  double recommended_time_step = 0.0;   // contact time / 20 (Kruggel-Emden)
+  double effective_restitution = 0.0;     // rebound ratio of the max(.,0) law
+  double tangential_damping_rate = 0.0;   // gamma_t = eta_t / (2 m_ij) [1/s] (Table 2.1)
+  double recommended_time_step = 0.0;     // contact time / 20 (Kruggel-Emden)
 };
 
 // Validates the input (throws std::invalid_argument naming the quantity) and

@@ -11,17 +11,17 @@
 namespace sanguis::dem {
 
 struct ParticleStore {
-  std::vector<std::int64_t> id;          // stable identifier (output, checkpoints)
-  std::vector<std::int32_t> material;    // index into the material table
-  std::vector<double> radius;            // [m]
-  std::vector<double> mass;              // [kg]
-  std::vector<double> inverse_mass;      // [1/kg]
-  std::vector<double> inverse_inertia;   // 1 / (2/5 m R^2) [1/(kg m^2)]
-  std::vector<Vec3> position;            // centre of mass [m]
-  std::vector<Vec3> velocity;            // [m/s]
-  std::vector<Vec3> angular_velocity;    // [rad/s]
-  std::vector<Vec3> force;               // sum of contact forces [N] (gravity excluded)
-  std::vector<Vec3> torque;              // sum of contact torques [N m]
+  std::vector<std::int64_t> id;            // stable identifier (output, checkpoints)
+  std::vector<std::int32_t> material;      // index into the material table
+  std::vector<double> radius;              // [m]
+  std::vector<double> mass;                // [kg]
+  std::vector<double> inverse_mass;        // [1/kg]
+  std::vector<double> inverse_inertia;     // 1 / (2/5 m R^2) [1/(kg m^2)]
+  std::vector<Vec3> position;              // centre of mass [m]
+  std::vector<Vec3> velocity;              // [m/s]
+  std::vector<Vec3> angular_velocity;      // [rad/s]
+  std::vector<Vec3> force;                 // sum of contact forces [N] (gravity excluded)
+  std::vector<Vec3> torque;                // sum of contact torques [N m]
   std::vector<std::int32_t> coordination;  // contacts touching this particle at the last step
 
   std::size_t size() const { return position.size(); }

@@ -102,8 +102,8 @@ void DemSimulation::compute_forces() {
     c.relative_angular_velocity = w[i] - w[j];
     c.reduced_radius = rad[i] * rad[j] / sum_r;
     const ContactResponse r = evaluate_contact(
-        setup_.contacts.get(static_cast<std::size_t>(mat[i]), static_cast<std::size_t>(mat[j])),
-        c, h, dt);
+        setup_.contacts.get(static_cast<std::size_t>(mat[i]), static_cast<std::size_t>(mat[j])), c,
+        h, dt);
     f[i] += r.force;
     f[j] -= r.force;
     tq[i] += cross(arm_i, r.force) + r.rolling_torque;
@@ -121,8 +121,8 @@ void DemSimulation::compute_forces() {
     const std::uint32_t i = walls_.first[k];
     const Obstacle& obstacle = setup_.obstacles[walls_.second[k]];
     ContactHistory& h = walls_.history[k];
-    const SphereObstacleGap gap = obstacle.active(now) ? sphere_gap(obstacle, x[i], rad[i])
-                                                       : SphereObstacleGap{-1.0, {}};
+    const SphereObstacleGap gap =
+        obstacle.active(now) ? sphere_gap(obstacle, x[i], rad[i]) : SphereObstacleGap{-1.0, {}};
     if (gap.overlap < 0.0) {
       if (h.normal.x != 0.0 || h.normal.y != 0.0 || h.normal.z != 0.0) h = ContactHistory{};
       continue;
@@ -134,10 +134,10 @@ void DemSimulation::compute_forces() {
     c.relative_velocity = v[i] + cross(w[i], arm_i);  // obstacles are fixed
     c.relative_angular_velocity = w[i];
     c.reduced_radius = rad[i];
-    const ContactResponse r = evaluate_contact(
-        setup_.contacts.get(static_cast<std::size_t>(mat[i]),
-                            static_cast<std::size_t>(obstacle.material)),
-        c, h, dt);
+    const ContactResponse r =
+        evaluate_contact(setup_.contacts.get(static_cast<std::size_t>(mat[i]),
+                                             static_cast<std::size_t>(obstacle.material)),
+                         c, h, dt);
     f[i] += r.force;
     tq[i] += cross(arm_i, r.force) + r.rolling_torque;
     ++coord[i];

@@ -39,11 +39,11 @@ class ContactTable {
 
 struct DemSetup {
   Domain domain;
-  Vec3 gravity;                        // [m/s^2]
-  double time_step = 0.0;              // [s]
+  Vec3 gravity;            // [m/s^2]
+  double time_step = 0.0;  // [s]
   IntegratorKind integrator = IntegratorKind::kLeapfrog;
-  double skin = 0.0;                   // Verlet skin [m]; 0 -> 0.1 x smallest diameter
-  double max_overlap_ratio = 0.5;      // overlap / R beyond which the run stops as unstable
+  double skin = 0.0;               // Verlet skin [m]; 0 -> 0.1 x smallest diameter
+  double max_overlap_ratio = 0.5;  // overlap / R beyond which the run stops as unstable
   std::vector<std::string> material_names;
   ContactTable contacts;
   std::vector<Obstacle> obstacles;

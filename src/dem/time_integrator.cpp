@@ -15,20 +15,28 @@ IntegratorKind parse_integrator(const std::string& name) {
 
 const char* to_string(IntegratorKind kind) {
   switch (kind) {
-    case IntegratorKind::kForwardEuler: return "euler";
-    case IntegratorKind::kLeapfrog: return "leapfrog";
-    case IntegratorKind::kAdamsBashforth2: return "adams_bashforth_2";
-    case IntegratorKind::kAdamsBashforth3: return "adams_bashforth_3";
+    case IntegratorKind::kForwardEuler:
+      return "euler";
+    case IntegratorKind::kLeapfrog:
+      return "leapfrog";
+    case IntegratorKind::kAdamsBashforth2:
+      return "adams_bashforth_2";
+    case IntegratorKind::kAdamsBashforth3:
+      return "adams_bashforth_3";
   }
   return "?";
 }
 
 int order_of(IntegratorKind kind) {
   switch (kind) {
-    case IntegratorKind::kForwardEuler: return 1;
-    case IntegratorKind::kLeapfrog: return 2;
-    case IntegratorKind::kAdamsBashforth2: return 2;
-    case IntegratorKind::kAdamsBashforth3: return 3;
+    case IntegratorKind::kForwardEuler:
+      return 1;
+    case IntegratorKind::kLeapfrog:
+      return 2;
+    case IntegratorKind::kAdamsBashforth2:
+      return 2;
+    case IntegratorKind::kAdamsBashforth3:
+      return 3;
   }
   return 0;
 }
@@ -39,9 +47,12 @@ namespace {
 // history allows (1 = Euler, 2, 3).
 inline Vec3 ab_increment(int order, double dt, const Vec3& r0, const Vec3& r1, const Vec3& r2) {
   switch (order) {
-    case 3: return (dt / 12.0) * (23.0 * r0 - 16.0 * r1 + 5.0 * r2);
-    case 2: return (dt / 2.0) * (3.0 * r0 - r1);
-    default: return dt * r0;
+    case 3:
+      return (dt / 12.0) * (23.0 * r0 - 16.0 * r1 + 5.0 * r2);
+    case 2:
+      return (dt / 2.0) * (3.0 * r0 - r1);
+    default:
+      return dt * r0;
   }
 }
 

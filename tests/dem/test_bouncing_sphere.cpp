@@ -14,7 +14,9 @@ namespace {
 
 constexpr double kRadius = 1e-3, kDensity = 2500.0;
 
-double sphere_mass() { return 4.0 / 3.0 * std::numbers::pi * std::pow(kRadius, 3) * kDensity; }
+double sphere_mass() {
+  return 4.0 / 3.0 * std::numbers::pi * std::pow(kRadius, 3) * kDensity;
+}
 
 ProcedureResult wall_parameters(double en, NormalDampingModel model) {
   ProcedureInput in;
@@ -53,7 +55,8 @@ double observed_order(IntegratorKind kind, bool contact_at_start) {
     x.push_back(std::log(p.contact_time / n));
     y.push_back(std::log(r.relative_l2_error));
   }
-  const double mx = (x[0] + x[1] + x[2] + x[3] + x[4]) / 5, my = (y[0] + y[1] + y[2] + y[3] + y[4]) / 5;
+  const double mx = (x[0] + x[1] + x[2] + x[3] + x[4]) / 5,
+               my = (y[0] + y[1] + y[2] + y[3] + y[4]) / 5;
   double sxy = 0, sxx = 0;
   for (std::size_t k = 0; k < x.size(); ++k) {
     sxy += (x[k] - mx) * (y[k] - my);
@@ -79,13 +82,12 @@ TEST_P(BouncingSphereOrder, ContactStartingBetweenStepsDegeneratesToFirstOrder) 
   EXPECT_NEAR(order, 1.0, 0.15) << to_string(GetParam().kind);
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    Integrators, BouncingSphereOrder,
-    ::testing::Values(OrderCase{IntegratorKind::kForwardEuler, 1.0},
-                      OrderCase{IntegratorKind::kLeapfrog, 2.0},
-                      OrderCase{IntegratorKind::kAdamsBashforth2, 2.0},
-                      OrderCase{IntegratorKind::kAdamsBashforth3, 3.0}),
-    [](const auto& info) { return std::string(to_string(info.param.kind)); });
+INSTANTIATE_TEST_SUITE_P(Integrators, BouncingSphereOrder,
+                         ::testing::Values(OrderCase{IntegratorKind::kForwardEuler, 1.0},
+                                           OrderCase{IntegratorKind::kLeapfrog, 2.0},
+                                           OrderCase{IntegratorKind::kAdamsBashforth2, 2.0},
+                                           OrderCase{IntegratorKind::kAdamsBashforth3, 3.0}),
+                         [](const auto& info) { return std::string(to_string(info.param.kind)); });
 
 struct RestitutionCase {
   IntegratorKind kind;
@@ -124,7 +126,8 @@ std::vector<RestitutionCase> restitution_cases() {
 INSTANTIATE_TEST_SUITE_P(Integrators, MeasuredRestitution, ::testing::ValuesIn(restitution_cases()),
                          [](const auto& info) {
                            return std::string(to_string(info.param.kind)) + "_en" +
-                                  std::to_string(static_cast<int>(std::lround(info.param.en * 100)));
+                                  std::to_string(
+                                      static_cast<int>(std::lround(info.param.en * 100)));
                          });
 
 }  // namespace

@@ -17,14 +17,14 @@
 namespace sanguis::validation {
 
 struct BounceSetup {
-  double radius = 1e-3;         // [m]
-  double density = 2500.0;      // [kg/m^3]
-  double impact_speed = 1.0;    // v0 [m/s]
+  double radius = 1e-3;       // [m]
+  double density = 2500.0;    // [kg/m^3]
+  double impact_speed = 1.0;  // v0 [m/s]
   dem::ContactParameters contact;
   dem::IntegratorKind integrator = dem::IntegratorKind::kLeapfrog;
-  double time_step = 0.0;       // [s]
-  bool contact_at_start = true; // case (i) of §2.6.1; else case (ii)
-  double approach_time = 0.0;   // t1 for case (ii) [s]
+  double time_step = 0.0;        // [s]
+  bool contact_at_start = true;  // case (i) of §2.6.1; else case (ii)
+  double approach_time = 0.0;    // t1 for case (ii) [s]
 };
 
 struct BounceResult {
@@ -34,8 +34,7 @@ struct BounceResult {
 
 class BounceSolution {
  public:
-  BounceSolution(double mass, double kn, double eta_n, double v0, double t1)
-      : v0_(v0), t1_(t1) {
+  BounceSolution(double mass, double kn, double eta_n, double v0, double t1) : v0_(v0), t1_(t1) {
     const double omega0 = std::sqrt(kn / mass);
     gamma_ = eta_n / (2.0 * mass);
     underdamped_ = gamma_ < omega0;
@@ -58,7 +57,8 @@ class BounceSolution {
   }
   double overlap_rate(double t) const {
     const double s = t - t1_;
-    return v0_ * std::exp(-gamma_ * s) * (std::cos(omega_ * s) - gamma_ / omega_ * std::sin(omega_ * s));
+    return v0_ * std::exp(-gamma_ * s) *
+           (std::cos(omega_ * s) - gamma_ / omega_ * std::sin(omega_ * s));
   }
   double overlap_acceleration(double t) const {
     const double s = t - t1_;

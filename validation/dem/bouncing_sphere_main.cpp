@@ -39,8 +39,9 @@ int main() {
         // contact starts at 30% of a step, whatever the step
         b.approach_time = (std::floor(0.1 * n) + 0.3) * b.time_step;
         const validation::BounceResult r = validation::simulate_bounce(b);
-        std::printf("%s,%s,%d,%.9g,%.9g,%.9g\n", dem::to_string(kind), contact_case == 1 ? "i" : "ii",
-                    n, b.time_step, r.relative_l2_error, r.restitution);
+        std::printf("%s,%s,%d,%.9g,%.9g,%.9g\n", dem::to_string(kind),
+                    contact_case == 1 ? "i" : "ii", n, b.time_step, r.relative_l2_error,
+                    r.restitution);
       }
     }
   }
