@@ -43,7 +43,8 @@ struct ContactResponse {
 
 // Rotates a vector lying in the previous tangent plane into the current one by the
 // smallest rotation that takes the old normal onto the new normal (q_rot of eq. 2.8).
-inline Vec3 rotate_into_new_plane(const Vec3& v, const Vec3& old_normal, const Vec3& new_normal) {
+[[gnu::always_inline]] inline Vec3 rotate_into_new_plane(const Vec3& v, const Vec3& old_normal,
+                                                          const Vec3& new_normal) {
   const double c = dot(old_normal, new_normal);
   if (c <= -0.999999) return Vec3{};  // normal flipped: no meaningful memory to carry
   const Vec3 k = cross(old_normal, new_normal);
@@ -51,8 +52,10 @@ inline Vec3 rotate_into_new_plane(const Vec3& v, const Vec3& old_normal, const V
   return c * v + cross(k, v) + (dot(k, v) / (1.0 + c)) * k;
 }
 
-inline ContactResponse evaluate_contact(const ContactParameters& p, const ContactKinematics& c,
-                                        ContactHistory& h, double dt) {
+// Forced inline: it runs once per contact per step inside the force loops.
+[[gnu::always_inline]] inline ContactResponse evaluate_contact(const ContactParameters& p,
+                                                               const ContactKinematics& c,
+                                                               ContactHistory& h, double dt) {
   ContactResponse out;
   const Vec3& n = c.normal;
   const double normal_speed = dot(c.relative_velocity, n);  // d(dn)/dt
@@ -70,9 +73,10 @@ inline ContactResponse evaluate_contact(const ContactParameters& p, const Contac
   Vec3 delta = continuing ? rotate_into_new_plane(h.tangential_displacement, h.normal, n) : Vec3{};
   delta += dt * vt;
   Vec3 ft = -p.tangential_stiffness * delta - p.tangential_damping * vt;
-  const double ft_norm = norm(ft);
   const double ft_max = p.friction * fn;
-  if (ft_norm > ft_max) {
+  const double ft_norm2 = norm2(ft);
+  if (ft_norm2 > ft_max * ft_max) {
+    const double ft_norm = std::sqrt(ft_norm2);
     // Sliding: Ft = mu_c |Fn| ut,cumul, and delta_t such that -kt delta - eta_t vt = Ft, so
     // that Ft stays continuous when the contact sticks again (eq. 2.8, second line).
     ft = ft_norm > 0.0 ? (ft_max / ft_norm) * ft : Vec3{};

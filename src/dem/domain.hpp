@@ -15,6 +15,23 @@ struct Domain {
 
   Vec3 length() const { return max - min; }
 
+  // Minimum image of a separation that is at most 1.5 box lengths long (true between two
+  // neighbour-list builds, which wrap positions): a compare and a subtraction per axis,
+  // no rounding call in the contact loop.
+  Vec3 near_image(Vec3 d) const {
+    for (int k = 0; k < 3; ++k) {
+      if (periodic[static_cast<std::size_t>(k)]) {
+        const double l = max[k] - min[k];
+        if (d[k] > 0.5 * l) {
+          d[k] -= l;
+        } else if (d[k] < -0.5 * l) {
+          d[k] += l;
+        }
+      }
+    }
+    return d;
+  }
+
   Vec3 minimum_image(Vec3 d) const {
     for (int k = 0; k < 3; ++k) {
       if (periodic[static_cast<std::size_t>(k)]) {

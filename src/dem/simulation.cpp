@@ -84,7 +84,7 @@ void DemSimulation::compute_forces() {
     const std::uint32_t j = pairs_.second[k];
     ContactHistory& h = pairs_.history[k];
     Vec3 d = x[j] - x[i];
-    if (periodic) d = domain.minimum_image(d);
+    if (periodic) d = domain.near_image(d);
     const double sum_r = rad[i] + rad[j];
     const double dist2 = norm2(d);
     if (dist2 > sum_r * sum_r) {
@@ -92,22 +92,25 @@ void DemSimulation::compute_forces() {
       continue;
     }
     const double dist = std::sqrt(dist2);
-    const Vec3 normal = dist > 0.0 ? d / dist : Vec3{0.0, 0.0, 1.0};
+    const Vec3 normal = dist > 0.0 ? (1.0 / dist) * d : Vec3{0.0, 0.0, 1.0};
     ContactKinematics c;
     c.normal = normal;
     c.overlap = sum_r - dist;
-    const Vec3 arm_i = (rad[i] - 0.5 * c.overlap) * normal;   // contact point - x_i
-    const Vec3 arm_j = -(rad[j] - 0.5 * c.overlap) * normal;  // contact point - x_j
-    c.relative_velocity = (v[i] + cross(w[i], arm_i)) - (v[j] + cross(w[j], arm_j));
+    // Lever arms from the centres to the contact point (midpoint of the overlap):
+    // C - x_i = a_i n and C - x_j = -a_j n, so both moments share n x F.
+    const double a_i = rad[i] - 0.5 * c.overlap;
+    const double a_j = rad[j] - 0.5 * c.overlap;
+    c.relative_velocity = (v[i] - v[j]) + cross(a_i * w[i] + a_j * w[j], normal);
     c.relative_angular_velocity = w[i] - w[j];
     c.reduced_radius = rad[i] * rad[j] / sum_r;
     const ContactResponse r = evaluate_contact(
-        setup_.contacts.get(static_cast<std::size_t>(mat[i]), static_cast<std::size_t>(mat[j])), c,
-        h, dt);
+        setup_.contacts.get(static_cast<std::size_t>(mat[i]), static_cast<std::size_t>(mat[j])),
+        c, h, dt);
+    const Vec3 moment = cross(normal, r.force);
     f[i] += r.force;
     f[j] -= r.force;
-    tq[i] += cross(arm_i, r.force) + r.rolling_torque;
-    tq[j] -= cross(arm_j, r.force) + r.rolling_torque;
+    tq[i] += a_i * moment + r.rolling_torque;
+    tq[j] += a_j * moment - r.rolling_torque;
     ++coord[i];
     ++coord[j];
     ++touching;
