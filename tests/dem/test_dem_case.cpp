@@ -5,7 +5,9 @@
 
 #include <array>
 #include <cmath>
+#include <fstream>
 #include <functional>
+#include <iterator>
 #include <limits>
 #include <numbers>
 #include <sstream>
@@ -575,6 +577,25 @@ count = COUNT)");
   EXPECT_EQ(
       load(replaced(replaced(lattice, "SPACING", "2.5e-3"), "COUNT", "10")).setup.particles.size(),
       10u);
+}
+
+// --- The documentation's example -------------------------------------------------
+
+TEST(DemCase, MinimalExampleOfTheDocsLoads) {
+  std::ifstream in(std::string(SANGUIS_SOURCE_DIR) + "/docs/case-file.md");
+  ASSERT_TRUE(in) << "cannot read docs/case-file.md";
+  const std::string doc{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  const std::size_t marker = doc.find("<!-- example: minimal");
+  ASSERT_NE(marker, std::string::npos);
+  const std::size_t begin = doc.find("```toml\n", marker);
+  ASSERT_NE(begin, std::string::npos);
+  const std::size_t end = doc.find("```", begin + 8);
+  ASSERT_NE(end, std::string::npos);
+  const DemCase c = load(doc.substr(begin + 8, end - begin - 8));
+  EXPECT_EQ(c.name, "minimal");
+  EXPECT_EQ(c.setup.particles.size(), 30u);
+  EXPECT_EQ(c.setup.obstacles.size(), 1u);
+  EXPECT_EQ(c.setup.time_step, c.smallest_contact_time / 20.0);
 }
 
 }  // namespace
