@@ -159,7 +159,8 @@ bool step_to_live_contacts(DemSimulation& sim) {
 class RestartTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    const std::string test_name = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    std::string test_name = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    for (char& ch : test_name) ch = ch == '/' ? '_' : ch;  // parameterised: "Name/euler"
     std::random_device entropy;
     dir_ = fs::temp_directory_path() /
            ("sanguis_test_restart_" + test_name + "_" + std::to_string(entropy()));
