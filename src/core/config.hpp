@@ -72,7 +72,7 @@ class ConfigTable {
   std::optional<ConfigTable> find_table(const std::string& key) const;
   std::vector<ConfigTable> table_array(const std::string& key) const;  // missing -> empty
 
-  // Throws on the first key (in file order) that was never read.
+  // Throws on the first key never read (toml++ keeps keys sorted: alphabetical order).
   void check_no_unknown_keys() const;
 
   // Error for this table's `key` with a reason (for checks done by callers).

@@ -173,6 +173,13 @@ ResolvedInteraction parse_interaction(const ConfigTable& t,
   b = find(names[1]);
   const MaterialSpec& ma = materials[a];
   const MaterialSpec& mb = materials[b];
+  for (const MaterialSpec* m : {&ma, &mb}) {
+    if (!m->used_by_particles && !m->used_by_obstacles) {
+      t.fail("materials", "material '" + m->name +
+                              "' is used by no [[particles]] group and no "
+                              "[[obstacle]]");
+    }
+  }
   if (!ma.used_by_particles && !mb.used_by_particles) {
     t.fail("materials",
            "no particle uses either material; interactions between obstacles are "
@@ -435,9 +442,12 @@ DemCase load_dem_case(const ConfigTable& cfg, const std::filesystem::path& sourc
                            w);
   }
   // Periodic axes need room for the linked cells.
-  double r_max = 0.0;
-  for (double r : s.particles.radius) r_max = std::max(r_max, r);
-  const double skin = s.skin > 0.0 ? s.skin : 0.2 * r_max;
+  double r_max = 0.0, r_min = std::numeric_limits<double>::infinity();
+  for (double r : s.particles.radius) {
+    r_max = std::max(r_max, r);
+    r_min = std::min(r_min, r);
+  }
+  const double skin = s.skin > 0.0 ? s.skin : 0.2 * r_min;  // as DemSimulation chooses it
   for (int k = 0; k < 3; ++k) {
     if (s.domain.periodic[static_cast<std::size_t>(k)] &&
         s.domain.max[k] - s.domain.min[k] < 3.0 * (2.0 * r_max + skin)) {

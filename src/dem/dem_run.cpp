@@ -114,13 +114,16 @@ class SnapshotWriter {
     if (restart) {
       particles_.load_existing(t);
       obstacles_.load_existing(t);
+      next_frame_ = static_cast<std::int64_t>(particles_.entries().size());
     }
   }
 
-  void write(const DemSimulation& sim, std::int64_t frame) {
+  // Frames are numbered in the order they are written (not by time), so an extra
+  // snapshot (end time off the output grid, a blow-up) never overwrites another.
+  void write(const DemSimulation& sim) {
     if (!enabled_) return;
     char name[64];
-    std::snprintf(name, sizeof name, "%08lld", static_cast<long long>(frame));
+    std::snprintf(name, sizeof name, "%08lld", static_cast<long long>(next_frame_++));
     const std::string p = std::string("particles/particles_") + name + ".vtu";
     const std::string o = std::string("obstacles/obstacles_") + name + ".vtp";
     io::write_point_cloud_vtu(dir_ / p, particle_cloud(sim.particles()));
@@ -135,6 +138,7 @@ class SnapshotWriter {
   std::filesystem::path dir_;
   bool enabled_;
   io::PvdIndex particles_, obstacles_;
+  std::int64_t next_frame_ = 0;
 };
 
 std::int64_t steps_for(double duration, double dt) {
@@ -178,7 +182,7 @@ RunSummary run_dem_case(const DemCase& c, const RunOptions& options, std::ostrea
   SnapshotWriter snapshots(dir, c.output.vtk, options.restart, sim.time());
   io::CsvWriter csv(csv_path, kDiagnosticColumns, options.restart && fs::exists(csv_path));
   const auto record = [&]() {
-    snapshots.write(sim, sim.step_index() / output_every);
+    snapshots.write(sim);
     csv.row(diagnostic_row(sim.diagnostics()));
   };
   if (!options.restart) record();
@@ -217,7 +221,10 @@ RunSummary run_dem_case(const DemCase& c, const RunOptions& options, std::ostrea
     log << "ERROR: " << e.what() << "\n";
     throw;
   }
-  if (sim.step_index() % output_every != 0) record();
+  // A last record at the end time if it is off the output grid; not when stopping early
+  // for a later restart, so that a split run writes exactly the rows of a whole one.
+  const bool stopped_early = sim.step_index() < total_steps && !summary.settled;
+  if (sim.step_index() % output_every != 0 && !stopped_early) record();
   sim.save_checkpoint(checkpoint);
 
   summary.steps = sim.step_index() - first_step;

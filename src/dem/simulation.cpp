@@ -104,8 +104,8 @@ void DemSimulation::compute_forces() {
     c.relative_angular_velocity = w[i] - w[j];
     c.reduced_radius = rad[i] * rad[j] / sum_r;
     const ContactResponse r = evaluate_contact(
-        setup_.contacts.get(static_cast<std::size_t>(mat[i]), static_cast<std::size_t>(mat[j])),
-        c, h, dt);
+        setup_.contacts.get(static_cast<std::size_t>(mat[i]), static_cast<std::size_t>(mat[j])), c,
+        h, dt);
     const Vec3 moment = cross(normal, r.force);
     f[i] += r.force;
     f[j] -= r.force;

@@ -600,3 +600,24 @@ TEST(DemCase, MinimalExampleOfTheDocsLoads) {
 
 }  // namespace
 }  // namespace sanguis::dem
+
+namespace sanguis::dem {
+namespace {
+
+TEST(DemCase, InteractionWithAnUnusedMaterialIsAnError) {
+  std::string text = kValidCase;
+  text += R"(
+[[material]]
+name = "rubber"
+density_kg_m3 = 1100.0
+
+[[interaction]]
+materials = ["glass", "rubber"]
+mode = "explicit"
+normal_stiffness_N_m = 1e5
+)";
+  expect_case_error(text, "interaction[2].materials", "used by no");
+}
+
+}  // namespace
+}  // namespace sanguis::dem

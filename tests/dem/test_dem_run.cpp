@@ -84,5 +84,28 @@ TEST(DemRun, StopsWhenSettledAndWritesOneRowPerOutput) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(DemRun, AnEndTimeOffTheOutputGridGetsItsOwnSnapshot) {
+  const auto dir = std::filesystem::temp_directory_path() / "sanguis_test_dem_run_frames";
+  std::filesystem::remove_all(dir);
+  std::string text = kSettle;
+  text.replace(text.find("end_time_s = 2.0"), 16, "end_time_s = 0.02");
+  text.replace(text.find("interval_s = 0.01"), 17, "interval_s = 0.006");
+  text.replace(text.find("vtk = false"), 11, "vtk = true");
+  text.replace(text.find("mean_velocity_below_m_s = 1e-5"), 30, "mean_velocity_below_m_s = 1e-12");
+  const DemCase c = load_dem_case(ConfigTable::parse_string(text, "frames.toml"), "frames.toml");
+  RunOptions options;
+  options.output_dir = dir;
+  options.quiet = true;
+  std::ostringstream console;
+  run_dem_case(c, options, console);
+  // Outputs at 0, 0.006, 0.012, 0.018 and the end 0.02: five distinct frames.
+  int frames = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir / "particles")) {
+    frames += e.path().extension() == ".vtu";
+  }
+  EXPECT_EQ(frames, 5);
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace sanguis::dem
