@@ -44,7 +44,7 @@ struct ContactResponse {
 // Rotates a vector lying in the previous tangent plane into the current one by the
 // smallest rotation that takes the old normal onto the new normal (q_rot of eq. 2.8).
 [[gnu::always_inline]] inline Vec3 rotate_into_new_plane(const Vec3& v, const Vec3& old_normal,
-                                                          const Vec3& new_normal) {
+                                                         const Vec3& new_normal) {
   const double c = dot(old_normal, new_normal);
   if (c <= -0.999999) return Vec3{};  // normal flipped: no meaningful memory to carry
   const Vec3 k = cross(old_normal, new_normal);

@@ -6,15 +6,29 @@ namespace sanguis::dem {
 
 std::size_t ParticleStore::add_sphere(std::int64_t particle_id, std::int32_t material_index,
                                       double r, double density, const Vec3& x, const Vec3& v,
-                                      const Vec3& w) {
+                                      const Vec3& w, std::int32_t species_index) {
   const double m = 4.0 / 3.0 * std::numbers::pi * r * r * r * density;
   const double inertia = 0.4 * m * r * r;
+  const std::size_t i = add_body(particle_id, material_index, species_index, r, m,
+                                 {inertia, inertia, inertia}, {}, x, v, w);
+  spherical[i] = 1;
+  return i;
+}
+
+std::size_t ParticleStore::add_body(std::int64_t particle_id, std::int32_t material_index,
+                                    std::int32_t species_index, double bounding_radius, double m,
+                                    const Vec3& inertia, const Quaternion& q, const Vec3& x,
+                                    const Vec3& v, const Vec3& w) {
   id.push_back(particle_id);
   material.push_back(material_index);
-  radius.push_back(r);
+  radius.push_back(bounding_radius);
   mass.push_back(m);
   inverse_mass.push_back(1.0 / m);
-  inverse_inertia.push_back(1.0 / inertia);
+  species.push_back(species_index);
+  spherical.push_back(0);
+  inertia_body.push_back(inertia);
+  inverse_inertia_body.push_back({1.0 / inertia.x, 1.0 / inertia.y, 1.0 / inertia.z});
+  orientation.push_back(q);
   position.push_back(x);
   velocity.push_back(v);
   angular_velocity.push_back(w);

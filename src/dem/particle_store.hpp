@@ -1,11 +1,13 @@
 #pragma once
 // Particle state as a structure of arrays: each field is one contiguous array
 // indexed by the particle's local index, so that kernels stream through memory.
-// Spheres only for now: mass and moment of inertia are scalars.
+// Spheres and rigid bodies of any shape: a body carries an orientation and its
+// principal moments of inertia (body frame = principal axes, origin = centroid).
 #include <cstddef>
 #include <cstdint>
 #include <vector>
 
+#include "core/quaternion.hpp"
 #include "core/vec3.hpp"
 
 namespace sanguis::dem {
@@ -13,10 +15,14 @@ namespace sanguis::dem {
 struct ParticleStore {
   std::vector<std::int64_t> id;            // stable identifier (output, checkpoints)
   std::vector<std::int32_t> material;      // index into the material table
-  std::vector<double> radius;              // [m]
+  std::vector<double> radius;              // bounding radius about the centroid [m]
   std::vector<double> mass;                // [kg]
   std::vector<double> inverse_mass;        // [1/kg]
-  std::vector<double> inverse_inertia;     // 1 / (2/5 m R^2) [1/(kg m^2)]
+  std::vector<std::int32_t> species;       // index into the species (shape) table
+  std::vector<std::uint8_t> spherical;     // 1: a sphere (isotropic: no orientation dynamics)
+  std::vector<Vec3> inertia_body;          // principal moments of inertia [kg m^2]
+  std::vector<Vec3> inverse_inertia_body;  // their inverses [1/(kg m^2)]
+  std::vector<Quaternion> orientation;     // body frame -> space frame
   std::vector<Vec3> position;              // centre of mass [m]
   std::vector<Vec3> velocity;              // [m/s]
   std::vector<Vec3> angular_velocity;      // [rad/s]
@@ -28,7 +34,15 @@ struct ParticleStore {
 
   // Appends a sphere of the given radius and density; returns its index.
   std::size_t add_sphere(std::int64_t particle_id, std::int32_t material_index, double r,
-                         double density, const Vec3& x, const Vec3& v, const Vec3& w);
+                         double density, const Vec3& x, const Vec3& v, const Vec3& w,
+                         std::int32_t species_index = 0);
+
+  // Appends a rigid body: `bounding_radius` encloses it about its centroid, `inertia`
+  // are the principal moments [kg m^2] in the body frame, `q` maps body to space.
+  std::size_t add_body(std::int64_t particle_id, std::int32_t material_index,
+                       std::int32_t species_index, double bounding_radius, double m,
+                       const Vec3& inertia, const Quaternion& q, const Vec3& x, const Vec3& v,
+                       const Vec3& w);
 };
 
 }  // namespace sanguis::dem

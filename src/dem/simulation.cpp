@@ -183,7 +183,10 @@ DemDiagnostics DemSimulation::diagnostics() const {
     const double v2 = norm2(p.velocity[i]);
     const double w2 = norm2(p.angular_velocity[i]);
     d.kinetic_energy_translational += 0.5 * p.mass[i] * v2;
-    d.kinetic_energy_rotational += 0.5 * w2 / p.inverse_inertia[i];
+    const Vec3 wb = rotate_inverse(p.orientation[i], p.angular_velocity[i]);
+    const Vec3& j = p.inertia_body[i];
+    d.kinetic_energy_rotational +=
+        0.5 * (j.x * wb.x * wb.x + j.y * wb.y * wb.y + j.z * wb.z * wb.z);
     const double speed = std::sqrt(v2);
     d.mean_velocity += speed;
     d.max_velocity = std::max(d.max_velocity, speed);
@@ -257,7 +260,11 @@ void for_each_particle_array(ParticleStore& p, F&& f) {
   f(p.radius);
   f(p.mass);
   f(p.inverse_mass);
-  f(p.inverse_inertia);
+  f(p.species);
+  f(p.spherical);
+  f(p.inertia_body);
+  f(p.inverse_inertia_body);
+  f(p.orientation);
   f(p.position);
   f(p.velocity);
   f(p.angular_velocity);

@@ -56,6 +56,53 @@ inline Vec3 ab_increment(int order, double dt, const Vec3& r0, const Vec3& r1, c
   }
 }
 
+// Component-wise product (diagonal inertia tensors in the body frame).
+constexpr Vec3 scale(const Vec3& a, const Vec3& b) {
+  return {a.x * b.x, a.y * b.y, a.z * b.z};
+}
+
+// dq/dt = 1/2 (0, omega) q with omega in the space frame, one explicit step, renormalised.
+inline Quaternion advance_orientation(const Quaternion& q, const Vec3& omega, double dt) {
+  const Quaternion dq = Quaternion{0.0, omega.x, omega.y, omega.z} * q;
+  const double h = 0.5 * dt;
+  return normalized({q.w + h * dq.w, q.x + h * dq.x, q.y + h * dq.y, q.z + h * dq.z});
+}
+
+// Thesis §2.5.2, first order: eq. 2.34 in the body frame, then the orientation with the
+// new angular velocity.
+inline void rotate_first_order(Quaternion& q, Vec3& omega, const Vec3& torque, const Vec3& inertia,
+                               const Vec3& inverse_inertia, double dt) {
+  const Vec3 wb = rotate_inverse(q, omega);
+  const Vec3 tb = rotate_inverse(q, torque);
+  const Vec3 alpha = scale(inverse_inertia, tb - cross(wb, scale(inertia, wb)));  // eq. 2.34
+  omega = rotate(q, wb + dt * alpha);
+  q = advance_orientation(q, omega, dt);
+}
+
+// Exact rotation of a free rigid body about its principal axis k for time h: the body
+// turns by h L_k / J_k, and the body components of the (space-fixed) angular momentum
+// turn the other way.
+inline void free_rotation_about_axis(Quaternion& q, Vec3& body_momentum, int k, double h,
+                                     const Vec3& inverse_inertia) {
+  const double half_angle = 0.5 * h * body_momentum[k] * inverse_inertia[k];
+  Quaternion r{std::cos(half_angle), 0.0, 0.0, 0.0};
+  (k == 0 ? r.x : (k == 1 ? r.y : r.z)) = std::sin(half_angle);
+  q = q * r;
+  body_momentum = rotate_inverse(r, body_momentum);
+}
+
+// Symmetric splitting of the free rotor (Dullweber, Leimkuhler & McLachlan, J. Chem. Phys.
+// 107, 5840, 1997): x(h/2) y(h/2) z(h) y(h/2) x(h/2). Second order, keeps |L| exactly.
+inline void free_rotation(Quaternion& q, Vec3& body_momentum, double h,
+                          const Vec3& inverse_inertia) {
+  free_rotation_about_axis(q, body_momentum, 0, 0.5 * h, inverse_inertia);
+  free_rotation_about_axis(q, body_momentum, 1, 0.5 * h, inverse_inertia);
+  free_rotation_about_axis(q, body_momentum, 2, h, inverse_inertia);
+  free_rotation_about_axis(q, body_momentum, 1, 0.5 * h, inverse_inertia);
+  free_rotation_about_axis(q, body_momentum, 0, 0.5 * h, inverse_inertia);
+  q = normalized(q);
+}
+
 void resize_history(MultistepHistory& h, std::size_t n) {
   for (int k = 0; k < 2; ++k) {
     h.velocity[k].resize(n);
@@ -75,14 +122,21 @@ void TimeIntegrator::advance(ParticleStore& p, const Vec3& gravity, double dt) {
   const Vec3* f = p.force.data();
   const Vec3* t = p.torque.data();
   const double* inv_m = p.inverse_mass.data();
-  const double* inv_i = p.inverse_inertia.data();
+  const Vec3* inv_j = p.inverse_inertia_body.data();
+  const Vec3* j_body = p.inertia_body.data();
+  const std::uint8_t* sphere = p.spherical.data();
+  Quaternion* q = p.orientation.data();
 
   switch (kind_) {
     case IntegratorKind::kForwardEuler:  // eq. 2.30
       for (std::size_t i = 0; i < n; ++i) {
         x[i] += dt * v[i];
         v[i] += dt * (inv_m[i] * f[i] + gravity);
-        w[i] += (dt * inv_i[i]) * t[i];
+        if (sphere[i]) {
+          w[i] += (dt * inv_j[i].x) * t[i];
+        } else {
+          rotate_first_order(q[i], w[i], t[i], j_body[i], inv_j[i], dt);
+        }
       }
       break;
     case IntegratorKind::kLeapfrog: {  // eq. 2.31, kick-drift half
@@ -90,15 +144,26 @@ void TimeIntegrator::advance(ParticleStore& p, const Vec3& gravity, double dt) {
       half_angular_velocity_.resize(n);
       for (std::size_t i = 0; i < n; ++i) {
         const Vec3 kick = (0.5 * dt) * (inv_m[i] * f[i] + gravity);
-        const Vec3 spin = (0.5 * dt * inv_i[i]) * t[i];
         half_velocity_[i] = v[i] + kick;
-        half_angular_velocity_[i] = w[i] + spin;
         x[i] += dt * half_velocity_[i];
         // The forces at x_{n+1} see the predicted v_{n+1} = v_n + dt a_n rather than
         // v_{n+1/2}: with velocity-dependent (damping) forces this keeps the scheme
         // second order (the half-step velocity makes it first order, see Fig. 2.5 report).
         v[i] = half_velocity_[i] + kick;
-        w[i] = half_angular_velocity_[i] + spin;
+        if (sphere[i]) {
+          const Vec3 spin = (0.5 * dt * inv_j[i].x) * t[i];
+          half_angular_velocity_[i] = w[i] + spin;
+          w[i] = half_angular_velocity_[i] + spin;
+        } else {
+          // Half kick of the body-frame angular momentum, free rotation over dt (DLM), and
+          // the predicted omega_{n+1} for the forces; finish() applies the second half kick.
+          Vec3 lb = scale(j_body[i], rotate_inverse(q[i], w[i])) +
+                    (0.5 * dt) * rotate_inverse(q[i], t[i]);
+          free_rotation(q[i], lb, dt, inv_j[i]);
+          half_angular_velocity_[i] = lb;  // body-frame angular momentum L_{n+1/2}
+          const Vec3 lb_predicted = lb + (0.5 * dt) * rotate_inverse(q[i], t[i]);
+          w[i] = rotate(q[i], scale(inv_j[i], lb_predicted));
+        }
       }
       break;
     }
@@ -113,13 +178,18 @@ void TimeIntegrator::advance(ParticleStore& p, const Vec3& gravity, double dt) {
       const int order = std::min(max_order, h.depth + 1);
       for (std::size_t i = 0; i < n; ++i) {
         const Vec3 a = inv_m[i] * f[i] + gravity;
-        const Vec3 alpha = inv_i[i] * t[i];
+        const Vec3 alpha = inv_j[i].x * t[i];  // spheres only; bodies below
         const Vec3 v_now = v[i];
         const Vec3 w_now = w[i];
         x[i] += ab_increment(order, dt, v_now, h.velocity[0][i], h.velocity[1][i]);
         v[i] += ab_increment(order, dt, a, h.acceleration[0][i], h.acceleration[1][i]);
-        w[i] += ab_increment(order, dt, alpha, h.angular_acceleration[0][i],
-                             h.angular_acceleration[1][i]);
+        if (sphere[i]) {
+          w[i] += ab_increment(order, dt, alpha, h.angular_acceleration[0][i],
+                               h.angular_acceleration[1][i]);
+        } else {
+          // Non-spherical bodies rotate with the first-order scheme of §2.5.2.
+          rotate_first_order(q[i], w[i], t[i], j_body[i], inv_j[i], dt);
+        }
         h.velocity[1][i] = h.velocity[0][i];
         h.acceleration[1][i] = h.acceleration[0][i];
         h.angular_velocity[1][i] = h.angular_velocity[0][i];
@@ -140,8 +210,14 @@ void TimeIntegrator::finish(ParticleStore& p, const Vec3& gravity, double dt) {
   const std::size_t n = p.size();
   for (std::size_t i = 0; i < n; ++i) {  // final half kick with a_{n+1}
     p.velocity[i] = half_velocity_[i] + (0.5 * dt) * (p.inverse_mass[i] * p.force[i] + gravity);
-    p.angular_velocity[i] =
-        half_angular_velocity_[i] + (0.5 * dt * p.inverse_inertia[i]) * p.torque[i];
+    if (p.spherical[i]) {
+      p.angular_velocity[i] =
+          half_angular_velocity_[i] + (0.5 * dt * p.inverse_inertia_body[i].x) * p.torque[i];
+    } else {
+      const Quaternion& q = p.orientation[i];
+      const Vec3 lb = half_angular_velocity_[i] + (0.5 * dt) * rotate_inverse(q, p.torque[i]);
+      p.angular_velocity[i] = rotate(q, scale(p.inverse_inertia_body[i], lb));
+    }
   }
 }
 

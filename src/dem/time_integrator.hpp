@@ -3,8 +3,13 @@
 //   forward Euler                 eq. 2.30   (order 1)
 //   leapfrog                      eq. 2.31   (order 2, symplectic; default)
 //   Adams-Bashforth 2 and 3       eq. 2.32   (orders 2 and 3; multi-step)
-// The same scheme advances the angular velocity (spheres have an isotropic
-// inertia, so eq. 2.3 reduces to d(omega)/dt = T / I).
+// Spheres (isotropic inertia) advance their angular velocity with the same
+// scheme, eq. 2.3 reducing to d(omega)/dt = T / I. Other bodies integrate eq. 2.34
+// in the body frame with a unit quaternion: with Euler and Adams-Bashforth, the
+// first-order scheme of §2.5.2 (explicit Euler on eq. 2.34, then dq/dt =
+// 1/2 omega q); with leapfrog, a second-order symplectic splitting (half kicks of
+// the angular momentum around the free-rotor splitting of Dullweber, Leimkuhler
+// and McLachlan 1997), which conserves |L| exactly and energy to O(dt^2).
 //
 // One step is split around the force evaluation:
 //   advance(): uses the accelerations a_n (forces at x_n) to produce x_{n+1}
@@ -51,7 +56,8 @@ class TimeIntegrator {
  private:
   IntegratorKind kind_;
   MultistepHistory history_;
-  // Leapfrog: v_{n+1/2} between advance() and finish() (not state: rebuilt every step).
+  // Leapfrog: v_{n+1/2} and, for spheres, omega_{n+1/2} (for other bodies the body-frame
+  // angular momentum L_{n+1/2}) between advance() and finish(); not state: rebuilt every step.
   std::vector<Vec3> half_velocity_, half_angular_velocity_;
 };
 

@@ -33,8 +33,8 @@ DemSetup sliding_pair(double shift_x) {
   const auto wrap = [&](double x) { return x >= 0.02 ? x - 0.02 : x; };
   s.particles.add_sphere(0, 0, r, 2500.0, {wrap(shift_x), 0.01, 0.01}, {0.525, 0.02, 0.0},
                          {0.0, 0.0, 3.0});
-  s.particles.add_sphere(1, 0, r, 2500.0, {wrap(shift_x + 2e-3), 0.01, 0.01},
-                         {0.475, -0.02, 0.0}, {0.0, 0.0, -3.0});
+  s.particles.add_sphere(1, 0, r, 2500.0, {wrap(shift_x + 2e-3), 0.01, 0.01}, {0.475, -0.02, 0.0},
+                         {0.0, 0.0, -3.0});
   return s;
 }
 

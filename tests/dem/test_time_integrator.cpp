@@ -45,7 +45,7 @@ TEST(TimeIntegrator, AdamsBashforthSchemesIntegrateConstantTorque) {
     p.torque[0] = {0.0, 0.0, 1e-9};
     TimeIntegrator integrator(kind);
     for (int n = 0; n < 100; ++n) integrator.advance(p, {}, 1e-3);
-    EXPECT_NEAR(p.angular_velocity[0].z, 0.1 * 1e-9 * p.inverse_inertia[0], 1e-9)
+    EXPECT_NEAR(p.angular_velocity[0].z, 0.1 * 1e-9 * p.inverse_inertia_body[0].x, 1e-9)
         << to_string(kind);
     EXPECT_EQ(integrator.history().depth, 2);
   }
