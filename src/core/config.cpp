@@ -190,6 +190,26 @@ std::vector<Vec3> ConfigTable::get_vec3_list(const std::string& key) const {
   return out;
 }
 
+std::vector<std::vector<double>> ConfigTable::get_number_rows(const std::string& key,
+                                                              std::size_t columns) const {
+  const toml::node& n = require(key);
+  const toml::array* a = n.as_array();
+  const std::string shape = "an array of [" + std::to_string(columns) + " numbers] rows";
+  if (a == nullptr) fail(key, "expected " + shape);
+  std::vector<std::vector<double>> out;
+  for (std::size_t i = 0; i < a->size(); ++i) {
+    const toml::array* row = a->get(i)->as_array();
+    if (row == nullptr || row->size() != columns) {
+      fail(key, "entry " + std::to_string(i) + " is not a row of " + std::to_string(columns) +
+                    " numbers");
+    }
+    std::vector<double> values;
+    for (std::size_t k = 0; k < columns; ++k) values.push_back(number(*row->get(k), key));
+    out.push_back(std::move(values));
+  }
+  return out;
+}
+
 std::vector<std::string> ConfigTable::get_string_list(const std::string& key) const {
   const toml::node& n = require(key);
   const toml::array* a = n.as_array();

@@ -48,6 +48,9 @@ class ConfigTable {
   std::array<bool, 3> get_bool3(const std::string& key) const;
   std::vector<Vec3> get_vec3_list(const std::string& key) const;
   std::vector<std::string> get_string_list(const std::string& key) const;
+  // An array of rows of `columns` numbers each, e.g. [[t0, v0], [t1, v1]].
+  std::vector<std::vector<double>> get_number_rows(const std::string& key,
+                                                   std::size_t columns) const;
 
   // Optional values with a default.
   double get_double(const std::string& key, double fallback) const;

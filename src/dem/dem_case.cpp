@@ -61,6 +61,45 @@ void check_box(const ConfigTable& t, const Vec3& lo, const Vec3& hi, const std::
   }
 }
 
+Vec3 parse_unit_vector(const ConfigTable& t, const std::string& key) {
+  const Vec3 v = t.get_vec3(key);
+  const double n = norm(v);
+  if (!(n > 0.0)) t.fail(key, "must be a non-zero vector");
+  return v / n;
+}
+
+// A speed law of an obstacle's translation ([m/s]) or rotation ([rad/s]).
+SpeedLaw parse_speed_law(const ConfigTable& t, const std::string& speed_unit,
+                         const std::string& acceleration_unit) {
+  SpeedLaw law;
+  const std::string kind = t.get_choice("law", {"constant", "ramp", "piecewise"});
+  const std::string speed_key = "speed_" + speed_unit;
+  if (kind == "constant") {
+    law.kind = SpeedLaw::Kind::kConstant;
+    law.speed = t.get_double(speed_key);
+    law.start = t.get_non_negative("start_s", 0.0);
+  } else if (kind == "ramp") {
+    law.kind = SpeedLaw::Kind::kRamp;
+    law.speed = t.get_double(speed_key);
+    law.acceleration = t.get_positive("acceleration_" + acceleration_unit);
+    if (law.speed < 0.0) {
+      t.fail(speed_key, "a ramp's final speed must be >= 0 (reverse the direction instead)");
+    }
+    law.start = t.get_non_negative("start_s", 0.0);
+  } else {
+    law.kind = SpeedLaw::Kind::kPiecewise;
+    const std::string key = "points_s_" + speed_unit;
+    for (const auto& row : t.get_number_rows(key, 2)) {
+      if (!law.points.empty() && !(row[0] > law.points.back().first)) {
+        t.fail(key, "times must increase strictly");
+      }
+      law.points.emplace_back(row[0], row[1]);
+    }
+    if (law.points.empty()) t.fail(key, "needs at least one [time, speed] point");
+  }
+  return law;
+}
+
 Obstacle parse_obstacle(const ConfigTable& t, std::vector<MaterialSpec>& materials,
                         std::size_t index) {
   Obstacle o;
@@ -85,6 +124,15 @@ Obstacle parse_obstacle(const ConfigTable& t, std::vector<MaterialSpec>& materia
     o.shape = box;
   }
   if (t.has("remove_at_s")) o.remove_at = t.get_non_negative("remove_at_s", 0.0);
+  if (auto tr = t.find_table("translation")) {
+    o.motion.direction = parse_unit_vector(*tr, "direction");
+    o.motion.translation = parse_speed_law(*tr, "m_s", "m_s2");
+  }
+  if (auto rot = t.find_table("rotation")) {
+    o.motion.axis = parse_unit_vector(*rot, "axis");
+    o.motion.centre = rot->get_vec3("centre_m");
+    o.motion.rotation = parse_speed_law(*rot, "rad_s", "rad_s2");
+  }
   return o;
 }
 

@@ -83,7 +83,7 @@ class SphereHash {
 
 bool overlaps_obstacle(const Vec3& x, double r, const std::vector<Obstacle>& obstacles) {
   for (const Obstacle& o : obstacles) {
-    if (o.active(0.0) && sphere_gap(o, x, r).overlap > 0.0) return true;
+    if (o.active(0.0) && sphere_gap(o, 0.0, x, r).overlap > 0.0) return true;
   }
   return false;
 }
@@ -177,7 +177,7 @@ std::optional<std::string> find_overlap(const std::vector<SphereSeed>& spheres,
     hash.add(s, i);
     for (const Obstacle& o : obstacles) {
       if (!found && o.active(0.0) &&
-          sphere_gap(o, s.position, s.radius).overlap > tolerance * s.radius) {
+          sphere_gap(o, 0.0, s.position, s.radius).overlap > tolerance * s.radius) {
         found = "particle " + std::to_string(i) + " overlaps obstacle '" + o.name + "'";
       }
     }

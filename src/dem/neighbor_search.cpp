@@ -24,6 +24,29 @@ NeighborSearch::NeighborSearch(const Domain& domain, double skin, double max_rad
   }
 }
 
+double NeighborSearch::obstacle_travel(const Obstacle& o, double t0, double t1) const {
+  // Bound on how far any point of the obstacle inside the domain moved between t0 and t1.
+  const ObstacleMotion& m = o.motion;
+  double travel = norm(m.offset_at(t1) - m.offset_at(t0));
+  if (m.rotation.moving()) {
+    const double reach = norm(domain_.max - domain_.min) +
+                         norm(m.centre - 0.5 * (domain_.min + domain_.max)) + norm(m.offset_at(t1));
+    travel += std::abs(m.rotation.distance_at(t1) - m.rotation.distance_at(t0)) * reach;
+  }
+  return travel;
+}
+
+bool NeighborSearch::needs_rebuild(const ParticleStore& particles,
+                                   const std::vector<Obstacle>& obstacles, double time) const {
+  for (const Obstacle& o : obstacles) {
+    if (!o.motion.is_static() && o.active(time) &&
+        obstacle_travel(o, reference_time_, time) > 0.5 * skin_) {
+      return true;
+    }
+  }
+  return needs_rebuild(particles);
+}
+
 bool NeighborSearch::needs_rebuild(const ParticleStore& particles) const {
   const std::size_t n = particles.size();
   if (reference_.size() != n) return true;
@@ -125,7 +148,7 @@ void NeighborSearch::rebuild(ParticleStore& particles, const std::vector<Obstacl
     for (std::size_t o = 0; o < obstacles.size(); ++o) {
       if (!obstacles[o].active(time)) continue;
       const SphereObstacleGap gap =
-          sphere_gap(obstacles[o], particles.position[i], particles.radius[i]);
+          sphere_gap(obstacles[o], time, particles.position[i], particles.radius[i]);
       if (gap.overlap > -skin_) {
         scratch_.push(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(o), {});
       }
@@ -135,6 +158,7 @@ void NeighborSearch::rebuild(ParticleStore& particles, const std::vector<Obstacl
   std::swap(walls, scratch_);
 
   reference_ = particles.position;
+  reference_time_ = time;
   ++rebuilds_;
 }
 

@@ -18,8 +18,11 @@ class NeighborSearch {
   NeighborSearch() = default;
   NeighborSearch(const Domain& domain, double skin, double max_radius);
 
-  // True when the lists may miss a contact: max displacement > skin / 2.
+  // True when the lists may miss a contact: a particle, or a point of a moving obstacle,
+  // has moved more than skin / 2 since the last build.
   bool needs_rebuild(const ParticleStore& particles) const;
+  bool needs_rebuild(const ParticleStore& particles, const std::vector<Obstacle>& obstacles,
+                     double time) const;
 
   // Wraps periodic positions, bins particles and rebuilds both lists, carrying the
   // contact histories over. Obstacles inactive at `time` get no entries.
@@ -31,10 +34,12 @@ class NeighborSearch {
   const std::vector<Vec3>& reference_positions() const { return reference_; }
   std::vector<Vec3>& reference_positions() { return reference_; }
   std::int64_t& rebuild_counter() { return rebuilds_; }
+  double& reference_time() { return reference_time_; }
 
  private:
   void bin(const ParticleStore& particles);
   std::int64_t cell_of(const Vec3& x) const;
+  double obstacle_travel(const Obstacle& o, double t0, double t1) const;
 
   Domain domain_;
   double skin_ = 0.0;
@@ -45,6 +50,7 @@ class NeighborSearch {
   std::vector<std::uint32_t> cell_members_;  // particle indices sorted by cell
   std::vector<Vec3> reference_;              // positions at the last rebuild
   std::int64_t rebuilds_ = 0;
+  double reference_time_ = 0.0;  // time of the last rebuild [s]
   ContactList scratch_;
   std::vector<std::uint32_t> candidates_;
 };

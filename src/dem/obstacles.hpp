@@ -1,14 +1,15 @@
 #pragma once
-// Fixed obstacles for spheres: infinite planes and finite axis-aligned boxes
-// (a closed container is a set of them). Each may be removed at a given time
-// (the dam-break gate of §3.2.1 when lifted instantly). Narrow phase against a
-// sphere is analytic.
+// Obstacles for spheres: infinite planes and finite boxes (a closed container is
+// a set of them), fixed or moving with prescribed kinematics (obstacle_motion.hpp),
+// each removable at a given time (the dam-break gate of §3.2.1 lifted instantly).
+// Narrow phase against a sphere is analytic, in the obstacle's initial frame.
 #include <cstdint>
 #include <limits>
 #include <string>
 #include <variant>
 
 #include "core/vec3.hpp"
+#include "dem/obstacle_motion.hpp"
 
 namespace sanguis::dem {
 
@@ -26,6 +27,7 @@ struct Obstacle {
   std::int32_t material = 0;
   std::variant<PlaneShape, AxisAlignedBoxShape> shape;
   double remove_at = std::numeric_limits<double>::infinity();  // [s]
+  ObstacleMotion motion;  // shape given at t = 0; static unless a speed law is set
 
   bool active(double time) const { return time < remove_at; }
 };
@@ -83,8 +85,18 @@ inline SphereObstacleGap sphere_gap(const AxisAlignedBoxShape& box, const Vec3& 
   return gap;
 }
 
-inline SphereObstacleGap sphere_gap(const Obstacle& o, const Vec3& centre, double radius) {
-  return std::visit([&](const auto& shape) { return sphere_gap(shape, centre, radius); }, o.shape);
+// Gap of a sphere with an obstacle at its pose at time t.
+inline SphereObstacleGap sphere_gap(const Obstacle& o, double t, const Vec3& centre,
+                                    double radius) {
+  if (o.motion.is_static()) {
+    return std::visit([&](const auto& shape) { return sphere_gap(shape, centre, radius); },
+                      o.shape);
+  }
+  const Vec3 local = o.motion.to_initial_frame(t, centre);
+  SphereObstacleGap gap =
+      std::visit([&](const auto& shape) { return sphere_gap(shape, local, radius); }, o.shape);
+  gap.normal = o.motion.direction_to_space(t, gap.normal);
+  return gap;
 }
 
 }  // namespace sanguis::dem

@@ -46,7 +46,8 @@ void DemSimulation::step() {
   ParticleStore& p = setup_.particles;
   integrator_.advance(p, setup_.gravity, dt);
   ++step_;
-  if (search_.needs_rebuild(p)) search_.rebuild(p, setup_.obstacles, time(), pairs_, walls_);
+  if (search_.needs_rebuild(p, setup_.obstacles, time()))
+    search_.rebuild(p, setup_.obstacles, time(), pairs_, walls_);
   compute_forces();
   integrator_.finish(p, setup_.gravity, dt);
   if (step_ % 64 == 0) check_state();
@@ -124,8 +125,8 @@ void DemSimulation::compute_forces() {
     const std::uint32_t i = walls_.first[k];
     const Obstacle& obstacle = setup_.obstacles[walls_.second[k]];
     ContactHistory& h = walls_.history[k];
-    const SphereObstacleGap gap =
-        obstacle.active(now) ? sphere_gap(obstacle, x[i], rad[i]) : SphereObstacleGap{-1.0, {}};
+    const SphereObstacleGap gap = obstacle.active(now) ? sphere_gap(obstacle, now, x[i], rad[i])
+                                                       : SphereObstacleGap{-1.0, {}};
     if (gap.overlap < 0.0) {
       if (h.normal.x != 0.0 || h.normal.y != 0.0 || h.normal.z != 0.0) h = ContactHistory{};
       continue;
@@ -134,8 +135,14 @@ void DemSimulation::compute_forces() {
     c.normal = gap.normal;
     c.overlap = gap.overlap;
     const Vec3 arm_i = (rad[i] - 0.5 * c.overlap) * gap.normal;
-    c.relative_velocity = v[i] + cross(w[i], arm_i);  // obstacles are fixed
+    c.relative_velocity = v[i] + cross(w[i], arm_i);
+    if (!obstacle.motion.is_static()) {
+      c.relative_velocity -= obstacle.motion.velocity_at(now, x[i] + arm_i);
+    }
     c.relative_angular_velocity = w[i];
+    if (obstacle.motion.rotation.moving()) {
+      c.relative_angular_velocity -= obstacle.motion.rotation.speed_at(now) * obstacle.motion.axis;
+    }
     c.reduced_radius = rad[i];
     const ContactResponse r =
         evaluate_contact(setup_.contacts.get(static_cast<std::size_t>(mat[i]),
@@ -294,6 +301,7 @@ void DemSimulation::save_checkpoint(const std::filesystem::path& file) const {
     auto& search = const_cast<NeighborSearch&>(search_);
     put(out, search.reference_positions());
     put(out, search.rebuild_counter());
+    put(out, search.reference_time());
     put_list(out, pairs_);
     put_list(out, walls_);
     put(out, max_overlap_ratio_);
@@ -333,6 +341,7 @@ void DemSimulation::load_checkpoint(const std::filesystem::path& file) {
     }
     get(in, search_.reference_positions());
     get(in, search_.rebuild_counter());
+    get(in, search_.reference_time());
     get_list(in, pairs_);
     get_list(in, walls_);
     get(in, max_overlap_ratio_);
