@@ -108,8 +108,10 @@ void print_params(const ParamsOptions& o) {
       "--damping-model exact_restitution to make it equal en.\n");
 }
 
-int run_command(const std::string& case_file, const std::string& output, bool restart, bool quiet) {
-  const dem::DemCase c = dem::load_dem_case(case_file);
+int run_command(const std::string& case_file, const std::string& output, bool restart, bool quiet,
+                int threads) {
+  dem::DemCase c = dem::load_dem_case(case_file);
+  if (threads > 0) c.setup.threads = threads;
   dem::RunOptions options;
   options.output_dir =
       output.empty() ? std::filesystem::path("output") / c.name : std::filesystem::path(output);
@@ -137,6 +139,10 @@ int main(int argc, char** argv) {
   run->add_option("--output,-o", output, "output directory (default: output/<case name>)");
   run->add_flag("--restart", restart, "continue from OUTPUT/checkpoint.bin");
   run->add_flag("--quiet,-q", quiet, "no progress line");
+  int run_threads = 0;
+  run->add_option("--threads,-t", run_threads,
+                  "OpenMP threads (default: the case's simulation.threads, else all cores)")
+      ->check(CLI::Range(1, 1024));
 
   ParamsOptions po;
   auto* params = app.add_subcommand("params", "contact parameters by the procedure of §2.4");
@@ -173,7 +179,7 @@ int main(int argc, char** argv) {
   }
 
   try {
-    if (*run) return run_command(case_file, output, restart, quiet);
+    if (*run) return run_command(case_file, output, restart, quiet, run_threads);
     if (*params) {
       print_params(po);
       return 0;
@@ -181,10 +187,6 @@ int main(int argc, char** argv) {
     if (*bench_cmd) {
       if (bench_name != "dem-spheres") {
         throw InputError("", "bench", "unknown benchmark '" + bench_name + "' (dem-spheres)");
-      }
-      if (bo.threads != 1) {
-        std::cerr << "sanguis bench: note: the solver is single-threaded for now; "
-                     "--threads is recorded only\n";
       }
       std::cout << bench::run_dem_spheres(bo) << std::endl;
       return 0;

@@ -30,6 +30,7 @@ dem::DemSetup dem_spheres_setup(const BenchOptions& o) {
   s.time_step = 5e-7;
   s.integrator = dem::IntegratorKind::kLeapfrog;  // velocity Verlet, as fix nve/sphere
   s.skin = 2e-4;
+  s.threads = o.threads;
   s.material_names = {"glass", "floor"};
 
   // Table 2.1 stiffnesses; damping from en = 0.45, et = 0.3 with the pair reduced mass,

@@ -8,6 +8,8 @@
 #include <set>
 #include <sstream>
 
+#include <omp.h>
+
 #include "dem/insertion.hpp"
 
 namespace sanguis::dem {
@@ -328,6 +330,9 @@ DemCase load_dem_case(const ConfigTable& cfg, const std::filesystem::path& sourc
   s.gravity = sim.get_vec3("gravity_m_s2", {0.0, 0.0, -9.81});
   s.skin = sim.get_non_negative("skin_m", 0.0);
   s.max_overlap_ratio = sim.get_positive("abort_overlap_ratio", 0.5);
+  const std::int64_t threads = sim.get_int("threads", 0);
+  if (threads < 0 || threads > 1024) sim.fail("threads", "must be 0 (all cores) or 1..1024");
+  s.threads = threads == 0 ? std::max(1, omp_get_num_procs()) : static_cast<int>(threads);
   const bool allow_large_dt = sim.get_bool("allow_large_time_step", false);
   const bool dt_given = sim.has("time_step_s");
   const double dt_value = dt_given ? sim.get_positive("time_step_s") : 0.0;
@@ -512,6 +517,7 @@ std::string describe(const DemCase& c) {
   o << "case            " << c.name << "  (" << c.source.string() << ")\n";
   o << "particles       " << s.particles.size() << "\n";
   o << "obstacles       " << s.obstacles.size() << "\n";
+  o << "threads         " << s.threads << " (results do not depend on it)\n";
   o << "integrator      " << to_string(s.integrator) << " (order " << order_of(s.integrator)
     << ")\n";
   o << "time step       " << s.time_step << " s  = Tc / " << c.smallest_contact_time / s.time_step

@@ -32,12 +32,14 @@ DemSimulation::DemSimulation(DemSetup setup)
     }
   }
   search_ = NeighborSearch(setup_.domain, setup_.skin, r_max);
-  search_.rebuild(p, setup_.obstacles, time(), pairs_, walls_);
+  threads_ = std::max(1, setup_.threads);
+  integrator_.set_threads(threads_);
+  rebuild_lists();
   compute_forces();
 }
 
 void DemSimulation::refresh_forces() {
-  search_.rebuild(setup_.particles, setup_.obstacles, time(), pairs_, walls_);
+  rebuild_lists();
   compute_forces();
 }
 
@@ -46,8 +48,7 @@ void DemSimulation::step() {
   ParticleStore& p = setup_.particles;
   integrator_.advance(p, setup_.gravity, dt);
   ++step_;
-  if (search_.needs_rebuild(p, setup_.obstacles, time()))
-    search_.rebuild(p, setup_.obstacles, time(), pairs_, walls_);
+  if (search_.needs_rebuild(p, setup_.obstacles, time())) rebuild_lists();
   compute_forces();
   integrator_.finish(p, setup_.gravity, dt);
   if (step_ % 64 == 0) check_state();
@@ -62,25 +63,18 @@ void DemSimulation::compute_forces() {
   const std::size_t n = p.size();
   const double dt = setup_.time_step;
   const double now = time();
-  std::fill(p.force.begin(), p.force.end(), Vec3{});
-  std::fill(p.torque.begin(), p.torque.end(), Vec3{});
-  std::fill(p.coordination.begin(), p.coordination.end(), 0);
 
   const Vec3* x = p.position.data();
   const Vec3* v = p.velocity.data();
   const Vec3* w = p.angular_velocity.data();
   const double* rad = p.radius.data();
   const std::int32_t* mat = p.material.data();
-  Vec3* f = p.force.data();
-  Vec3* tq = p.torque.data();
-  std::int32_t* coord = p.coordination.data();
   const Domain& domain = setup_.domain;
   const bool periodic = domain.periodic[0] || domain.periodic[1] || domain.periodic[2];
 
-  double worst = 0.0;
-  std::int64_t touching = 0;
-  const std::size_t n_pairs = pairs_.size();
-  for (std::size_t k = 0; k < n_pairs; ++k) {
+  // Sphere-sphere contact k (eq. 2.5-2.13 through evaluate_contact).
+  const auto pair_outcome = [&](std::size_t k) __attribute__((always_inline)) {
+    ContactOutcome out;
     const std::uint32_t i = pairs_.first[k];
     const std::uint32_t j = pairs_.second[k];
     ContactHistory& h = pairs_.history[k];
@@ -90,7 +84,7 @@ void DemSimulation::compute_forces() {
     const double dist2 = norm2(d);
     if (dist2 > sum_r * sum_r) {
       if (h.normal.x != 0.0 || h.normal.y != 0.0 || h.normal.z != 0.0) h = ContactHistory{};
-      continue;
+      return out;
     }
     const double dist = std::sqrt(dist2);
     const Vec3 normal = dist > 0.0 ? (1.0 / dist) * d : Vec3{0.0, 0.0, 1.0};
@@ -108,20 +102,17 @@ void DemSimulation::compute_forces() {
         setup_.contacts.get(static_cast<std::size_t>(mat[i]), static_cast<std::size_t>(mat[j])), c,
         h, dt);
     const Vec3 moment = cross(normal, r.force);
-    f[i] += r.force;
-    f[j] -= r.force;
-    tq[i] += a_i * moment + r.rolling_torque;
-    tq[j] += a_j * moment - r.rolling_torque;
-    ++coord[i];
-    ++coord[j];
-    ++touching;
-    worst = std::max(worst, c.overlap / std::min(rad[i], rad[j]));
-  }
-  touching_pairs_ = touching;
+    out.force = r.force;
+    out.torque_first = a_i * moment + r.rolling_torque;
+    out.torque_second = a_j * moment - r.rolling_torque;
+    out.overlap_ratio = c.overlap / std::min(rad[i], rad[j]);
+    out.touching = true;
+    return out;
+  };
 
-  touching = 0;
-  const std::size_t n_walls = walls_.size();
-  for (std::size_t k = 0; k < n_walls; ++k) {
+  // Sphere-obstacle contact k.
+  const auto wall_outcome = [&](std::size_t k) __attribute__((always_inline)) {
+    ContactOutcome out;
     const std::uint32_t i = walls_.first[k];
     const Obstacle& obstacle = setup_.obstacles[walls_.second[k]];
     ContactHistory& h = walls_.history[k];
@@ -129,7 +120,7 @@ void DemSimulation::compute_forces() {
                                                        : SphereObstacleGap{-1.0, {}};
     if (gap.overlap < 0.0) {
       if (h.normal.x != 0.0 || h.normal.y != 0.0 || h.normal.z != 0.0) h = ContactHistory{};
-      continue;
+      return out;
     }
     ContactKinematics c;
     c.normal = gap.normal;
@@ -148,15 +139,105 @@ void DemSimulation::compute_forces() {
         evaluate_contact(setup_.contacts.get(static_cast<std::size_t>(mat[i]),
                                              static_cast<std::size_t>(obstacle.material)),
                          c, h, dt);
-    f[i] += r.force;
-    tq[i] += cross(arm_i, r.force) + r.rolling_torque;
-    ++coord[i];
-    ++touching;
-    worst = std::max(worst, c.overlap / rad[i]);
+    out.force = r.force;
+    out.torque_first = cross(arm_i, r.force) + r.rolling_torque;
+    out.overlap_ratio = c.overlap / rad[i];
+    out.touching = true;
+    return out;
+  };
+
+  Vec3* f = p.force.data();
+  Vec3* tq = p.torque.data();
+  std::int32_t* coord = p.coordination.data();
+  const std::size_t n_pairs = pairs_.size();
+  const std::size_t n_walls = walls_.size();
+  double worst = 0.0;
+  std::int64_t touching_pairs = 0, touching_walls = 0;
+
+  if (threads_ <= 1) {
+    // Serial: accumulate directly, contacts in list order.
+    std::fill(p.force.begin(), p.force.end(), Vec3{});
+    std::fill(p.torque.begin(), p.torque.end(), Vec3{});
+    std::fill(p.coordination.begin(), p.coordination.end(), 0);
+    for (std::size_t k = 0; k < n_pairs; ++k) {
+      const ContactOutcome o = pair_outcome(k);
+      if (!o.touching) continue;
+      const std::uint32_t i = pairs_.first[k], j = pairs_.second[k];
+      f[i] += o.force;
+      f[j] -= o.force;
+      tq[i] += o.torque_first;
+      tq[j] += o.torque_second;
+      ++coord[i];
+      ++coord[j];
+      ++touching_pairs;
+      worst = std::max(worst, o.overlap_ratio);
+    }
+    for (std::size_t k = 0; k < n_walls; ++k) {
+      const ContactOutcome o = wall_outcome(k);
+      if (!o.touching) continue;
+      const std::uint32_t i = walls_.first[k];
+      f[i] += o.force;
+      tq[i] += o.torque_first;
+      ++coord[i];
+      ++touching_walls;
+      worst = std::max(worst, o.overlap_ratio);
+    }
+  } else {
+    // Threads: every contact writes its own slot, then each particle sums its contacts in
+    // increasing contact index, walls last: exactly the order of the serial loop, so the
+    // result is bitwise the same for any number of threads (no atomics).
+    const int nt = threads_;
+#pragma omp parallel num_threads(nt)
+    {
+#pragma omp for schedule(static) reduction(max : worst) reduction(+ : touching_pairs)
+      for (std::size_t k = 0; k < n_pairs; ++k) {
+        pair_buffer_[k] = pair_outcome(k);
+        if (pair_buffer_[k].touching) {
+          ++touching_pairs;
+          worst = std::max(worst, pair_buffer_[k].overlap_ratio);
+        }
+      }
+#pragma omp for schedule(static) reduction(max : worst) reduction(+ : touching_walls)
+      for (std::size_t k = 0; k < n_walls; ++k) {
+        wall_buffer_[k] = wall_outcome(k);
+        if (wall_buffer_[k].touching) {
+          ++touching_walls;
+          worst = std::max(worst, wall_buffer_[k].overlap_ratio);
+        }
+      }
+#pragma omp for schedule(static)
+      for (std::size_t i = 0; i < n; ++i) {
+        Vec3 force{}, torque{};
+        std::int32_t count = 0;
+        for (std::uint32_t e = incident_offset_[i]; e < incident_offset_[i + 1]; ++e) {
+          const std::uint32_t entry = incident_[e];
+          const ContactOutcome& o = pair_buffer_[entry >> 1];
+          if (!o.touching) continue;
+          if ((entry & 1u) == 0) {
+            force += o.force;
+            torque += o.torque_first;
+          } else {
+            force -= o.force;
+            torque += o.torque_second;
+          }
+          ++count;
+        }
+        for (std::uint32_t k = wall_offset_[i]; k < wall_offset_[i + 1]; ++k) {
+          const ContactOutcome& o = wall_buffer_[k];
+          if (!o.touching) continue;
+          force += o.force;
+          torque += o.torque_first;
+          ++count;
+        }
+        f[i] = force;
+        tq[i] = torque;
+        coord[i] = count;
+      }
+    }
   }
-  touching_walls_ = touching;
+  touching_pairs_ = touching_pairs;
+  touching_walls_ = touching_walls;
   max_overlap_ratio_ = worst;
-  (void)n;
 
   if (!(worst <= setup_.max_overlap_ratio)) {
     std::ostringstream msg;
@@ -166,6 +247,36 @@ void DemSimulation::compute_forces() {
            "created overlapping";
     throw SimulationError(msg.str());
   }
+}
+
+void DemSimulation::rebuild_lists() {
+  search_.rebuild(setup_.particles, setup_.obstacles, time(), pairs_, walls_);
+  build_incidence();
+}
+
+void DemSimulation::build_incidence() {
+  if (threads_ <= 1) return;
+  // Incidence lists for the gather: for each particle its pair contacts in increasing
+  // index (bit 0: the particle is the pair's second body), and its range of wall contacts.
+  const std::size_t n = setup_.particles.size();
+  incident_offset_.assign(n + 1, 0);
+  for (std::size_t k = 0; k < pairs_.size(); ++k) {
+    ++incident_offset_[pairs_.first[k] + 1];
+    ++incident_offset_[pairs_.second[k] + 1];
+  }
+  for (std::size_t i = 0; i < n; ++i) incident_offset_[i + 1] += incident_offset_[i];
+  incident_.resize(incident_offset_[n]);
+  incident_fill_.assign(incident_offset_.begin(), incident_offset_.end() - 1);
+  for (std::size_t k = 0; k < pairs_.size(); ++k) {
+    const auto entry = static_cast<std::uint32_t>(k << 1);
+    incident_[incident_fill_[pairs_.first[k]]++] = entry;
+    incident_[incident_fill_[pairs_.second[k]]++] = entry | 1u;
+  }
+  wall_offset_.assign(n + 1, 0);
+  for (std::size_t k = 0; k < walls_.size(); ++k) ++wall_offset_[walls_.first[k] + 1];
+  for (std::size_t i = 0; i < n; ++i) wall_offset_[i + 1] += wall_offset_[i];
+  pair_buffer_.resize(pairs_.size());
+  wall_buffer_.resize(walls_.size());
 }
 
 void DemSimulation::check_state() const {
@@ -347,6 +458,7 @@ void DemSimulation::load_checkpoint(const std::filesystem::path& file) {
     get(in, max_overlap_ratio_);
     get(in, touching_pairs_);
     get(in, touching_walls_);
+    build_incidence();
   } catch (const std::runtime_error& e) {
     throw InputError(file.string(), "", e.what());
   }

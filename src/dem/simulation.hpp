@@ -37,6 +37,15 @@ class ContactTable {
   std::vector<bool> defined_;
 };
 
+// What one contact contributes to its two bodies (no second body for walls).
+struct ContactOutcome {
+  Vec3 force;          // on the first body (the second gets -force)
+  Vec3 torque_first;   // total torque on the first body
+  Vec3 torque_second;  // total torque on the second body
+  double overlap_ratio = 0.0;
+  bool touching = false;
+};
+
 struct DemSetup {
   Domain domain;
   Vec3 gravity;            // [m/s^2]
@@ -44,6 +53,7 @@ struct DemSetup {
   IntegratorKind integrator = IntegratorKind::kLeapfrog;
   double skin = 0.0;               // Verlet skin [m]; 0 -> 0.1 x smallest diameter
   double max_overlap_ratio = 0.5;  // overlap / R beyond which the run stops as unstable
+  int threads = 1;                 // OpenMP threads; results are bitwise the same for any count
   std::vector<std::string> material_names;
   ContactTable contacts;
   std::vector<Obstacle> obstacles;
@@ -94,6 +104,8 @@ class DemSimulation {
 
  private:
   void compute_forces();
+  void rebuild_lists();
+  void build_incidence();
   void check_state() const;
 
   DemSetup setup_;
@@ -103,6 +115,11 @@ class DemSimulation {
   std::int64_t step_ = 0;
   double max_overlap_ratio_ = 0.0;
   std::int64_t touching_pairs_ = 0, touching_walls_ = 0;
+  int threads_ = 1;
+  // Threaded force gather (see compute_forces): per-contact outcomes and, per particle,
+  // its contacts in increasing index. Rebuilt with the lists, not part of the state.
+  std::vector<ContactOutcome> pair_buffer_, wall_buffer_;
+  std::vector<std::uint32_t> incident_offset_, incident_, incident_fill_, wall_offset_;
 };
 
 }  // namespace sanguis::dem

@@ -129,6 +129,7 @@ void TimeIntegrator::advance(ParticleStore& p, const Vec3& gravity, double dt) {
 
   switch (kind_) {
     case IntegratorKind::kForwardEuler:  // eq. 2.30
+#pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1)
       for (std::size_t i = 0; i < n; ++i) {
         x[i] += dt * v[i];
         v[i] += dt * (inv_m[i] * f[i] + gravity);
@@ -142,6 +143,7 @@ void TimeIntegrator::advance(ParticleStore& p, const Vec3& gravity, double dt) {
     case IntegratorKind::kLeapfrog: {  // eq. 2.31, kick-drift half
       half_velocity_.resize(n);
       half_angular_velocity_.resize(n);
+#pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1)
       for (std::size_t i = 0; i < n; ++i) {
         const Vec3 kick = (0.5 * dt) * (inv_m[i] * f[i] + gravity);
         half_velocity_[i] = v[i] + kick;
@@ -176,6 +178,7 @@ void TimeIntegrator::advance(ParticleStore& p, const Vec3& gravity, double dt) {
       }
       const int max_order = kind_ == IntegratorKind::kAdamsBashforth2 ? 2 : 3;
       const int order = std::min(max_order, h.depth + 1);
+#pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1)
       for (std::size_t i = 0; i < n; ++i) {
         const Vec3 a = inv_m[i] * f[i] + gravity;
         const Vec3 alpha = inv_j[i].x * t[i];  // spheres only; bodies below
@@ -208,6 +211,7 @@ void TimeIntegrator::advance(ParticleStore& p, const Vec3& gravity, double dt) {
 void TimeIntegrator::finish(ParticleStore& p, const Vec3& gravity, double dt) {
   if (kind_ != IntegratorKind::kLeapfrog) return;
   const std::size_t n = p.size();
+#pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1)
   for (std::size_t i = 0; i < n; ++i) {  // final half kick with a_{n+1}
     p.velocity[i] = half_velocity_[i] + (0.5 * dt) * (p.inverse_mass[i] * p.force[i] + gravity);
     if (p.spherical[i]) {

@@ -47,6 +47,8 @@ class TimeIntegrator {
   explicit TimeIntegrator(IntegratorKind kind = IntegratorKind::kLeapfrog) : kind_(kind) {}
 
   IntegratorKind kind() const { return kind_; }
+  // Particles are independent: the loops run on `threads` OpenMP threads.
+  void set_threads(int threads) { threads_ = threads < 1 ? 1 : threads; }
   void advance(ParticleStore& p, const Vec3& gravity, double dt);
   void finish(ParticleStore& p, const Vec3& gravity, double dt);
 
@@ -55,6 +57,7 @@ class TimeIntegrator {
 
  private:
   IntegratorKind kind_;
+  int threads_ = 1;
   MultistepHistory history_;
   // Leapfrog: v_{n+1/2} and, for spheres, omega_{n+1/2} (for other bodies the body-frame
   // angular momentum L_{n+1/2}) between advance() and finish(); not state: rebuilt every step.
