@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "dem/contact_law.hpp"
+#include "geometry/gjk.hpp"
 
 namespace sanguis::dem {
 
@@ -38,6 +39,52 @@ inline void carry_history(const ContactList& previous, ContactList& fresh) {
     while (p < np && ((std::uint64_t{previous.first[p]} << 32) | previous.second[p]) < key) ++p;
     if (p < np && ((std::uint64_t{previous.first[p]} << 32) | previous.second[p]) == key) {
       fresh.history[k] = previous.history[p];
+    }
+  }
+}
+
+// Candidate contacts involving non-spherical bodies, one entry per pair of convex
+// elements (two crosses touch at up to four points, each with its own memory),
+// sorted by (first, second, element_first, element_second). For obstacle contacts
+// `second` is the obstacle index and `element_second` is 0.
+struct BodyContactList {
+  std::vector<std::uint32_t> first, second;
+  std::vector<std::uint16_t> element_first, element_second;
+  std::vector<ContactHistory> history;
+  std::vector<geometry::GjkWarmStart> warm;  // last GJK simplex: the next call starts there
+
+  std::size_t size() const { return first.size(); }
+  void clear() {
+    first.clear();
+    second.clear();
+    element_first.clear();
+    element_second.clear();
+    history.clear();
+    warm.clear();
+  }
+  void push(std::uint32_t a, std::uint32_t b, std::uint16_t ea, std::uint16_t eb) {
+    first.push_back(a);
+    second.push_back(b);
+    element_first.push_back(ea);
+    element_second.push_back(eb);
+    history.push_back({});
+    warm.push_back({});
+  }
+  std::uint64_t key(std::size_t k) const {  // particles < 2^24, elements < 2^8
+    return (std::uint64_t{first[k]} << 40) | (std::uint64_t{second[k]} << 16) |
+           (std::uint64_t{element_first[k]} << 8) | element_second[k];
+  }
+};
+
+inline void carry_history(const BodyContactList& previous, BodyContactList& fresh) {
+  std::size_t p = 0;
+  const std::size_t np = previous.size();
+  for (std::size_t k = 0; k < fresh.size() && p < np; ++k) {
+    const std::uint64_t key = fresh.key(k);
+    while (p < np && previous.key(p) < key) ++p;
+    if (p < np && previous.key(p) == key) {
+      fresh.history[k] = previous.history[p];
+      fresh.warm[k] = previous.warm[p];
     }
   }
 }

@@ -50,11 +50,28 @@ bool NeighborSearch::needs_rebuild(const ParticleStore& particles,
 bool NeighborSearch::needs_rebuild(const ParticleStore& particles) const {
   const std::size_t n = particles.size();
   if (reference_.size() != n) return true;
-  const double limit2 = 0.25 * skin_ * skin_;
+  const double limit = 0.5 * skin_;
+  const double limit2 = limit * limit;
   const Vec3* x = particles.position.data();
   const Vec3* r = reference_.data();
+  bool stale = false;
+  for (std::size_t i = 0; i < n; ++i) stale |= norm2(x[i] - r[i]) > limit2;
+  if (stale || reference_orientation_.empty()) return stale;  // empty: no bodies at last build
+  // A rotating body moves its surface points by up to R_bound * angle more.
   for (std::size_t i = 0; i < n; ++i) {
-    if (norm2(x[i] - r[i]) > limit2) return true;
+    if (particles.spherical[i]) continue;
+    const Quaternion& q = particles.orientation[i];
+    const Quaternion& q0 = reference_orientation_[i];
+    const double c = std::min(1.0, std::abs(q.w * q0.w + q.x * q0.x + q.y * q0.y + q.z * q0.z));
+    const double angle = 2.0 * std::acos(c);
+    if (norm(x[i] - r[i]) + particles.radius[i] * angle > limit) return true;
+  }
+  return false;
+}
+
+bool NeighborSearch::has_bodies(const ParticleStore& particles) {
+  for (std::uint8_t s : particles.spherical) {
+    if (!s) return true;
   }
   return false;
 }
@@ -158,6 +175,11 @@ void NeighborSearch::rebuild(ParticleStore& particles, const std::vector<Obstacl
   std::swap(walls, scratch_);
 
   reference_ = particles.position;
+  if (has_bodies(particles)) {
+    reference_orientation_ = particles.orientation;
+  } else {
+    reference_orientation_.clear();
+  }
   reference_time_ = time;
   ++rebuilds_;
 }

@@ -35,20 +35,24 @@ class NeighborSearch {
   std::vector<Vec3>& reference_positions() { return reference_; }
   std::int64_t& rebuild_counter() { return rebuilds_; }
   double& reference_time() { return reference_time_; }
+  std::vector<Quaternion>& reference_orientations() { return reference_orientation_; }
+  const Domain& domain() const { return domain_; }
 
  private:
   void bin(const ParticleStore& particles);
   std::int64_t cell_of(const Vec3& x) const;
   double obstacle_travel(const Obstacle& o, double t0, double t1) const;
+  static bool has_bodies(const ParticleStore& particles);
 
   Domain domain_;
   double skin_ = 0.0;
   double max_radius_ = 0.0;
   std::array<std::int64_t, 3> cells_{1, 1, 1};
   Vec3 cell_size_;
-  std::vector<std::uint32_t> cell_start_;    // CSR offsets, size n_cells + 1
-  std::vector<std::uint32_t> cell_members_;  // particle indices sorted by cell
-  std::vector<Vec3> reference_;              // positions at the last rebuild
+  std::vector<std::uint32_t> cell_start_;          // CSR offsets, size n_cells + 1
+  std::vector<std::uint32_t> cell_members_;        // particle indices sorted by cell
+  std::vector<Vec3> reference_;                    // positions at the last rebuild
+  std::vector<Quaternion> reference_orientation_;  // orientations then (only with bodies)
   std::int64_t rebuilds_ = 0;
   double reference_time_ = 0.0;  // time of the last rebuild [s]
   ContactList scratch_;

@@ -11,6 +11,7 @@
 
 #include "core/error.hpp"
 #include "core/io/atomic_file.hpp"
+#include "dem/body_contacts.hpp"
 
 namespace sanguis::dem {
 
@@ -32,7 +33,21 @@ DemSimulation::DemSimulation(DemSetup setup)
     }
   }
   search_ = NeighborSearch(setup_.domain, setup_.skin, r_max);
-  threads_ = std::max(1, setup_.threads);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (p.spherical[i]) continue;
+    has_bodies_ = true;
+    if (static_cast<std::size_t>(p.species[i]) >= setup_.shapes.size() ||
+        setup_.shapes[static_cast<std::size_t>(p.species[i])].is_sphere()) {
+      throw std::invalid_argument("a non-spherical particle has no shape in the species table");
+    }
+  }
+  // Threads pay off only with enough work per thread between two barriers; below that the
+  // serial path is used (same results, bit for bit), which also keeps small runs from
+  // stalling when the cores are shared.
+  const std::size_t per_thread =
+      setup_.particles_per_thread > 0 ? setup_.particles_per_thread : (has_bodies_ ? 500 : 4000);
+  const auto useful = static_cast<int>(std::max<std::size_t>(1, p.size() / per_thread));
+  threads_ = std::clamp(setup_.threads, 1, useful);
   integrator_.set_threads(threads_);
   rebuild_lists();
   compute_forces();
@@ -57,6 +72,35 @@ void DemSimulation::step() {
 void DemSimulation::run_until(double t) {
   while (time() < t - 0.5 * setup_.time_step) step();
 }
+
+namespace {
+
+// The elements of particle i for the narrow phase: a sphere is one element, its centre
+// point with a crust equal to its radius.
+const geometry::ConvexShape kPointCore = geometry::Sphere{0.0};
+
+struct ElementView {
+  const geometry::ConvexShape* core;
+  Vec3 position;           // space frame
+  Quaternion orientation;  // element -> space
+  double crust;
+  double reach;
+};
+
+inline std::size_t element_count(const ParticleStore& p, const std::vector<ParticleShape>& shapes,
+                                 std::size_t i) {
+  return p.spherical[i] ? 1 : shapes[static_cast<std::size_t>(p.species[i])].elements.size();
+}
+
+inline ElementView element_view(const ParticleStore& p, const std::vector<ParticleShape>& shapes,
+                                std::size_t i, std::size_t e, const Vec3& centre) {
+  if (p.spherical[i]) return {&kPointCore, centre, Quaternion{}, p.radius[i], p.radius[i]};
+  const ShapeElement& el = shapes[static_cast<std::size_t>(p.species[i])].elements[e];
+  const Quaternion& q = p.orientation[i];
+  return {&el.core, centre + rotate(q, el.position), q * el.orientation, el.crust, el.reach};
+}
+
+}  // namespace
 
 void DemSimulation::compute_forces() {
   ParticleStore& p = setup_.particles;
@@ -146,9 +190,108 @@ void DemSimulation::compute_forces() {
     return out;
   };
 
+  // Element contacts (bodies, or a body and a sphere): GJK on the cores (body_contacts.hpp).
+  const auto& shapes = setup_.shapes;
+  const auto size_of = [&](std::size_t i) {
+    return p.spherical[i] ? rad[i]
+                          : shapes[static_cast<std::size_t>(p.species[i])].equivalent_radius;
+  };
+  const auto element_response = [&](std::size_t i, const Vec3& xi, const ElementContact& ec,
+                                    const Vec3& other_point_velocity, const Vec3& other_omega,
+                                    const Vec3& other_centre, const ContactParameters& params,
+                                    ContactHistory& h, ContactOutcome& out) {
+    const Vec3 arm_i = ec.point - xi;
+    const Vec3 arm_j = ec.point - other_centre;
+    ContactKinematics c;
+    c.normal = ec.normal;
+    c.overlap = ec.overlap;
+    c.relative_velocity = v[i] + cross(w[i], arm_i) - other_point_velocity;
+    c.relative_angular_velocity = w[i] - other_omega;
+    const double li = norm(arm_i), lj = norm(arm_j);
+    c.reduced_radius = lj > 0.0 ? li * lj / (li + lj) : li;
+    const ContactResponse r = evaluate_contact(params, c, h, dt);
+    out.force = r.force;
+    out.torque_first = cross(arm_i, r.force) + r.rolling_torque;
+    out.torque_second = -(cross(arm_j, r.force) + r.rolling_torque);
+    out.touching = true;
+  };
+  std::int64_t deep = 0;
+  const auto body_pair_outcome = [&](std::size_t k) {
+    ContactOutcome out;
+    const std::uint32_t i = body_pairs_.first[k], j = body_pairs_.second[k];
+    ContactHistory& h = body_pairs_.history[k];
+    Vec3 d = x[j] - x[i];
+    if (periodic) d = domain.near_image(d);
+    const Vec3 xj = x[i] + d;
+    const ElementView a = element_view(p, shapes, i, body_pairs_.element_first[k], x[i]);
+    const ElementView b = element_view(p, shapes, j, body_pairs_.element_second[k], xj);
+    const ElementContact ec =
+        element_pair_contact(*a.core, {a.position, a.orientation}, a.crust, *b.core,
+                             {b.position, b.orientation}, b.crust, &body_pairs_.warm[k]);
+    if (!ec.touching) {
+      if (h.normal.x != 0.0 || h.normal.y != 0.0 || h.normal.z != 0.0) h = ContactHistory{};
+      return out;
+    }
+    const Vec3 vj = v[j] + cross(w[j], ec.point - xj);
+    element_response(
+        i, x[i], ec, vj, w[j], xj,
+        setup_.contacts.get(static_cast<std::size_t>(mat[i]), static_cast<std::size_t>(mat[j])), h,
+        out);
+    out.overlap_ratio = ec.overlap / std::min(size_of(i), size_of(j));
+    out.deep = ec.deep;
+    return out;
+  };
+  const auto body_wall_outcome = [&](std::size_t k) {
+    ContactOutcome out;
+    const std::uint32_t i = body_walls_.first[k];
+    const Obstacle& obstacle = setup_.obstacles[body_walls_.second[k]];
+    ContactHistory& h = body_walls_.history[k];
+    ElementContact ec;
+    if (obstacle.active(now)) {
+      const ElementView a = element_view(p, shapes, i, body_walls_.element_first[k], x[i]);
+      const geometry::Pose pose{a.position, a.orientation};
+      const ObstacleMotion& m = obstacle.motion;
+      if (const auto* plane = std::get_if<PlaneShape>(&obstacle.shape)) {
+        const Vec3 point = m.is_static() ? plane->point
+                                         : m.centre + m.offset_at(now) +
+                                               rotate(m.rotation_at(now), plane->point - m.centre);
+        ec = element_plane_contact(*a.core, pose, a.crust, point,
+                                   m.direction_to_space(now, plane->normal));
+      } else {
+        const auto& box = std::get<AxisAlignedBoxShape>(obstacle.shape);
+        const geometry::ConvexShape core = geometry::Box{0.5 * (box.max - box.min)};
+        const Vec3 centre0 = 0.5 * (box.min + box.max);
+        const geometry::Pose box_pose =
+            m.is_static() ? geometry::Pose{centre0, Quaternion{}}
+                          : geometry::Pose{m.centre + m.offset_at(now) +
+                                               rotate(m.rotation_at(now), centre0 - m.centre),
+                                           m.rotation_at(now)};
+        ec =
+            element_pair_contact(*a.core, pose, a.crust, core, box_pose, 0.0, &body_walls_.warm[k]);
+      }
+    }
+    if (!ec.touching) {
+      if (h.normal.x != 0.0 || h.normal.y != 0.0 || h.normal.z != 0.0) h = ContactHistory{};
+      return out;
+    }
+    const ObstacleMotion& m = obstacle.motion;
+    const Vec3 wall_velocity = m.is_static() ? Vec3{} : m.velocity_at(now, ec.point);
+    const Vec3 wall_omega = m.rotation.moving() ? m.rotation.speed_at(now) * m.axis : Vec3{};
+    // The obstacle has no centre: its lever arm is irrelevant (no torque on it); use the point.
+    element_response(i, x[i], ec, wall_velocity, wall_omega, ec.point,
+                     setup_.contacts.get(static_cast<std::size_t>(mat[i]),
+                                         static_cast<std::size_t>(obstacle.material)),
+                     h, out);
+    out.overlap_ratio = ec.overlap / size_of(i);
+    out.deep = ec.deep;
+    return out;
+  };
+
   Vec3* f = p.force.data();
   Vec3* tq = p.torque.data();
   std::int32_t* coord = p.coordination.data();
+  const std::size_t n_body_pairs = body_pairs_.size();
+  const std::size_t n_body_walls = body_walls_.size();
   const std::size_t n_pairs = pairs_.size();
   const std::size_t n_walls = walls_.size();
   double worst = 0.0;
@@ -172,6 +315,20 @@ void DemSimulation::compute_forces() {
       ++touching_pairs;
       worst = std::max(worst, o.overlap_ratio);
     }
+    for (std::size_t k = 0; k < n_body_pairs; ++k) {
+      const ContactOutcome o = body_pair_outcome(k);
+      if (!o.touching) continue;
+      const std::uint32_t i = body_pairs_.first[k], j = body_pairs_.second[k];
+      f[i] += o.force;
+      f[j] -= o.force;
+      tq[i] += o.torque_first;
+      tq[j] += o.torque_second;
+      ++coord[i];
+      ++coord[j];
+      ++touching_pairs;
+      deep += o.deep;
+      worst = std::max(worst, o.overlap_ratio);
+    }
     for (std::size_t k = 0; k < n_walls; ++k) {
       const ContactOutcome o = wall_outcome(k);
       if (!o.touching) continue;
@@ -180,6 +337,17 @@ void DemSimulation::compute_forces() {
       tq[i] += o.torque_first;
       ++coord[i];
       ++touching_walls;
+      worst = std::max(worst, o.overlap_ratio);
+    }
+    for (std::size_t k = 0; k < n_body_walls; ++k) {
+      const ContactOutcome o = body_wall_outcome(k);
+      if (!o.touching) continue;
+      const std::uint32_t i = body_walls_.first[k];
+      f[i] += o.force;
+      tq[i] += o.torque_first;
+      ++coord[i];
+      ++touching_walls;
+      deep += o.deep;
       worst = std::max(worst, o.overlap_ratio);
     }
   } else {
@@ -205,6 +373,24 @@ void DemSimulation::compute_forces() {
           worst = std::max(worst, wall_buffer_[k].overlap_ratio);
         }
       }
+#pragma omp for schedule(dynamic, 64) reduction(max : worst) reduction(+ : touching_pairs, deep)
+      for (std::size_t k = 0; k < n_body_pairs; ++k) {
+        body_pair_buffer_[k] = body_pair_outcome(k);
+        if (body_pair_buffer_[k].touching) {
+          ++touching_pairs;
+          deep += body_pair_buffer_[k].deep;
+          worst = std::max(worst, body_pair_buffer_[k].overlap_ratio);
+        }
+      }
+#pragma omp for schedule(dynamic, 64) reduction(max : worst) reduction(+ : touching_walls, deep)
+      for (std::size_t k = 0; k < n_body_walls; ++k) {
+        body_wall_buffer_[k] = body_wall_outcome(k);
+        if (body_wall_buffer_[k].touching) {
+          ++touching_walls;
+          deep += body_wall_buffer_[k].deep;
+          worst = std::max(worst, body_wall_buffer_[k].overlap_ratio);
+        }
+      }
 #pragma omp for schedule(static)
       for (std::size_t i = 0; i < n; ++i) {
         Vec3 force{}, torque{};
@@ -222,12 +408,36 @@ void DemSimulation::compute_forces() {
           }
           ++count;
         }
+        if (has_bodies_) {
+          for (std::uint32_t e = body_incident_offset_[i]; e < body_incident_offset_[i + 1]; ++e) {
+            const std::uint32_t entry = body_incident_[e];
+            const ContactOutcome& o = body_pair_buffer_[entry >> 1];
+            if (!o.touching) continue;
+            if ((entry & 1u) == 0) {
+              force += o.force;
+              torque += o.torque_first;
+            } else {
+              force -= o.force;
+              torque += o.torque_second;
+            }
+            ++count;
+          }
+        }
         for (std::uint32_t k = wall_offset_[i]; k < wall_offset_[i + 1]; ++k) {
           const ContactOutcome& o = wall_buffer_[k];
           if (!o.touching) continue;
           force += o.force;
           torque += o.torque_first;
           ++count;
+        }
+        if (has_bodies_) {
+          for (std::uint32_t k = body_wall_offset_[i]; k < body_wall_offset_[i + 1]; ++k) {
+            const ContactOutcome& o = body_wall_buffer_[k];
+            if (!o.touching) continue;
+            force += o.force;
+            torque += o.torque_first;
+            ++count;
+          }
         }
         f[i] = force;
         tq[i] = torque;
@@ -238,6 +448,7 @@ void DemSimulation::compute_forces() {
   touching_pairs_ = touching_pairs;
   touching_walls_ = touching_walls;
   max_overlap_ratio_ = worst;
+  deep_contacts_ = deep;
 
   if (!(worst <= setup_.max_overlap_ratio)) {
     std::ostringstream msg;
@@ -251,7 +462,62 @@ void DemSimulation::compute_forces() {
 
 void DemSimulation::rebuild_lists() {
   search_.rebuild(setup_.particles, setup_.obstacles, time(), pairs_, walls_);
+  if (has_bodies_) split_body_contacts();
   build_incidence();
+}
+
+// Moves the candidate pairs that involve a non-spherical body from the sphere lists to
+// the element lists (one entry per pair of elements whose bounding balls are within the
+// skin), carrying the element histories over.
+void DemSimulation::split_body_contacts() {
+  const ParticleStore& p = setup_.particles;
+  const auto& shapes = setup_.shapes;
+  const double skin = search_.skin();
+  const double now = time();
+  const Domain& domain = setup_.domain;
+
+  ContactList spheres_only;
+  BodyContactList fresh;
+  for (std::size_t k = 0; k < pairs_.size(); ++k) {
+    const std::uint32_t i = pairs_.first[k], j = pairs_.second[k];
+    if (p.spherical[i] && p.spherical[j]) {
+      spheres_only.push(i, j, pairs_.history[k]);
+      continue;
+    }
+    const Vec3 xj = p.position[i] + domain.minimum_image(p.position[j] - p.position[i]);
+    for (std::size_t ea = 0; ea < element_count(p, shapes, i); ++ea) {
+      const ElementView a = element_view(p, shapes, i, ea, p.position[i]);
+      for (std::size_t eb = 0; eb < element_count(p, shapes, j); ++eb) {
+        const ElementView b = element_view(p, shapes, j, eb, xj);
+        const double cut = a.reach + b.reach + skin;
+        if (norm2(b.position - a.position) < cut * cut) {
+          fresh.push(i, j, static_cast<std::uint16_t>(ea), static_cast<std::uint16_t>(eb));
+        }
+      }
+    }
+  }
+  pairs_ = std::move(spheres_only);
+  carry_history(body_pairs_, fresh);
+  body_pairs_ = std::move(fresh);
+
+  ContactList sphere_walls;
+  BodyContactList fresh_walls;
+  for (std::size_t k = 0; k < walls_.size(); ++k) {
+    const std::uint32_t i = walls_.first[k], o = walls_.second[k];
+    if (p.spherical[i]) {
+      sphere_walls.push(i, o, walls_.history[k]);
+      continue;
+    }
+    for (std::size_t ea = 0; ea < element_count(p, shapes, i); ++ea) {
+      const ElementView a = element_view(p, shapes, i, ea, p.position[i]);
+      if (sphere_gap(setup_.obstacles[o], now, a.position, a.reach).overlap > -skin) {
+        fresh_walls.push(i, o, static_cast<std::uint16_t>(ea), 0);
+      }
+    }
+  }
+  walls_ = std::move(sphere_walls);
+  carry_history(body_walls_, fresh_walls);
+  body_walls_ = std::move(fresh_walls);
 }
 
 void DemSimulation::build_incidence() {
@@ -277,6 +543,26 @@ void DemSimulation::build_incidence() {
   for (std::size_t i = 0; i < n; ++i) wall_offset_[i + 1] += wall_offset_[i];
   pair_buffer_.resize(pairs_.size());
   wall_buffer_.resize(walls_.size());
+
+  body_incident_offset_.assign(n + 1, 0);
+  for (std::size_t k = 0; k < body_pairs_.size(); ++k) {
+    ++body_incident_offset_[body_pairs_.first[k] + 1];
+    ++body_incident_offset_[body_pairs_.second[k] + 1];
+  }
+  for (std::size_t i = 0; i < n; ++i) body_incident_offset_[i + 1] += body_incident_offset_[i];
+  body_incident_.resize(body_incident_offset_[n]);
+  incident_fill_.assign(body_incident_offset_.begin(), body_incident_offset_.end() - 1);
+  for (std::size_t k = 0; k < body_pairs_.size(); ++k) {
+    const auto entry = static_cast<std::uint32_t>(k << 1);
+    body_incident_[incident_fill_[body_pairs_.first[k]]++] = entry;
+    body_incident_[incident_fill_[body_pairs_.second[k]]++] = entry | 1u;
+  }
+  body_wall_offset_.assign(n + 1, 0);
+  for (std::size_t k = 0; k < body_walls_.size(); ++k)
+    ++body_wall_offset_[body_walls_.first[k] + 1];
+  for (std::size_t i = 0; i < n; ++i) body_wall_offset_[i + 1] += body_wall_offset_[i];
+  body_pair_buffer_.resize(body_pairs_.size());
+  body_wall_buffer_.resize(body_walls_.size());
 }
 
 void DemSimulation::check_state() const {
@@ -371,6 +657,29 @@ void get_list(std::istream& in, ContactList& list) {
   }
 }
 
+void put_body_list(std::ostream& out, const BodyContactList& list) {
+  put(out, list.first);
+  put(out, list.second);
+  put(out, list.element_first);
+  put(out, list.element_second);
+  put(out, list.history);
+  put(out, list.warm);
+}
+
+void get_body_list(std::istream& in, BodyContactList& list) {
+  get(in, list.first);
+  get(in, list.second);
+  get(in, list.element_first);
+  get(in, list.element_second);
+  get(in, list.history);
+  get(in, list.warm);
+  const std::size_t n = list.first.size();
+  if (list.second.size() != n || list.element_first.size() != n ||
+      list.element_second.size() != n || list.history.size() != n || list.warm.size() != n) {
+    throw std::runtime_error("checkpoint contact list is inconsistent");
+  }
+}
+
 template <typename F>
 void for_each_particle_array(ParticleStore& p, F&& f) {
   f(p.id);
@@ -415,6 +724,9 @@ void DemSimulation::save_checkpoint(const std::filesystem::path& file) const {
     put(out, search.reference_time());
     put_list(out, pairs_);
     put_list(out, walls_);
+    put(out, search.reference_orientations());
+    put_body_list(out, body_pairs_);
+    put_body_list(out, body_walls_);
     put(out, max_overlap_ratio_);
     put(out, touching_pairs_);
     put(out, touching_walls_);
@@ -455,6 +767,9 @@ void DemSimulation::load_checkpoint(const std::filesystem::path& file) {
     get(in, search_.reference_time());
     get_list(in, pairs_);
     get_list(in, walls_);
+    get(in, search_.reference_orientations());
+    get_body_list(in, body_pairs_);
+    get_body_list(in, body_walls_);
     get(in, max_overlap_ratio_);
     get(in, touching_pairs_);
     get(in, touching_walls_);

@@ -11,6 +11,7 @@
 #include "dem/domain.hpp"
 #include "dem/neighbor_search.hpp"
 #include "dem/obstacles.hpp"
+#include "dem/particle_shape.hpp"
 #include "dem/particle_store.hpp"
 #include "dem/time_integrator.hpp"
 
@@ -44,6 +45,7 @@ struct ContactOutcome {
   Vec3 torque_second;  // total torque on the second body
   double overlap_ratio = 0.0;
   bool touching = false;
+  bool deep = false;  // element contact deeper than the crusts
 };
 
 struct DemSetup {
@@ -54,9 +56,12 @@ struct DemSetup {
   double skin = 0.0;               // Verlet skin [m]; 0 -> 0.1 x smallest diameter
   double max_overlap_ratio = 0.5;  // overlap / R beyond which the run stops as unstable
   int threads = 1;                 // OpenMP threads; results are bitwise the same for any count
+  std::size_t particles_per_thread =
+      0;  // fewer per thread: fewer threads (0: 500 with bodies, 4000 spheres)
   std::vector<std::string> material_names;
   ContactTable contacts;
   std::vector<Obstacle> obstacles;
+  std::vector<ParticleShape> shapes;  // species table (ParticleStore::species); spheres may omit it
   ParticleStore particles;
 };
 
@@ -70,6 +75,7 @@ struct DemDiagnostics {
   std::int64_t particle_contacts = 0;         // touching particle pairs
   std::int64_t wall_contacts = 0;             // touching particle-obstacle pairs
   double max_overlap_ratio = 0.0;             // max overlap / smaller radius
+  std::int64_t deep_contacts = 0;             // body contacts deeper than the crusts
 };
 
 class DemSimulation {
@@ -89,8 +95,11 @@ class DemSimulation {
   ParticleStore& particles() { return setup_.particles; }
   const ContactList& particle_contacts() const { return pairs_; }
   const ContactList& wall_contacts() const { return walls_; }
+  const BodyContactList& body_contacts() const { return body_pairs_; }
+  const BodyContactList& body_wall_contacts() const { return body_walls_; }
   TimeIntegrator& integrator() { return integrator_; }
   const NeighborSearch& neighbor_search() const { return search_; }
+  int threads() const { return threads_; }  // threads in use (small systems run serially)
 
   DemDiagnostics diagnostics() const;
 
@@ -106,6 +115,7 @@ class DemSimulation {
   void compute_forces();
   void rebuild_lists();
   void build_incidence();
+  void split_body_contacts();
   void check_state() const;
 
   DemSetup setup_;
@@ -120,6 +130,12 @@ class DemSimulation {
   // its contacts in increasing index. Rebuilt with the lists, not part of the state.
   std::vector<ContactOutcome> pair_buffer_, wall_buffer_;
   std::vector<std::uint32_t> incident_offset_, incident_, incident_fill_, wall_offset_;
+  // Contacts involving non-spherical bodies, element by element (body_contacts.hpp).
+  bool has_bodies_ = false;
+  BodyContactList body_pairs_, body_walls_;
+  std::vector<ContactOutcome> body_pair_buffer_, body_wall_buffer_;
+  std::vector<std::uint32_t> body_incident_offset_, body_incident_, body_wall_offset_;
+  std::int64_t deep_contacts_ = 0;  // element contacts whose overlap exceeded the crusts
 };
 
 }  // namespace sanguis::dem

@@ -1,5 +1,7 @@
 #include "dem/time_integrator.hpp"
 
+#include "core/parallel.hpp"
+
 #include <stdexcept>
 
 namespace sanguis::dem {
@@ -129,8 +131,7 @@ void TimeIntegrator::advance(ParticleStore& p, const Vec3& gravity, double dt) {
 
   switch (kind_) {
     case IntegratorKind::kForwardEuler:  // eq. 2.30
-#pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1)
-      for (std::size_t i = 0; i < n; ++i) {
+      parallel_for(n, threads_, [&](std::size_t i) {
         x[i] += dt * v[i];
         v[i] += dt * (inv_m[i] * f[i] + gravity);
         if (sphere[i]) {
@@ -138,13 +139,12 @@ void TimeIntegrator::advance(ParticleStore& p, const Vec3& gravity, double dt) {
         } else {
           rotate_first_order(q[i], w[i], t[i], j_body[i], inv_j[i], dt);
         }
-      }
+      });
       break;
     case IntegratorKind::kLeapfrog: {  // eq. 2.31, kick-drift half
       half_velocity_.resize(n);
       half_angular_velocity_.resize(n);
-#pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1)
-      for (std::size_t i = 0; i < n; ++i) {
+      parallel_for(n, threads_, [&](std::size_t i) {
         const Vec3 kick = (0.5 * dt) * (inv_m[i] * f[i] + gravity);
         half_velocity_[i] = v[i] + kick;
         x[i] += dt * half_velocity_[i];
@@ -166,7 +166,7 @@ void TimeIntegrator::advance(ParticleStore& p, const Vec3& gravity, double dt) {
           const Vec3 lb_predicted = lb + (0.5 * dt) * rotate_inverse(q[i], t[i]);
           w[i] = rotate(q[i], scale(inv_j[i], lb_predicted));
         }
-      }
+      });
       break;
     }
     case IntegratorKind::kAdamsBashforth2:
@@ -178,8 +178,7 @@ void TimeIntegrator::advance(ParticleStore& p, const Vec3& gravity, double dt) {
       }
       const int max_order = kind_ == IntegratorKind::kAdamsBashforth2 ? 2 : 3;
       const int order = std::min(max_order, h.depth + 1);
-#pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1)
-      for (std::size_t i = 0; i < n; ++i) {
+      parallel_for(n, threads_, [&](std::size_t i) {
         const Vec3 a = inv_m[i] * f[i] + gravity;
         const Vec3 alpha = inv_j[i].x * t[i];  // spheres only; bodies below
         const Vec3 v_now = v[i];
@@ -201,7 +200,7 @@ void TimeIntegrator::advance(ParticleStore& p, const Vec3& gravity, double dt) {
         h.acceleration[0][i] = a;
         h.angular_velocity[0][i] = w_now;
         h.angular_acceleration[0][i] = alpha;
-      }
+      });
       h.depth = std::min(h.depth + 1, 2);
       break;
     }
@@ -211,8 +210,7 @@ void TimeIntegrator::advance(ParticleStore& p, const Vec3& gravity, double dt) {
 void TimeIntegrator::finish(ParticleStore& p, const Vec3& gravity, double dt) {
   if (kind_ != IntegratorKind::kLeapfrog) return;
   const std::size_t n = p.size();
-#pragma omp parallel for schedule(static) num_threads(threads_) if (threads_ > 1)
-  for (std::size_t i = 0; i < n; ++i) {  // final half kick with a_{n+1}
+  parallel_for(n, threads_, [&](std::size_t i) {  // final half kick with a_{n+1}
     p.velocity[i] = half_velocity_[i] + (0.5 * dt) * (p.inverse_mass[i] * p.force[i] + gravity);
     if (p.spherical[i]) {
       p.angular_velocity[i] =
@@ -222,7 +220,7 @@ void TimeIntegrator::finish(ParticleStore& p, const Vec3& gravity, double dt) {
       const Vec3 lb = half_angular_velocity_[i] + (0.5 * dt) * rotate_inverse(q, p.torque[i]);
       p.angular_velocity[i] = rotate(q, scale(p.inverse_inertia_body[i], lb));
     }
-  }
+  });
 }
 
 }  // namespace sanguis::dem

@@ -72,8 +72,10 @@ struct Snapshot {
 Snapshot run(int threads, IntegratorKind kind) {
   DemCase c = load_dem_case(ConfigTable::parse_string(kPile, "pile.toml"), "pile.toml");
   c.setup.threads = threads;
+  c.setup.particles_per_thread = 1;  // force threads on this small system
   c.setup.integrator = kind;
   DemSimulation sim(c.setup);
+  EXPECT_EQ(sim.threads(), threads);
   std::int64_t contacts_seen = 0;  // the run must exercise contacts, pairs and walls
   for (int n = 0; n < 3000; ++n) {
     sim.step();
