@@ -10,7 +10,9 @@
 
 #include <omp.h>
 
+#include "core/io/mesh_files.hpp"
 #include "dem/insertion.hpp"
+#include "geometry/convex_hull.hpp"
 
 namespace sanguis::dem {
 
@@ -32,7 +34,10 @@ struct ParticleGroup {
   explicit ParticleGroup(ConfigTable t) : table(std::move(t)) {}
   ConfigTable table;
   std::size_t material = 0;
-  double r_min = 0.0, r_max = 0.0;
+  double r_min = 0.0, r_max = 0.0;  // spheres; for bodies both are the bounding radius
+  int shape = -1;                   // index into DemSetup::shapes, -1 for spheres
+  bool random_orientation = true;   // bodies
+  Quaternion orientation;           // bodies, when not random
   std::string arrangement;
   std::int64_t count = 0;
   Vec3 region_min, region_max;
@@ -138,7 +143,107 @@ Obstacle parse_obstacle(const ConfigTable& t, std::vector<MaterialSpec>& materia
   return o;
 }
 
-ParticleGroup parse_group(const ConfigTable& t, std::vector<MaterialSpec>& materials) {
+// Uniformly distributed orientation (normalised 4D Gaussian, Shoemake).
+Quaternion random_orientation(std::mt19937_64& rng) {
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  Quaternion q{gauss(rng), gauss(rng), gauss(rng), gauss(rng)};
+  return normalized(q);
+}
+
+Quaternion parse_rotation(const ConfigTable& t) {
+  if (!t.has("rotation_axis") && !t.has("rotation_angle_deg")) return {};
+  const Vec3 axis = t.get_vec3("rotation_axis", {0.0, 0.0, 1.0});
+  if (!(norm(axis) > 0.0)) t.fail("rotation_axis", "must be a non-zero vector");
+  return Quaternion::from_axis_angle(
+      axis, t.get_double("rotation_angle_deg", 0.0) * std::numbers::pi / 180.0);
+}
+
+// One convex element: type and its dimensions.
+geometry::ConvexShape parse_convex(const ConfigTable& t, const std::filesystem::path& source) {
+  const std::string type =
+      t.get_choice("type", {"box", "cylinder", "cone", "ellipsoid", "polyhedron", "sphere"});
+  if (type == "sphere") return geometry::Sphere{t.get_positive("radius_m")};
+  if (type == "box") {
+    const Vec3 size = t.get_vec3("size_m");
+    for (int k = 0; k < 3; ++k) {
+      if (!(size[k] > 0.0)) t.fail("size_m", "every side must be > 0");
+    }
+    return geometry::Box{0.5 * size};
+  }
+  if (type == "cylinder") {
+    return geometry::Cylinder{t.get_positive("radius_m"), 0.5 * t.get_positive("height_m")};
+  }
+  if (type == "cone") return geometry::Cone{t.get_positive("radius_m"), t.get_positive("height_m")};
+  if (type == "ellipsoid") {
+    const Vec3 a = t.get_vec3("semi_axes_m");
+    for (int k = 0; k < 3; ++k) {
+      if (!(a[k] > 0.0)) t.fail("semi_axes_m", "every semi-axis must be > 0");
+    }
+    return geometry::Ellipsoid{a};
+  }
+  // polyhedron: the convex hull of given vertices or of a mesh file (STL/OBJ)
+  std::vector<Vec3> points;
+  if (t.has("file")) {
+    std::filesystem::path file = t.get_string("file");
+    if (file.is_relative()) file = source.parent_path() / file;
+    try {
+      const io::SurfaceMesh mesh = io::read_surface_mesh(file);
+      if (!geometry::is_convex_mesh(mesh)) {
+        t.fail("file", "the mesh in '" + file.string() +
+                           "' is not convex; split it into convex pieces (type = \"composite\")");
+      }
+      points = mesh.vertices;
+    } catch (const std::runtime_error& e) {
+      t.fail("file", e.what());
+    }
+    const double scale = t.get_positive("scale", 1.0);
+    for (Vec3& p : points) p *= scale;
+  } else {
+    points = t.get_vec3_list("vertices_m");
+  }
+  try {
+    return geometry::make_convex_polyhedron(points);
+  } catch (const std::invalid_argument& e) {
+    t.fail(t.has("file") ? "file" : "vertices_m", e.what());
+  }
+}
+
+// A [[shape]] table: a species of non-spherical particles.
+ParticleShape parse_shape(const ConfigTable& t, const std::filesystem::path& source) {
+  const std::string name = t.get_string("name");
+  geometry::Composite elements;
+  double smallest = std::numeric_limits<double>::infinity();  // smallest element half-size
+  const auto note_size = [&](const geometry::ConvexShape& shape) {
+    const geometry::Aabb b = geometry::local_bounds(shape);
+    for (int k = 0; k < 3; ++k) smallest = std::min(smallest, 0.5 * (b.max[k] - b.min[k]));
+  };
+  if (t.has("type") && t.get_string("type") == "cross") {
+    (void)t.get_choice("type", {"cross"});
+    elements = geometry::cross_particle(t.get_positive("length_m"), t.get_positive("width_m"),
+                                        t.get_positive("thickness_m"));
+  } else if (t.has("type") && t.get_string("type") == "composite") {
+    (void)t.get_choice("type", {"composite"});
+    for (const ConfigTable& e : t.table_array("element")) {
+      geometry::CompositeElement el{parse_convex(e, source), e.get_vec3("position_m", {}),
+                                    parse_rotation(e)};
+      elements.push_back(std::move(el));
+    }
+    if (elements.empty()) t.fail("element", "a composite needs at least one [[shape.element]]");
+  } else {
+    elements.push_back({parse_convex(t, source), {}, {}});
+  }
+  for (const auto& e : elements) note_size(e.shape);
+  // Default crust: 10% of the smallest half-size (the core keeps 90%, app. A.2.3).
+  const double crust = t.get_positive("crust_m", 0.1 * smallest);
+  try {
+    return make_particle_shape(name, elements, crust);
+  } catch (const std::invalid_argument& e) {
+    t.fail("crust_m", e.what());
+  }
+}
+
+ParticleGroup parse_group(const ConfigTable& t, std::vector<MaterialSpec>& materials,
+                          const std::vector<ParticleShape>& shapes) {
   ParticleGroup g(t);
   g.material = material_index(t, "material", materials);
   MaterialSpec& mat = materials[g.material];
@@ -146,7 +251,26 @@ ParticleGroup parse_group(const ConfigTable& t, std::vector<MaterialSpec>& mater
     t.fail("material", "material '" + mat.name + "' has no density_kg_m3, needed for particles");
   }
   mat.used_by_particles = true;
-  if (t.has("radius_m")) {
+  if (t.has("shape")) {
+    const std::string name = t.get_string("shape");
+    for (std::size_t k = 0; k < shapes.size(); ++k) {
+      if (shapes[k].name == name) g.shape = static_cast<int>(k);
+    }
+    if (g.shape < 0) t.fail("shape", "unknown shape '" + name + "' (define it in [[shape]])");
+    const ParticleShape& sh = shapes[static_cast<std::size_t>(g.shape)];
+    g.r_min = g.r_max = sh.bounding_radius;
+    mat.radius_sum += sh.equivalent_radius;
+    mat.groups += 1;
+    mat.radius_min = std::min(mat.radius_min, sh.equivalent_radius);
+    const std::string orientation = t.get_choice("orientation", {"random", "fixed"}, "random");
+    g.random_orientation = orientation == "random";
+    if (!g.random_orientation) {
+      const Vec3 axis = t.get_vec3("orientation_axis", {0.0, 0.0, 1.0});
+      if (!(norm(axis) > 0.0)) t.fail("orientation_axis", "must be a non-zero vector");
+      g.orientation = Quaternion::from_axis_angle(
+          axis, t.get_double("orientation_angle_deg", 0.0) * std::numbers::pi / 180.0);
+    }
+  } else if (t.has("radius_m")) {
     g.r_min = g.r_max = t.get_positive("radius_m");
     if (t.has("radius_min_m") || t.has("radius_max_m")) {
       t.fail("radius_m", "give either radius_m or radius_min_m and radius_max_m, not both");
@@ -156,9 +280,11 @@ ParticleGroup parse_group(const ConfigTable& t, std::vector<MaterialSpec>& mater
     g.r_max = t.get_positive("radius_max_m");
     if (g.r_max < g.r_min) t.fail("radius_max_m", "must be >= radius_min_m");
   }
-  mat.radius_sum += 0.5 * (g.r_min + g.r_max);
-  mat.groups += 1;
-  mat.radius_min = std::min(mat.radius_min, g.r_min);
+  if (g.shape < 0) {
+    mat.radius_sum += 0.5 * (g.r_min + g.r_max);
+    mat.groups += 1;
+    mat.radius_min = std::min(mat.radius_min, g.r_min);
+  }
 
   g.arrangement = t.get_choice("arrangement", {"random", "lattice", "list"});
   g.velocity = t.get_vec3("velocity_m_s", {});
@@ -166,6 +292,7 @@ ParticleGroup parse_group(const ConfigTable& t, std::vector<MaterialSpec>& mater
   g.velocity_noise = t.get_non_negative("velocity_noise_m_s", 0.0);
   if (g.arrangement == "list") {
     if (g.r_min != g.r_max) t.fail("radius_min_m", "a 'list' arrangement needs one radius_m");
+    // (bodies: positions are centres of mass; their bounding spheres must not overlap)
     g.positions = t.get_vec3_list("positions_m");
     if (g.positions.empty()) t.fail("positions_m", "must list at least one position");
     if (t.has("velocities_m_s")) {
@@ -288,9 +415,31 @@ ResolvedInteraction parse_interaction(const ConfigTable& t,
   } else {
     ContactParameters& p = out.parameters;
     p.normal_stiffness = t.get_positive("normal_stiffness_N_m");
-    p.normal_damping = t.get_non_negative("normal_damping_N_s_m", 0.0);
+    // Damping as in Table 3.1: either eta directly, or en (eq. 2.22) and gamma_t = eta_t / 2 m_ij
+    // with the pair's reduced mass.
+    if (t.has("normal_restitution")) {
+      if (t.has("normal_damping_N_s_m")) {
+        t.fail("normal_restitution", "give normal_restitution or normal_damping_N_s_m, not both");
+      }
+      const double en = t.get_double("normal_restitution");
+      if (!(en > 0.0 && en <= 1.0)) t.fail("normal_restitution", "must be in (0, 1]");
+      const double omega0 = std::sqrt(p.normal_stiffness / reduced_mass_ref);
+      p.normal_damping = -2.0 * reduced_mass_ref * omega0 * std::log(en) /
+                         std::sqrt(kPi * kPi + std::log(en) * std::log(en));
+    } else {
+      p.normal_damping = t.get_non_negative("normal_damping_N_s_m", 0.0);
+    }
     p.tangential_stiffness = t.get_non_negative("tangential_stiffness_N_m", 0.0);
-    p.tangential_damping = t.get_non_negative("tangential_damping_N_s_m", 0.0);
+    if (t.has("tangential_damping_rate_1_s")) {
+      if (t.has("tangential_damping_N_s_m")) {
+        t.fail("tangential_damping_rate_1_s",
+               "give tangential_damping_rate_1_s or tangential_damping_N_s_m, not both");
+      }
+      p.tangential_damping =
+          2.0 * reduced_mass_ref * t.get_non_negative("tangential_damping_rate_1_s", 0.0);
+    } else {
+      p.tangential_damping = t.get_non_negative("tangential_damping_N_s_m", 0.0);
+    }
     p.friction = t.get_non_negative("friction", 0.5);
     p.rolling_friction = t.get_non_negative("rolling_friction", 0.0);
     p.rolling_stiffness = t.get_non_negative("rolling_stiffness_N_m_rad", 0.0);
@@ -358,6 +507,14 @@ DemCase load_dem_case(const ConfigTable& cfg, const std::filesystem::path& sourc
   }
   if (materials.empty()) cfg.fail("material", "at least one [[material]] is required");
 
+  // [[shape]]: species of non-spherical particles
+  for (const ConfigTable& t : cfg.table_array("shape")) {
+    s.shapes.push_back(parse_shape(t, source));
+    for (std::size_t k = 0; k + 1 < s.shapes.size(); ++k) {
+      if (s.shapes[k].name == s.shapes.back().name) t.fail("name", "shape defined twice");
+    }
+  }
+
   // [[obstacle]] and [[particles]]
   const auto obstacle_tables = cfg.table_array("obstacle");
   for (std::size_t k = 0; k < obstacle_tables.size(); ++k) {
@@ -365,7 +522,7 @@ DemCase load_dem_case(const ConfigTable& cfg, const std::filesystem::path& sourc
   }
   std::vector<ParticleGroup> groups;
   for (const ConfigTable& t : cfg.table_array("particles"))
-    groups.push_back(parse_group(t, materials));
+    groups.push_back(parse_group(t, materials, s.shapes));
   if (groups.empty()) cfg.fail("particles", "at least one [[particles]] group is required");
   for (const auto& m : materials) {
     if (m.used_by_particles && m.used_by_obstacles) {
@@ -490,9 +647,17 @@ DemCase load_dem_case(const ConfigTable& cfg, const std::filesystem::path& sourc
       const double a = g.velocity_noise / std::sqrt(3.0);
       v += Vec3{a * noise(rng), a * noise(rng), a * noise(rng)};
     }
-    s.particles.add_sphere(static_cast<std::int64_t>(i), static_cast<std::int32_t>(g.material),
-                           seeds[i].radius, *materials[g.material].density, seeds[i].position, v,
-                           w);
+    const double density = *materials[g.material].density;
+    if (g.shape < 0) {
+      s.particles.add_sphere(static_cast<std::int64_t>(i), static_cast<std::int32_t>(g.material),
+                             seeds[i].radius, density, seeds[i].position, v, w);
+    } else {
+      const ParticleShape& sh = s.shapes[static_cast<std::size_t>(g.shape)];
+      const Quaternion q = g.random_orientation ? random_orientation(rng) : g.orientation;
+      s.particles.add_body(static_cast<std::int64_t>(i), static_cast<std::int32_t>(g.material),
+                           g.shape, sh.bounding_radius, density * sh.volume,
+                           density * sh.inertia_per_density, q, seeds[i].position, v, w);
+    }
   }
   // Periodic axes need room for the linked cells.
   double r_max = 0.0, r_min = std::numeric_limits<double>::infinity();

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -13,6 +14,7 @@
 #include "core/io/vtk.hpp"
 #include "core/progress.hpp"
 #include "core/version.hpp"
+#include "dem/body_contacts.hpp"
 
 namespace sanguis::dem {
 
@@ -40,28 +42,63 @@ std::vector<double> diagnostic_row(const DemDiagnostics& d) {
           d.max_overlap_ratio};
 }
 
+// A sphere is one element for the narrow phase: its centre point with a crust equal to
+// its radius (as in the simulation's force loop).
+const geometry::ConvexShape kPointCore = geometry::Sphere{0.0};
+
+struct ElementGeometry {
+  const geometry::ConvexShape* core;
+  geometry::Pose pose;  // space frame
+  double crust;
+};
+
+ElementGeometry element_geometry(const ParticleStore& p, const std::vector<ParticleShape>& shapes,
+                                 std::size_t i, std::size_t e, const Vec3& centre) {
+  if (p.spherical[i]) return {&kPointCore, {centre, Quaternion{}}, p.radius[i]};
+  const ShapeElement& el = shapes[static_cast<std::size_t>(p.species[i])].elements[e];
+  return {&el.core, element_pose(el, centre, p.orientation[i]), el.crust};
+}
+
+// A point of an obstacle (given at t = 0) at its pose at time t.
+Vec3 obstacle_point_at(const ObstacleMotion& m, double t, const Vec3& x) {
+  if (m.is_static()) return x;
+  return m.centre + m.offset_at(t) + rotate(m.rotation_at(t), x - m.centre);
+}
+
+io::DataArray vector_array(const char* name, const std::vector<Vec3>& values) {
+  io::DataArray a{name, 3, {}};
+  a.values.reserve(3 * values.size());
+  for (const Vec3& v : values) a.values.insert(a.values.end(), {v.x, v.y, v.z});
+  return a;
+}
+
+}  // namespace
+
 io::PointCloud particle_cloud(const ParticleStore& p) {
   io::PointCloud cloud;
   cloud.points = p.position;
-  const auto vec_field = [&](const char* name, const std::vector<Vec3>& values) {
-    io::DataArray a{name, 3, {}};
-    a.values.reserve(3 * values.size());
-    for (const Vec3& v : values) a.values.insert(a.values.end(), {v.x, v.y, v.z});
-    cloud.point_data.push_back(std::move(a));
-  };
   cloud.point_data.push_back({"radius", 1, p.radius});
-  vec_field("velocity", p.velocity);
-  vec_field("angular_velocity", p.angular_velocity);
-  vec_field("force", p.force);
-  io::IntDataArray ids{"id", 1, {p.id.begin(), p.id.end()}};
-  io::IntDataArray coordination{"coordination", 1, {p.coordination.begin(), p.coordination.end()}};
-  io::IntDataArray material{"material", 1, {p.material.begin(), p.material.end()}};
-  cloud.int_point_data = {ids, coordination, material};
+  cloud.point_data.push_back(vector_array("velocity", p.velocity));
+  cloud.point_data.push_back(vector_array("angular_velocity", p.angular_velocity));
+  cloud.point_data.push_back(vector_array("force", p.force));
+  io::DataArray orientation{"orientation", 4, {}};
+  orientation.values.reserve(4 * p.size());
+  for (const Quaternion& q : p.orientation) {
+    orientation.values.insert(orientation.values.end(), {q.w, q.x, q.y, q.z});
+  }
+  cloud.point_data.push_back(std::move(orientation));
+  cloud.int_point_data = {
+      {"id", 1, {p.id.begin(), p.id.end()}},
+      {"coordination", 1, {p.coordination.begin(), p.coordination.end()}},
+      {"material", 1, {p.material.begin(), p.material.end()}},
+      {"species", 1, {p.species.begin(), p.species.end()}},
+      {"spherical", 1, {p.spherical.begin(), p.spherical.end()}},
+  };
   return cloud;
 }
 
 // Obstacles as polygons: boxes as their 6 faces, planes as a square patch covering the
-// domain, so that ParaView shows the container and the gate disappearing.
+// domain, so that ParaView shows the container, the gate lifting and disappearing.
 io::PolyMesh obstacle_mesh(const DemSetup& s, double time) {
   io::PolyMesh mesh;
   std::vector<std::int64_t> ids;
@@ -77,21 +114,30 @@ io::PolyMesh obstacle_mesh(const DemSetup& s, double time) {
   for (std::size_t o = 0; o < s.obstacles.size(); ++o) {
     const Obstacle& ob = s.obstacles[o];
     if (!ob.active(time)) continue;
+    const ObstacleMotion& m = ob.motion;
     const auto id = static_cast<std::int64_t>(o);
     if (const auto* plane = std::get_if<PlaneShape>(&ob.shape)) {
-      const Vec3 n = plane->normal;
-      const Vec3 helper = std::abs(n.x) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
-      const Vec3 u = cross(n, helper) / norm(cross(n, helper));
-      const Vec3 v = cross(n, u);
-      const Vec3 c = centre - dot(centre - plane->point, n) * n;
+      // The plane where it is at `time`; the patch axes are those at t = 0 turned with the
+      // obstacle (no jump when the normal passes the helper's threshold), and the patch
+      // stays centred on the domain: an infinite plane sliding along itself looks still.
+      const Vec3 n0 = plane->normal;
+      const Vec3 helper = std::abs(n0.x) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
+      const Vec3 u0 = cross(n0, helper) / norm(cross(n0, helper));
+      const Vec3 v0 = cross(n0, u0);
+      const Vec3 n = m.direction_to_space(time, n0);
+      const Vec3 u = m.direction_to_space(time, u0);
+      const Vec3 v = m.direction_to_space(time, v0);
+      const Vec3 point = obstacle_point_at(m, time, plane->point);
+      const Vec3 c = centre - dot(centre - point, n) * n;
       add_quad(c - half * u - half * v, c + half * u - half * v, c + half * u + half * v,
                c - half * u + half * v, id);
     } else {
       const auto& b = std::get<AxisAlignedBoxShape>(ob.shape);
-      const Vec3 p[8] = {{b.min.x, b.min.y, b.min.z}, {b.max.x, b.min.y, b.min.z},
-                         {b.max.x, b.max.y, b.min.z}, {b.min.x, b.max.y, b.min.z},
-                         {b.min.x, b.min.y, b.max.z}, {b.max.x, b.min.y, b.max.z},
-                         {b.max.x, b.max.y, b.max.z}, {b.min.x, b.max.y, b.max.z}};
+      Vec3 p[8] = {{b.min.x, b.min.y, b.min.z}, {b.max.x, b.min.y, b.min.z},
+                   {b.max.x, b.max.y, b.min.z}, {b.min.x, b.max.y, b.min.z},
+                   {b.min.x, b.min.y, b.max.z}, {b.max.x, b.min.y, b.max.z},
+                   {b.max.x, b.max.y, b.max.z}, {b.min.x, b.max.y, b.max.z}};
+      for (Vec3& corner : p) corner = obstacle_point_at(m, time, corner);
       const int faces[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
                                {2, 3, 7, 6}, {1, 2, 6, 5}, {0, 4, 7, 3}};
       for (const auto& f : faces) add_quad(p[f[0]], p[f[1]], p[f[2]], p[f[3]], id);
@@ -101,43 +147,313 @@ io::PolyMesh obstacle_mesh(const DemSetup& s, double time) {
   return mesh;
 }
 
+bool has_non_spherical(const ParticleStore& p) {
+  return std::any_of(p.spherical.begin(), p.spherical.end(), [](std::uint8_t s) { return s == 0; });
+}
+
+io::PolyMesh body_mesh(const std::vector<ParticleShape>& shapes, const ParticleStore& p) {
+  io::PolyMesh mesh;
+  io::IntDataArray ids{"id", 1, {}}, material{"material", 1, {}}, species{"species", 1, {}};
+  io::DataArray velocity{"velocity", 3, {}};
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (p.spherical[i]) continue;
+    const geometry::TriangleMesh& surface = shapes.at(static_cast<std::size_t>(p.species[i])).mesh;
+    const auto base = static_cast<std::int64_t>(mesh.points.size());
+    for (const Vec3& x : surface.vertices) {
+      mesh.points.push_back(p.position[i] + rotate(p.orientation[i], x));
+    }
+    const Vec3& v = p.velocity[i];
+    for (const auto& t : surface.triangles) {
+      mesh.polygons.push_back({base + t[0], base + t[1], base + t[2]});
+      ids.values.push_back(p.id[i]);
+      material.values.push_back(p.material[i]);
+      species.values.push_back(p.species[i]);
+      velocity.values.insert(velocity.values.end(), {v.x, v.y, v.z});
+    }
+  }
+  mesh.int_cell_data = {std::move(ids), std::move(material), std::move(species)};
+  mesh.cell_data = {std::move(velocity)};
+  return mesh;
+}
+
+std::vector<ContactRecord> touching_contacts(const DemSimulation& sim) {
+  const DemSetup& s = sim.setup();
+  const ParticleStore& p = sim.particles();
+  const auto& shapes = s.shapes;
+  const double now = sim.time();
+  const Domain& domain = s.domain;
+  const bool periodic = domain.periodic[0] || domain.periodic[1] || domain.periodic[2];
+  const std::vector<Vec3>& x = p.position;
+  const std::vector<Vec3>& v = p.velocity;
+  const std::vector<Vec3>& w = p.angular_velocity;
+  const std::vector<double>& rad = p.radius;
+  const auto params = [&](std::int32_t a, std::int32_t b) -> const ContactParameters& {
+    return s.contacts.get(static_cast<std::size_t>(a), static_cast<std::size_t>(b));
+  };
+  // dt = 0: the stored history already holds this step's increments (see the header).
+  const auto respond = [&](const ContactParameters& law, const ContactKinematics& c,
+                           const ContactHistory& stored, ContactRecord& r) {
+    ContactHistory h = stored;
+    const ContactResponse response = evaluate_contact(law, c, h, 0.0);
+    r.normal = c.normal;
+    r.overlap = c.overlap;
+    r.force = response.force;
+    r.normal_force = response.normal_force;
+  };
+  std::vector<ContactRecord> out;
+
+  // Sphere pairs: contact point midway in the overlap on the line of centres.
+  const ContactList& pairs = sim.particle_contacts();
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    const std::uint32_t i = pairs.first[k], j = pairs.second[k];
+    Vec3 d = x[j] - x[i];
+    if (periodic) d = domain.near_image(d);
+    const double sum_r = rad[i] + rad[j];
+    const double dist2 = norm2(d);
+    if (dist2 > sum_r * sum_r) continue;
+    const double dist = std::sqrt(dist2);
+    ContactKinematics c;
+    c.normal = dist > 0.0 ? (1.0 / dist) * d : Vec3{0.0, 0.0, 1.0};
+    c.overlap = sum_r - dist;
+    const double a_i = rad[i] - 0.5 * c.overlap;
+    const double a_j = rad[j] - 0.5 * c.overlap;
+    c.relative_velocity = (v[i] - v[j]) + cross(a_i * w[i] + a_j * w[j], c.normal);
+    c.relative_angular_velocity = w[i] - w[j];
+    c.reduced_radius = rad[i] * rad[j] / sum_r;
+    ContactRecord r;
+    r.kind = ContactKind::kSpherePair;
+    r.first = i;
+    r.second = j;
+    r.point = x[i] + a_i * c.normal;
+    r.first_centre = x[i];
+    r.second_centre = x[i] + d;
+    respond(params(p.material[i], p.material[j]), c, pairs.history[k], r);
+    out.push_back(r);
+  }
+
+  // Spheres on obstacles at their pose at `now`.
+  const ContactList& walls = sim.wall_contacts();
+  for (std::size_t k = 0; k < walls.size(); ++k) {
+    const std::uint32_t i = walls.first[k];
+    const Obstacle& obstacle = s.obstacles[walls.second[k]];
+    if (!obstacle.active(now)) continue;
+    const SphereObstacleGap gap = sphere_gap(obstacle, now, x[i], rad[i]);
+    if (gap.overlap < 0.0) continue;
+    ContactKinematics c;
+    c.normal = gap.normal;
+    c.overlap = gap.overlap;
+    const Vec3 arm_i = (rad[i] - 0.5 * c.overlap) * gap.normal;
+    c.relative_velocity = v[i] + cross(w[i], arm_i);
+    if (!obstacle.motion.is_static()) {
+      c.relative_velocity -= obstacle.motion.velocity_at(now, x[i] + arm_i);
+    }
+    c.relative_angular_velocity = w[i];
+    if (obstacle.motion.rotation.moving()) {
+      c.relative_angular_velocity -= obstacle.motion.rotation.speed_at(now) * obstacle.motion.axis;
+    }
+    c.reduced_radius = rad[i];
+    ContactRecord r;
+    r.kind = ContactKind::kSphereWall;
+    r.first = i;
+    r.second = walls.second[k];
+    r.point = x[i] + arm_i;
+    r.first_centre = x[i];
+    r.second_centre = r.point;
+    respond(params(p.material[i], obstacle.material), c, walls.history[k], r);
+    out.push_back(r);
+  }
+
+  // Element contacts: the simulation's narrow phase again, from the stored warm starts.
+  const auto element_kinematics = [&](std::size_t i, const ElementContact& ec,
+                                      const Vec3& other_point_velocity, const Vec3& other_omega,
+                                      const Vec3& other_centre) {
+    const Vec3 arm_i = ec.point - x[i];
+    const Vec3 arm_j = ec.point - other_centre;
+    ContactKinematics c;
+    c.normal = ec.normal;
+    c.overlap = ec.overlap;
+    c.relative_velocity = v[i] + cross(w[i], arm_i) - other_point_velocity;
+    c.relative_angular_velocity = w[i] - other_omega;
+    const double li = norm(arm_i), lj = norm(arm_j);
+    c.reduced_radius = lj > 0.0 ? li * lj / (li + lj) : li;
+    return c;
+  };
+  const BodyContactList& body_pairs = sim.body_contacts();
+  for (std::size_t k = 0; k < body_pairs.size(); ++k) {
+    const std::uint32_t i = body_pairs.first[k], j = body_pairs.second[k];
+    Vec3 d = x[j] - x[i];
+    if (periodic) d = domain.near_image(d);
+    const Vec3 xj = x[i] + d;
+    const ElementGeometry a = element_geometry(p, shapes, i, body_pairs.element_first[k], x[i]);
+    const ElementGeometry b = element_geometry(p, shapes, j, body_pairs.element_second[k], xj);
+    geometry::GjkWarmStart warm = body_pairs.warm[k];
+    const ElementContact ec =
+        element_pair_contact(*a.core, a.pose, a.crust, *b.core, b.pose, b.crust, &warm);
+    if (!ec.touching) continue;
+    ContactRecord r;
+    r.kind = ContactKind::kBodyPair;
+    r.first = i;
+    r.second = j;
+    r.point = ec.point;
+    r.first_centre = x[i];
+    r.second_centre = xj;
+    const Vec3 vj = v[j] + cross(w[j], ec.point - xj);
+    respond(params(p.material[i], p.material[j]), element_kinematics(i, ec, vj, w[j], xj),
+            body_pairs.history[k], r);
+    out.push_back(r);
+  }
+
+  const BodyContactList& body_walls = sim.body_wall_contacts();
+  for (std::size_t k = 0; k < body_walls.size(); ++k) {
+    const std::uint32_t i = body_walls.first[k];
+    const Obstacle& obstacle = s.obstacles[body_walls.second[k]];
+    if (!obstacle.active(now)) continue;
+    const ElementGeometry a = element_geometry(p, shapes, i, body_walls.element_first[k], x[i]);
+    const ObstacleMotion& m = obstacle.motion;
+    ElementContact ec;
+    if (const auto* plane = std::get_if<PlaneShape>(&obstacle.shape)) {
+      ec = element_plane_contact(*a.core, a.pose, a.crust, obstacle_point_at(m, now, plane->point),
+                                 m.direction_to_space(now, plane->normal));
+    } else {
+      const auto& box = std::get<AxisAlignedBoxShape>(obstacle.shape);
+      const geometry::ConvexShape core = geometry::Box{0.5 * (box.max - box.min)};
+      const geometry::Pose box_pose{obstacle_point_at(m, now, 0.5 * (box.min + box.max)),
+                                    m.rotation_at(now)};
+      geometry::GjkWarmStart warm = body_walls.warm[k];
+      ec = element_pair_contact(*a.core, a.pose, a.crust, core, box_pose, 0.0, &warm);
+    }
+    if (!ec.touching) continue;
+    ContactRecord r;
+    r.kind = ContactKind::kBodyWall;
+    r.first = i;
+    r.second = body_walls.second[k];
+    r.point = ec.point;
+    r.first_centre = x[i];
+    r.second_centre = ec.point;
+    const Vec3 wall_velocity = m.is_static() ? Vec3{} : m.velocity_at(now, ec.point);
+    const Vec3 wall_omega = m.rotation.moving() ? m.rotation.speed_at(now) * m.axis : Vec3{};
+    respond(params(p.material[i], obstacle.material),
+            element_kinematics(i, ec, wall_velocity, wall_omega, ec.point), body_walls.history[k],
+            r);
+    out.push_back(r);
+  }
+  return out;
+}
+
+ContactNetwork contact_network(const DemSimulation& sim) {
+  const ParticleStore& p = sim.particles();
+  const std::vector<ContactRecord> contacts = touching_contacts(sim);
+  ContactNetwork net;
+
+  io::PointCloud& points = net.points;
+  io::DataArray force{"force", 3, {}}, normal_force{"normal_force", 1, {}},
+      overlap{"overlap", 1, {}};
+  io::IntDataArray kind{"kind", 1, {}}, first_id{"first_id", 1, {}}, second_id{"second_id", 1, {}};
+  const auto second_label = [&](const ContactRecord& r) -> std::int64_t {
+    const bool wall = r.kind == ContactKind::kSphereWall || r.kind == ContactKind::kBodyWall;
+    return wall ? static_cast<std::int64_t>(r.second) : p.id[r.second];
+  };
+  for (const ContactRecord& r : contacts) {
+    points.points.push_back(r.point);
+    force.values.insert(force.values.end(), {r.force.x, r.force.y, r.force.z});
+    normal_force.values.push_back(r.normal_force);
+    overlap.values.push_back(r.overlap);
+    kind.values.push_back(static_cast<std::int64_t>(r.kind));
+    first_id.values.push_back(p.id[r.first]);
+    second_id.values.push_back(second_label(r));
+  }
+  points.point_data = {std::move(force), std::move(normal_force), std::move(overlap)};
+  points.int_point_data = {std::move(kind), std::move(first_id), std::move(second_id)};
+
+  // Branch vectors of the touching particle pairs. Element contacts of one pair are
+  // consecutive in the list (sorted by first, second, elements): summed into one line.
+  io::PolyMesh& lines = net.branches;
+  io::DataArray magnitude{"force_magnitude", 1, {}}, line_normal{"normal_force", 1, {}};
+  io::IntDataArray line_kind{"kind", 1, {}}, line_first{"first_id", 1, {}},
+      line_second{"second_id", 1, {}};
+  for (std::size_t k = 0; k < contacts.size();) {
+    const ContactRecord& r = contacts[k];
+    if (r.kind == ContactKind::kSphereWall || r.kind == ContactKind::kBodyWall) {
+      ++k;
+      continue;
+    }
+    Vec3 total = r.force;
+    double fn = r.normal_force;
+    std::size_t next = k + 1;
+    while (r.kind == ContactKind::kBodyPair && next < contacts.size() &&
+           contacts[next].kind == ContactKind::kBodyPair && contacts[next].first == r.first &&
+           contacts[next].second == r.second) {
+      total += contacts[next].force;
+      fn += contacts[next].normal_force;
+      ++next;
+    }
+    const auto base = static_cast<std::int64_t>(lines.points.size());
+    lines.points.insert(lines.points.end(), {r.first_centre, r.second_centre});
+    lines.lines.push_back({base, base + 1});
+    magnitude.values.push_back(norm(total));
+    line_normal.values.push_back(fn);
+    line_kind.values.push_back(static_cast<std::int64_t>(r.kind));
+    line_first.values.push_back(p.id[r.first]);
+    line_second.values.push_back(p.id[r.second]);
+    k = next;
+  }
+  lines.cell_data = {std::move(magnitude), std::move(line_normal)};
+  lines.int_cell_data = {std::move(line_kind), std::move(line_first), std::move(line_second)};
+  return net;
+}
+
+namespace {
+
+// One frame = one file per data set, each with its .pvd index: particles, obstacles,
+// contacts (points) and branches (lines), and bodies when the case has non-spherical
+// particles (fixed for a run: particles never change shape).
 class SnapshotWriter {
  public:
-  SnapshotWriter(const std::filesystem::path& dir, bool enabled, bool restart, double t)
-      : dir_(dir),
-        enabled_(enabled),
-        particles_(dir / "particles.pvd"),
-        obstacles_(dir / "obstacles.pvd") {
+  SnapshotWriter(const std::filesystem::path& dir, bool enabled, bool bodies, bool restart,
+                 double t)
+      : dir_(dir), enabled_(enabled), bodies_(bodies) {
     if (!enabled_) return;
-    std::filesystem::create_directories(dir / "particles");
-    std::filesystem::create_directories(dir / "obstacles");
-    if (restart) {
-      particles_.load_existing(t);
-      obstacles_.load_existing(t);
-      next_frame_ = static_cast<std::int64_t>(particles_.entries().size());
+    const std::vector<std::string> names =
+        bodies_
+            ? std::vector<std::string>{"particles", "obstacles", "contacts", "branches", "bodies"}
+            : std::vector<std::string>{"particles", "obstacles", "contacts", "branches"};
+    for (const std::string& name : names) {
+      std::filesystem::create_directories(dir / (name == "branches" ? "contacts" : name));
+      series_.emplace_back(dir / (name + ".pvd"));
+      if (restart) series_.back().load_existing(t);
     }
+    if (restart) next_frame_ = static_cast<std::int64_t>(series_[0].entries().size());
   }
 
   // Frames are numbered in the order they are written (not by time), so an extra
   // snapshot (end time off the output grid, a blow-up) never overwrites another.
   void write(const DemSimulation& sim) {
     if (!enabled_) return;
-    char name[64];
-    std::snprintf(name, sizeof name, "%08lld", static_cast<long long>(next_frame_++));
-    const std::string p = std::string("particles/particles_") + name + ".vtu";
-    const std::string o = std::string("obstacles/obstacles_") + name + ".vtp";
-    io::write_point_cloud_vtu(dir_ / p, particle_cloud(sim.particles()));
-    io::write_polymesh_vtp(dir_ / o, obstacle_mesh(sim.setup(), sim.time()));
-    particles_.add(sim.time(), p);
-    obstacles_.add(sim.time(), o);
-    particles_.write();
-    obstacles_.write();
+    char number[64];
+    std::snprintf(number, sizeof number, "%08lld", static_cast<long long>(next_frame_++));
+    const std::string frame(number);
+    const std::string files[5] = {
+        "particles/particles_" + frame + ".vtu", "obstacles/obstacles_" + frame + ".vtp",
+        "contacts/contacts_" + frame + ".vtu", "contacts/branches_" + frame + ".vtp",
+        "bodies/bodies_" + frame + ".vtp"};
+    io::write_point_cloud_vtu(dir_ / files[0], particle_cloud(sim.particles()));
+    io::write_polymesh_vtp(dir_ / files[1], obstacle_mesh(sim.setup(), sim.time()));
+    const ContactNetwork net = contact_network(sim);
+    io::write_point_cloud_vtu(dir_ / files[2], net.points);
+    io::write_polymesh_vtp(dir_ / files[3], net.branches);
+    if (bodies_)
+      io::write_polymesh_vtp(dir_ / files[4], body_mesh(sim.setup().shapes, sim.particles()));
+    for (std::size_t k = 0; k < series_.size(); ++k) {
+      series_[k].add(sim.time(), files[k]);
+      series_[k].write();
+    }
   }
 
  private:
   std::filesystem::path dir_;
   bool enabled_;
-  io::PvdIndex particles_, obstacles_;
+  bool bodies_;
+  std::vector<io::PvdIndex> series_;  // in the order of the files of write()
   std::int64_t next_frame_ = 0;
 };
 
@@ -179,7 +495,8 @@ RunSummary run_dem_case(const DemCase& c, const RunOptions& options, std::ostrea
       c.output.checkpoint_interval > 0 ? steps_for(c.output.checkpoint_interval, dt) : 0;
   const std::int64_t settle_after = std::llround(c.stop.settle_check_after / dt);
 
-  SnapshotWriter snapshots(dir, c.output.vtk, options.restart, sim.time());
+  SnapshotWriter snapshots(dir, c.output.vtk, has_non_spherical(sim.particles()), options.restart,
+                           sim.time());
   io::CsvWriter csv(csv_path, kDiagnosticColumns, options.restart && fs::exists(csv_path));
   const auto record = [&]() {
     snapshots.write(sim);
@@ -241,7 +558,9 @@ RunSummary run_dem_case(const DemCase& c, const RunOptions& options, std::ostrea
   progress.finish(done.str());
   log << done.str() << "\n";
   console << "outputs:\n"
-          << "  ParaView    " << (dir / "particles.pvd").string() << "  (and obstacles.pvd)\n"
+          << "  ParaView    " << (dir / "particles.pvd").string()
+          << "  (and obstacles.pvd, contacts.pvd, branches.pvd"
+          << (has_non_spherical(sim.particles()) ? ", bodies.pvd" : "") << ")\n"
           << "  diagnostics " << csv_path.string() << "\n"
           << "  log         " << (dir / "run.log").string() << "\n"
           << "  checkpoint  " << checkpoint.string() << "\n";

@@ -225,6 +225,11 @@ void DemSimulation::compute_forces() {
     const Vec3 xj = x[i] + d;
     const ElementView a = element_view(p, shapes, i, body_pairs_.element_first[k], x[i]);
     const ElementView b = element_view(p, shapes, j, body_pairs_.element_second[k], xj);
+    const double reach = a.reach + b.reach;
+    if (norm2(b.position - a.position) > reach * reach) {  // bounding balls apart: no GJK
+      if (h.normal.x != 0.0 || h.normal.y != 0.0 || h.normal.z != 0.0) h = ContactHistory{};
+      return out;
+    }
     const ElementContact ec =
         element_pair_contact(*a.core, {a.position, a.orientation}, a.crust, *b.core,
                              {b.position, b.orientation}, b.crust, &body_pairs_.warm[k]);
