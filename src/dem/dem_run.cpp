@@ -200,12 +200,20 @@ std::vector<ContactRecord> touching_contacts(const DemSimulation& sim) {
     r.force = response.force;
     r.normal_force = response.normal_force;
   };
+  // A blown-up state (the last snapshot of a failed run) may hold non-finite positions:
+  // their contacts are left out rather than fed to GJK/EPA.
+  const auto finite = [&](std::size_t i) {
+    const Vec3& xi = x[i];
+    const Quaternion& q = p.orientation[i];
+    return std::isfinite(xi.x + xi.y + xi.z + q.w + q.x + q.y + q.z);
+  };
   std::vector<ContactRecord> out;
 
   // Sphere pairs: contact point midway in the overlap on the line of centres.
   const ContactList& pairs = sim.particle_contacts();
   for (std::size_t k = 0; k < pairs.size(); ++k) {
     const std::uint32_t i = pairs.first[k], j = pairs.second[k];
+    if (!finite(i) || !finite(j)) continue;
     Vec3 d = x[j] - x[i];
     if (periodic) d = domain.near_image(d);
     const double sum_r = rad[i] + rad[j];
@@ -236,7 +244,7 @@ std::vector<ContactRecord> touching_contacts(const DemSimulation& sim) {
   for (std::size_t k = 0; k < walls.size(); ++k) {
     const std::uint32_t i = walls.first[k];
     const Obstacle& obstacle = s.obstacles[walls.second[k]];
-    if (!obstacle.active(now)) continue;
+    if (!obstacle.active(now) || !finite(i)) continue;
     const SphereObstacleGap gap = sphere_gap(obstacle, now, x[i], rad[i]);
     if (gap.overlap < 0.0) continue;
     ContactKinematics c;
@@ -281,6 +289,7 @@ std::vector<ContactRecord> touching_contacts(const DemSimulation& sim) {
   const BodyContactList& body_pairs = sim.body_contacts();
   for (std::size_t k = 0; k < body_pairs.size(); ++k) {
     const std::uint32_t i = body_pairs.first[k], j = body_pairs.second[k];
+    if (!finite(i) || !finite(j)) continue;
     Vec3 d = x[j] - x[i];
     if (periodic) d = domain.near_image(d);
     const Vec3 xj = x[i] + d;
@@ -307,7 +316,7 @@ std::vector<ContactRecord> touching_contacts(const DemSimulation& sim) {
   for (std::size_t k = 0; k < body_walls.size(); ++k) {
     const std::uint32_t i = body_walls.first[k];
     const Obstacle& obstacle = s.obstacles[body_walls.second[k]];
-    if (!obstacle.active(now)) continue;
+    if (!obstacle.active(now) || !finite(i)) continue;
     const ElementGeometry a = element_geometry(p, shapes, i, body_walls.element_first[k], x[i]);
     const ObstacleMotion& m = obstacle.motion;
     ElementContact ec;

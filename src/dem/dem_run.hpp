@@ -78,18 +78,24 @@ struct ContactRecord {
 
 // The touching contacts of the simulation's current state, in list order: sphere pairs,
 // sphere-walls, body (element) pairs, body-walls. The simulation keeps no per-contact
-// forces, so they are re-evaluated here: the geometry (overlap, normal, point) is
-// recomputed from the positions and orientations exactly as the force loop did (these
-// do not change between the force evaluation and the end of a step), and the force comes
-// from evaluate_contact on a copy of the stored history with dt = 0 (the history already
-// holds this step's tangential and rolling increments, so dt = 0 gives back the force the
-// step applied: -kt delta - eta_t vt, saturated). Approximation: the velocities are those
-// at the end of the step, while the force loop saw the integrator's predicted velocities
-// (leapfrog: v_n + dt a_n instead of v_{n+1}), so the damping terms differ by O(dt a).
-// Element contacts are recomputed by GJK/EPA from the stored warm start, as the step did.
+// forces, so they are re-evaluated here:
+//  - geometry (overlap, normal, contact point) is recomputed from the positions and
+//    orientations exactly as the force loop did: they do not change between the force
+//    evaluation and the end of a step. Element contacts run GJK/EPA again from a copy of
+//    the stored warm start (same poses: same simplex, same result);
+//  - the force is evaluate_contact on a copy of the stored history with dt = 0: the
+//    history already holds this step's tangential and rolling increments, so dt = 0
+//    gives back the force the step applied (-kt delta - eta_t vt, saturated at mu |Fn|).
+// Exact (to rounding) with Euler and Adams-Bashforth, whose forces see the velocities
+// of the end of the step. Approximation with leapfrog: its forces saw the predicted
+// velocity v_n + dt a_n, not the v_{n+1} available here, so the damping terms differ by
+// eta dt (a_{n+1} - a_n) / 2: visible during impacts, nil at rest.
+// Contacts of particles with non-finite positions (a blown-up state) are left out.
 std::vector<ContactRecord> touching_contacts(const DemSimulation& sim);
 
-// The contact frame: `points` has one point per touching contact, at its contact point,
+// The contact frame, written as two files since a .vtp here carries only cell data:
+// contacts/contacts_N.vtu (points) and contacts/branches_N.vtp (lines).
+// `points` has one point per touching contact, at its contact point,
 // with point data force (on the first body), normal_force, overlap, kind (ContactKind),
 // first_id (particle id) and second_id (particle id, or obstacle index for walls).
 // `branches` has one line per touching particle pair between the two centres (the branch
