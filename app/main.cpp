@@ -166,9 +166,11 @@ int main(int argc, char** argv) {
   bench::BenchOptions bo;
   std::string bench_name;
   auto* bench_cmd = app.add_subcommand("bench", "throughput benchmarks (one JSON line)");
-  bench_cmd->add_option("name", bench_name, "benchmark: dem-spheres")->required();
-  bench_cmd->add_option("--particles", bo.particles, "number of particles")->capture_default_str();
-  bench_cmd->add_option("--steps", bo.steps, "number of time steps")->capture_default_str();
+  bench_cmd->add_option("name", bench_name, "benchmark: dem-spheres | dem-crosses")->required();
+  auto* particles_opt = bench_cmd->add_option(
+      "--particles", bo.particles, "number of particles (dem-spheres 32000, dem-crosses 3000)");
+  auto* steps_opt =
+      bench_cmd->add_option("--steps", bo.steps, "time steps (dem-spheres 2000, dem-crosses 500)");
   bench_cmd->add_option("--threads", bo.threads, "threads")->capture_default_str();
   bench_cmd->add_option("--seed", bo.seed, "random seed")->capture_default_str();
 
@@ -185,10 +187,18 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (*bench_cmd) {
-      if (bench_name != "dem-spheres") {
-        throw InputError("", "bench", "unknown benchmark '" + bench_name + "' (dem-spheres)");
+      const bool particles_given = particles_opt->count() > 0;
+      const bool steps_given = steps_opt->count() > 0;
+      if (bench_name == "dem-spheres") {
+        std::cout << bench::run_dem_spheres(bo) << std::endl;
+      } else if (bench_name == "dem-crosses") {
+        if (!particles_given) bo.particles = 3000;
+        if (!steps_given) bo.steps = 500;
+        std::cout << bench::run_dem_crosses(bo) << std::endl;
+      } else {
+        throw InputError("", "bench",
+                         "unknown benchmark '" + bench_name + "' (dem-spheres, dem-crosses)");
       }
-      std::cout << bench::run_dem_spheres(bo) << std::endl;
       return 0;
     }
   } catch (const InputError& e) {

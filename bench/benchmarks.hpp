@@ -18,4 +18,8 @@ struct BenchOptions {
 // matched to LAMMPS gran/hooke/history (bench/lammps/in.dem-spheres).
 std::string run_dem_spheres(const BenchOptions& options);
 
+// dem-crosses: a column of crosses (thesis §3.2.2, Table 3.1) behind the gate of the
+// 64 x 30 cm dam-break box, stacked flat at random angles so that they touch.
+std::string run_dem_crosses(const BenchOptions& options);
+
 }  // namespace sanguis::bench

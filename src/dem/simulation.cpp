@@ -19,13 +19,19 @@ DemSimulation::DemSimulation(DemSetup setup)
     : setup_(std::move(setup)), integrator_(setup_.integrator) {
   ParticleStore& p = setup_.particles;
   if (!(setup_.time_step > 0.0)) throw std::invalid_argument("time step must be > 0");
+  // Default skin: 10% of the smallest diameter; for a body, of its volume-equivalent sphere
+  // (its bounding sphere can be far larger: a cross's is 3x, and the lists would swell).
   double r_max = 0.0, r_min = std::numeric_limits<double>::infinity();
-  for (double r : p.radius) {
-    r_max = std::max(r_max, r);
-    r_min = std::min(r_min, r);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    r_max = std::max(r_max, p.radius[i]);
+    const bool body =
+        !p.spherical[i] && static_cast<std::size_t>(p.species[i]) < setup_.shapes.size();
+    r_min = std::min(r_min,
+                     body ? setup_.shapes[static_cast<std::size_t>(p.species[i])].equivalent_radius
+                          : p.radius[i]);
   }
   if (p.size() == 0) r_max = r_min = 1.0;
-  if (setup_.skin <= 0.0) setup_.skin = 0.2 * r_min;  // 10% of the smallest diameter
+  if (setup_.skin <= 0.0) setup_.skin = 0.2 * r_min;
   const std::size_t n_materials = setup_.contacts.materials();
   for (std::size_t i = 0; i < p.size(); ++i) {
     if (static_cast<std::size_t>(p.material[i]) >= n_materials) {
@@ -481,6 +487,30 @@ void DemSimulation::split_body_contacts() {
   const double now = time();
   const Domain& domain = setup_.domain;
 
+  // Space-frame boxes of every element, grown by its crust and half the skin: two elements
+  // whose boxes are apart cannot touch before the next rebuild (each moves < skin / 2).
+  const std::size_t n = p.size();
+  std::vector<std::uint32_t> first_box(n + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    first_box[i + 1] = first_box[i] + static_cast<std::uint32_t>(element_count(p, shapes, i));
+  }
+  std::vector<geometry::Aabb> boxes(first_box[n]);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t e = 0; e < element_count(p, shapes, i); ++e) {
+      const ElementView a = element_view(p, shapes, i, e, p.position[i]);
+      geometry::Aabb b = p.spherical[i] ? geometry::Aabb{a.position, a.position}
+                                        : geometry::bounds(*a.core, a.position, a.orientation);
+      const Vec3 grow{a.crust + 0.5 * skin, a.crust + 0.5 * skin, a.crust + 0.5 * skin};
+      boxes[first_box[i] + e] = {b.min - grow, b.max + grow};
+    }
+  }
+  const auto boxes_meet = [&](const geometry::Aabb& a, geometry::Aabb b, const Vec3& shift) {
+    b.min += shift;
+    b.max += shift;
+    return a.min.x <= b.max.x && b.min.x <= a.max.x && a.min.y <= b.max.y && b.min.y <= a.max.y &&
+           a.min.z <= b.max.z && b.min.z <= a.max.z;
+  };
+
   ContactList spheres_only;
   BodyContactList fresh;
   for (std::size_t k = 0; k < pairs_.size(); ++k) {
@@ -489,13 +519,12 @@ void DemSimulation::split_body_contacts() {
       spheres_only.push(i, j, pairs_.history[k]);
       continue;
     }
-    const Vec3 xj = p.position[i] + domain.minimum_image(p.position[j] - p.position[i]);
+    // Periodic image of j next to i.
+    const Vec3 shift =
+        domain.minimum_image(p.position[j] - p.position[i]) - (p.position[j] - p.position[i]);
     for (std::size_t ea = 0; ea < element_count(p, shapes, i); ++ea) {
-      const ElementView a = element_view(p, shapes, i, ea, p.position[i]);
       for (std::size_t eb = 0; eb < element_count(p, shapes, j); ++eb) {
-        const ElementView b = element_view(p, shapes, j, eb, xj);
-        const double cut = a.reach + b.reach + skin;
-        if (norm2(b.position - a.position) < cut * cut) {
+        if (boxes_meet(boxes[first_box[i] + ea], boxes[first_box[j] + eb], shift)) {
           fresh.push(i, j, static_cast<std::uint16_t>(ea), static_cast<std::uint16_t>(eb));
         }
       }
