@@ -6,6 +6,9 @@
 // two crust surfaces (Fig. A.5). If the cores themselves intersect (overlap
 // larger than the crusts), EPA gives the penetration depth and normal.
 // Planes use the support function directly (exact, no iteration).
+#include <array>
+#include <limits>
+
 #include "dem/obstacles.hpp"
 #include "dem/particle_shape.hpp"
 #include "geometry/gjk.hpp"
@@ -24,6 +27,50 @@ inline geometry::Pose element_pose(const ShapeElement& e, const Vec3& body_posit
                                    const Quaternion& body_orientation) {
   return {body_position + rotate(body_orientation, e.position), body_orientation * e.orientation};
 }
+
+namespace detail {
+
+// Centre of the supporting feature of a core along -n (a face, an edge or a vertex), as
+// the mean of the core's vertices weighted by how deep each one is in the contact: with
+// `band` the overlap of the deepest vertex, weight 1 - (height above it) / band, i.e. the
+// vertex's own overlap over the deepest one (vertices out of contact weigh nothing). This
+// is the resultant of a bed of normal springs sampled at the vertices (Winkler): a face
+// lying flat pushes at its centre rather than at one corner, and the point moves
+// continuously towards the lower edge as the face tilts, giving the restoring torque of a
+// flat contact; the single contact point of §2.3 is kept.
+// Curved cores have a unique support point. Body-frame points; `down` is the body-frame
+// direction towards the plane.
+template <typename Vertices>
+inline Vec3 weighted_support(const Vertices& vertices, const Vec3& down, double band) {
+  double lowest = -std::numeric_limits<double>::infinity();
+  for (const Vec3& v : vertices) lowest = std::max(lowest, dot(v, down));
+  Vec3 sum;
+  double weights = 0.0;
+  for (const Vec3& v : vertices) {
+    const double w = 1.0 - (lowest - dot(v, down)) / band;
+    if (w > 0.0) {
+      sum += w * v;
+      weights += w;
+    }
+  }
+  return sum / weights;
+}
+
+inline Vec3 feature_centre(const geometry::ConvexShape& core, const Vec3& down, double band) {
+  if (const auto* box = std::get_if<geometry::Box>(&core)) {
+    const Vec3 h = box->half_extents;
+    const std::array<Vec3, 8> corners{
+        Vec3{-h.x, -h.y, -h.z}, Vec3{h.x, -h.y, -h.z}, Vec3{-h.x, h.y, -h.z}, Vec3{h.x, h.y, -h.z},
+        Vec3{-h.x, -h.y, h.z},  Vec3{h.x, -h.y, h.z},  Vec3{-h.x, h.y, h.z},  Vec3{h.x, h.y, h.z}};
+    return weighted_support(corners, down, band);
+  }
+  if (const auto* poly = std::get_if<geometry::ConvexPolyhedron>(&core)) {
+    return weighted_support(poly->vertices(), down, band);
+  }
+  return geometry::support(core, down);
+}
+
+}  // namespace detail
 
 // Two elements (of two particles, or a particle and an obstacle element with crust 0).
 inline ElementContact element_pair_contact(const geometry::ConvexShape& core_a,
@@ -57,20 +104,26 @@ inline ElementContact element_pair_contact(const geometry::ConvexShape& core_a,
 }
 
 // An element core (with its crust) against a plane whose normal points towards the
-// particles: exact, from the support point along -normal.
+// particles. The overlap is that of the deepest core point (exact, by support); the
+// contact point is the overlap-weighted centre of the supporting feature
+// (detail::feature_centre).
 inline ElementContact element_plane_contact(const geometry::ConvexShape& core,
                                             const geometry::Pose& pose, double crust,
                                             const Vec3& plane_point, const Vec3& plane_normal) {
   ElementContact c;
-  const Vec3 local = geometry::support(core, rotate_inverse(pose.orientation, -plane_normal));
-  const Vec3 p = pose.position + rotate(pose.orientation, local);
-  const double height = dot(p - plane_point, plane_normal);
+  const Vec3 down = rotate_inverse(pose.orientation, -plane_normal);
+  const Vec3 deepest = pose.position + rotate(pose.orientation, geometry::support(core, down));
+  const double height = dot(deepest - plane_point, plane_normal);
   if (height >= crust) return c;
   c.touching = true;
   c.deep = height < 0.0;
   c.overlap = crust - height;
   c.normal = -plane_normal;
-  c.point = p - (crust - 0.5 * c.overlap) * plane_normal;
+  const Vec3 centre =
+      pose.position + rotate(pose.orientation, detail::feature_centre(core, down, c.overlap));
+  // On the plane of the deepest point, half-way into the overlap.
+  c.point = centre - dot(centre - deepest, plane_normal) * plane_normal -
+            (crust - 0.5 * c.overlap) * plane_normal;
   return c;
 }
 

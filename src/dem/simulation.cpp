@@ -637,6 +637,7 @@ DemDiagnostics DemSimulation::diagnostics() const {
   d.particle_contacts = touching_pairs_;
   d.wall_contacts = touching_walls_;
   d.max_overlap_ratio = max_overlap_ratio_;
+  d.deep_contacts = deep_contacts_;
   return d;
 }
 
