@@ -61,8 +61,8 @@ struct ContactResponse {
   const double normal_speed = dot(c.relative_velocity, n);  // d(dn)/dt
 
   // eq. 2.5: viscoelastic, never attractive.
-  const double fn =
-      std::fmax(p.normal_stiffness * c.overlap + p.normal_damping * normal_speed, 0.0);
+  const double fn_trial = p.normal_stiffness * c.overlap + p.normal_damping * normal_speed;
+  const double fn = fn_trial > 0.0 ? fn_trial : 0.0;  // (std::fmax is a libm call here)
   out.normal_force = fn;
   out.force = -fn * n;
 
