@@ -406,25 +406,13 @@ void DemSimulation::compute_forces() {
       for (std::size_t i = 0; i < n; ++i) {
         Vec3 force{}, torque{};
         std::int32_t count = 0;
-        for (std::uint32_t e = incident_offset_[i]; e < incident_offset_[i + 1]; ++e) {
-          const std::uint32_t entry = incident_[e];
-          const ContactOutcome& o = pair_buffer_[entry >> 1];
-          if (!o.touching) continue;
-          if ((entry & 1u) == 0) {
-            force += o.force;
-            torque += o.torque_first;
-          } else {
-            force -= o.force;
-            torque += o.torque_second;
-          }
-          ++count;
-        }
-        if (has_bodies_) {
-          for (std::uint32_t e = body_incident_offset_[i]; e < body_incident_offset_[i + 1]; ++e) {
-            const std::uint32_t entry = body_incident_[e];
-            const ContactOutcome& o = body_pair_buffer_[entry >> 1];
+        const auto add_pairs = [&](const std::vector<std::uint32_t>& offset,
+                                   const std::vector<std::uint32_t>& entries,
+                                   const std::vector<ContactOutcome>& outcomes) {
+          for (std::uint32_t e = offset[i]; e < offset[i + 1]; ++e) {
+            const ContactOutcome& o = outcomes[entries[e] >> 1];
             if (!o.touching) continue;
-            if ((entry & 1u) == 0) {
+            if ((entries[e] & 1u) == 0) {
               force += o.force;
               torque += o.torque_first;
             } else {
@@ -433,23 +421,21 @@ void DemSimulation::compute_forces() {
             }
             ++count;
           }
-        }
-        for (std::uint32_t k = wall_offset_[i]; k < wall_offset_[i + 1]; ++k) {
-          const ContactOutcome& o = wall_buffer_[k];
-          if (!o.touching) continue;
-          force += o.force;
-          torque += o.torque_first;
-          ++count;
-        }
-        if (has_bodies_) {
-          for (std::uint32_t k = body_wall_offset_[i]; k < body_wall_offset_[i + 1]; ++k) {
-            const ContactOutcome& o = body_wall_buffer_[k];
-            if (!o.touching) continue;
-            force += o.force;
-            torque += o.torque_first;
+        };
+        const auto add_walls = [&](const std::vector<std::uint32_t>& offset,
+                                   const std::vector<ContactOutcome>& outcomes) {
+          for (std::uint32_t k = offset[i]; k < offset[i + 1]; ++k) {
+            if (!outcomes[k].touching) continue;
+            force += outcomes[k].force;
+            torque += outcomes[k].torque_first;
             ++count;
           }
-        }
+        };
+        // The order of the serial loop: sphere pairs, body pairs, sphere walls, body walls.
+        add_pairs(incident_offset_, incident_, pair_buffer_);
+        if (has_bodies_) add_pairs(body_incident_offset_, body_incident_, body_pair_buffer_);
+        add_walls(wall_offset_, wall_buffer_);
+        if (has_bodies_) add_walls(body_wall_offset_, body_wall_buffer_);
         f[i] = force;
         tq[i] = torque;
         coord[i] = count;
@@ -554,47 +540,50 @@ void DemSimulation::split_body_contacts() {
   body_walls_ = std::move(fresh_walls);
 }
 
+namespace {
+
+// For each particle, the contacts of a pair list it takes part in, in increasing contact
+// index (bit 0 of an entry: the particle is the pair's second body); CSR layout.
+void pair_incidence(const std::vector<std::uint32_t>& first,
+                    const std::vector<std::uint32_t>& second, std::size_t n,
+                    std::vector<std::uint32_t>& offset, std::vector<std::uint32_t>& entries,
+                    std::vector<std::uint32_t>& fill) {
+  offset.assign(n + 1, 0);
+  for (std::size_t k = 0; k < first.size(); ++k) {
+    ++offset[first[k] + 1];
+    ++offset[second[k] + 1];
+  }
+  for (std::size_t i = 0; i < n; ++i) offset[i + 1] += offset[i];
+  entries.resize(offset[n]);
+  fill.assign(offset.begin(), offset.end() - 1);
+  for (std::size_t k = 0; k < first.size(); ++k) {
+    const auto entry = static_cast<std::uint32_t>(k << 1);
+    entries[fill[first[k]]++] = entry;
+    entries[fill[second[k]]++] = entry | 1u;
+  }
+}
+
+// For a list sorted by particle (walls), each particle's range of entries.
+void particle_ranges(const std::vector<std::uint32_t>& first, std::size_t n,
+                     std::vector<std::uint32_t>& offset) {
+  offset.assign(n + 1, 0);
+  for (std::uint32_t i : first) ++offset[i + 1];
+  for (std::size_t i = 0; i < n; ++i) offset[i + 1] += offset[i];
+}
+
+}  // namespace
+
 void DemSimulation::build_incidence() {
   if (threads_ <= 1) return;
-  // Incidence lists for the gather: for each particle its pair contacts in increasing
-  // index (bit 0: the particle is the pair's second body), and its range of wall contacts.
+  // What the threaded gather reads (see compute_forces).
   const std::size_t n = setup_.particles.size();
-  incident_offset_.assign(n + 1, 0);
-  for (std::size_t k = 0; k < pairs_.size(); ++k) {
-    ++incident_offset_[pairs_.first[k] + 1];
-    ++incident_offset_[pairs_.second[k] + 1];
-  }
-  for (std::size_t i = 0; i < n; ++i) incident_offset_[i + 1] += incident_offset_[i];
-  incident_.resize(incident_offset_[n]);
-  incident_fill_.assign(incident_offset_.begin(), incident_offset_.end() - 1);
-  for (std::size_t k = 0; k < pairs_.size(); ++k) {
-    const auto entry = static_cast<std::uint32_t>(k << 1);
-    incident_[incident_fill_[pairs_.first[k]]++] = entry;
-    incident_[incident_fill_[pairs_.second[k]]++] = entry | 1u;
-  }
-  wall_offset_.assign(n + 1, 0);
-  for (std::size_t k = 0; k < walls_.size(); ++k) ++wall_offset_[walls_.first[k] + 1];
-  for (std::size_t i = 0; i < n; ++i) wall_offset_[i + 1] += wall_offset_[i];
+  pair_incidence(pairs_.first, pairs_.second, n, incident_offset_, incident_, incident_fill_);
+  particle_ranges(walls_.first, n, wall_offset_);
+  pair_incidence(body_pairs_.first, body_pairs_.second, n, body_incident_offset_, body_incident_,
+                 incident_fill_);
+  particle_ranges(body_walls_.first, n, body_wall_offset_);
   pair_buffer_.resize(pairs_.size());
   wall_buffer_.resize(walls_.size());
-
-  body_incident_offset_.assign(n + 1, 0);
-  for (std::size_t k = 0; k < body_pairs_.size(); ++k) {
-    ++body_incident_offset_[body_pairs_.first[k] + 1];
-    ++body_incident_offset_[body_pairs_.second[k] + 1];
-  }
-  for (std::size_t i = 0; i < n; ++i) body_incident_offset_[i + 1] += body_incident_offset_[i];
-  body_incident_.resize(body_incident_offset_[n]);
-  incident_fill_.assign(body_incident_offset_.begin(), body_incident_offset_.end() - 1);
-  for (std::size_t k = 0; k < body_pairs_.size(); ++k) {
-    const auto entry = static_cast<std::uint32_t>(k << 1);
-    body_incident_[incident_fill_[body_pairs_.first[k]]++] = entry;
-    body_incident_[incident_fill_[body_pairs_.second[k]]++] = entry | 1u;
-  }
-  body_wall_offset_.assign(n + 1, 0);
-  for (std::size_t k = 0; k < body_walls_.size(); ++k)
-    ++body_wall_offset_[body_walls_.first[k] + 1];
-  for (std::size_t i = 0; i < n; ++i) body_wall_offset_[i + 1] += body_wall_offset_[i];
   body_pair_buffer_.resize(body_pairs_.size());
   body_wall_buffer_.resize(body_walls_.size());
 }
