@@ -127,4 +127,26 @@ inline ElementContact element_plane_contact(const geometry::ConvexShape& core,
   return c;
 }
 
+// An element core against element `element` of an obstacle at time t (plane: exact by
+// support; box and shape obstacles: GJK with no crust on the obstacle side). Shared by the
+// force loop and the contact output.
+inline ElementContact element_obstacle_contact(const Obstacle& obstacle, std::size_t element,
+                                               double t, const geometry::ConvexShape& core,
+                                               const geometry::Pose& pose, double crust,
+                                               geometry::GjkWarmStart* warm) {
+  const ObstacleMotion& m = obstacle.motion;
+  if (const auto* plane = std::get_if<PlaneShape>(&obstacle.shape)) {
+    return element_plane_contact(core, pose, crust, m.point_at(t, plane->point),
+                                 m.direction_to_space(t, plane->normal));
+  }
+  if (const auto* box = std::get_if<AxisAlignedBoxShape>(&obstacle.shape)) {
+    const geometry::ConvexShape box_core = geometry::Box{0.5 * (box->max - box->min)};
+    const geometry::Pose box_pose{m.point_at(t, 0.5 * (box->min + box->max)), m.rotation_at(t)};
+    return element_pair_contact(core, pose, crust, box_core, box_pose, 0.0, warm);
+  }
+  const ObstacleElement& e = std::get<ShapeObstacle>(obstacle.shape).elements[element];
+  const geometry::Pose element_pose{m.point_at(t, e.position), m.rotation_at(t) * e.orientation};
+  return element_pair_contact(core, pose, crust, e.shape, element_pose, 0.0, warm);
+}
+
 }  // namespace sanguis::dem

@@ -4,6 +4,7 @@
 // list is rebuilt the histories of pairs that are still candidates are carried
 // over, so a rebuild never erases memory (see NeighborSearch::rebuild).
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "dem/contact_law.hpp"
@@ -70,9 +71,10 @@ struct BodyContactList {
     history.push_back({});
     warm.push_back({});
   }
-  std::uint64_t key(std::size_t k) const {  // particles < 2^24, elements < 2^8
-    return (std::uint64_t{first[k]} << 40) | (std::uint64_t{second[k]} << 16) |
-           (std::uint64_t{element_first[k]} << 8) | element_second[k];
+  // Sort key (first, second, element_first, element_second), compared lexicographically.
+  std::pair<std::uint64_t, std::uint32_t> key(std::size_t k) const {
+    return {(std::uint64_t{first[k]} << 32) | second[k],
+            (std::uint32_t{element_first[k]} << 16) | element_second[k]};
   }
 };
 
@@ -80,7 +82,7 @@ inline void carry_history(const BodyContactList& previous, BodyContactList& fres
   std::size_t p = 0;
   const std::size_t np = previous.size();
   for (std::size_t k = 0; k < fresh.size() && p < np; ++k) {
-    const std::uint64_t key = fresh.key(k);
+    const auto key = fresh.key(k);
     while (p < np && previous.key(p) < key) ++p;
     if (p < np && previous.key(p) == key) {
       fresh.history[k] = previous.history[p];

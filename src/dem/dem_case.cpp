@@ -107,15 +107,66 @@ SpeedLaw parse_speed_law(const ConfigTable& t, const std::string& speed_unit,
   return law;
 }
 
+Quaternion parse_rotation(const ConfigTable& t);
+
+// Shape obstacles are placed by `position_m` and an optional rotation.
+void place_elements(const ConfigTable& t, std::vector<ObstacleElement>& elements) {
+  const Vec3 position = t.get_vec3("position_m", {});
+  const Quaternion rotation = parse_rotation(t);
+  for (ObstacleElement& e : elements) {
+    e.position = position + rotate(rotation, e.position);
+    e.orientation = normalized(rotation * e.orientation);
+  }
+}
+
 Obstacle parse_obstacle(const ConfigTable& t, std::vector<MaterialSpec>& materials,
-                        std::size_t index) {
+                        std::size_t index, const std::vector<ParticleShape>& shapes,
+                        const std::vector<geometry::Composite>& raw_shapes,
+                        const std::filesystem::path& source) {
   Obstacle o;
   o.name = t.get_string("name", "obstacle" + std::to_string(index));
   const std::size_t m = material_index(t, "material", materials);
   o.material = static_cast<std::int32_t>(m);
   materials[m].used_by_obstacles = true;
-  const std::string type = t.get_choice("type", {"plane", "box"});
-  if (type == "plane") {
+  const std::string type = t.get_choice("type", {"plane", "box", "shape", "mesh"});
+  if (type == "shape") {
+    const std::string name = t.get_string("shape");
+    ShapeObstacle shaped;
+    for (std::size_t k = 0; k < shapes.size(); ++k) {
+      if (shapes[k].name != name) continue;
+      for (const geometry::CompositeElement& e : raw_shapes[k]) {
+        shaped.elements.push_back({e.shape, e.position, e.orientation});
+      }
+    }
+    if (shaped.elements.empty())
+      t.fail("shape", "unknown shape '" + name + "' (define it in [[shape]])");
+    place_elements(t, shaped.elements);
+    o.shape = std::move(shaped);
+  } else if (type == "mesh") {
+    // A triangulated surface (STL or OBJ): each triangle is an element.
+    std::filesystem::path file = t.get_string("file");
+    if (file.is_relative()) file = source.parent_path() / file;
+    io::SurfaceMesh mesh;
+    try {
+      mesh = io::read_surface_mesh(file);
+    } catch (const std::runtime_error& e) {
+      t.fail("file", e.what());
+    }
+    if (mesh.triangles.empty() || mesh.triangles.size() > 65535) {
+      t.fail("file", "needs 1 to 65535 triangles, has " + std::to_string(mesh.triangles.size()));
+    }
+    const double scale = t.get_positive("scale", 1.0);
+    ShapeObstacle shaped;
+    for (const auto& tri : mesh.triangles) {
+      shaped.elements.push_back(
+          {geometry::Triangle{scale * mesh.vertices[tri[0]], scale * mesh.vertices[tri[1]],
+                              scale * mesh.vertices[tri[2]]},
+           {},
+           {}});
+    }
+    place_elements(t, shaped.elements);
+    o.shape = std::move(shaped);
+  } else if (type == "plane") {
     PlaneShape plane;
     plane.point = t.get_vec3("point_m");
     plane.normal = t.get_vec3("normal");
@@ -209,7 +260,8 @@ geometry::ConvexShape parse_convex(const ConfigTable& t, const std::filesystem::
 }
 
 // A [[shape]] table: a species of non-spherical particles.
-ParticleShape parse_shape(const ConfigTable& t, const std::filesystem::path& source) {
+ParticleShape parse_shape(const ConfigTable& t, const std::filesystem::path& source,
+                          geometry::Composite& raw) {
   const std::string name = t.get_string("name");
   geometry::Composite elements;
   double smallest = std::numeric_limits<double>::infinity();  // smallest element half-size
@@ -233,6 +285,7 @@ ParticleShape parse_shape(const ConfigTable& t, const std::filesystem::path& sou
     elements.push_back({parse_convex(t, source), {}, {}});
   }
   for (const auto& e : elements) note_size(e.shape);
+  raw = elements;
   // Default crust: 10% of the smallest half-size (the core keeps 90%, app. A.2.3).
   const double crust = t.get_positive("crust_m", 0.1 * smallest);
   try {
@@ -507,9 +560,11 @@ DemCase load_dem_case(const ConfigTable& cfg, const std::filesystem::path& sourc
   }
   if (materials.empty()) cfg.fail("material", "at least one [[material]] is required");
 
-  // [[shape]]: species of non-spherical particles
+  // [[shape]]: species of non-spherical particles (and shapes for obstacles)
+  std::vector<geometry::Composite> raw_shapes;  // unshrunk elements in each shape's frame
   for (const ConfigTable& t : cfg.table_array("shape")) {
-    s.shapes.push_back(parse_shape(t, source));
+    raw_shapes.emplace_back();
+    s.shapes.push_back(parse_shape(t, source, raw_shapes.back()));
     for (std::size_t k = 0; k + 1 < s.shapes.size(); ++k) {
       if (s.shapes[k].name == s.shapes.back().name) t.fail("name", "shape defined twice");
     }
@@ -518,7 +573,8 @@ DemCase load_dem_case(const ConfigTable& cfg, const std::filesystem::path& sourc
   // [[obstacle]] and [[particles]]
   const auto obstacle_tables = cfg.table_array("obstacle");
   for (std::size_t k = 0; k < obstacle_tables.size(); ++k) {
-    s.obstacles.push_back(parse_obstacle(obstacle_tables[k], materials, k));
+    s.obstacles.push_back(
+        parse_obstacle(obstacle_tables[k], materials, k, s.shapes, raw_shapes, source));
   }
   std::vector<ParticleGroup> groups;
   for (const ConfigTable& t : cfg.table_array("particles"))

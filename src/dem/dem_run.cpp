@@ -131,6 +131,18 @@ io::PolyMesh obstacle_mesh(const DemSetup& s, double time) {
       const Vec3 c = centre - dot(centre - point, n) * n;
       add_quad(c - half * u - half * v, c + half * u - half * v, c + half * u + half * v,
                c - half * u + half * v, id);
+    } else if (const auto* shaped = std::get_if<ShapeObstacle>(&ob.shape)) {
+      for (const ObstacleElement& e : shaped->elements) {
+        const geometry::TriangleMesh piece = geometry::tessellate(e.shape, 24);
+        const Quaternion q = m.rotation_at(time) * e.orientation;
+        const Vec3 origin = m.point_at(time, e.position);
+        const auto base = static_cast<std::int64_t>(mesh.points.size());
+        for (const Vec3& v : piece.vertices) mesh.points.push_back(origin + rotate(q, v));
+        for (const auto& t : piece.triangles) {
+          mesh.polygons.push_back({base + t[0], base + t[1], base + t[2]});
+          ids.push_back(id);
+        }
+      }
     } else {
       const auto& b = std::get<AxisAlignedBoxShape>(ob.shape);
       Vec3 p[8] = {{b.min.x, b.min.y, b.min.z}, {b.max.x, b.min.y, b.min.z},
@@ -319,18 +331,9 @@ std::vector<ContactRecord> touching_contacts(const DemSimulation& sim) {
     if (!obstacle.active(now) || !finite(i)) continue;
     const ElementGeometry a = element_geometry(p, shapes, i, body_walls.element_first[k], x[i]);
     const ObstacleMotion& m = obstacle.motion;
-    ElementContact ec;
-    if (const auto* plane = std::get_if<PlaneShape>(&obstacle.shape)) {
-      ec = element_plane_contact(*a.core, a.pose, a.crust, obstacle_point_at(m, now, plane->point),
-                                 m.direction_to_space(now, plane->normal));
-    } else {
-      const auto& box = std::get<AxisAlignedBoxShape>(obstacle.shape);
-      const geometry::ConvexShape core = geometry::Box{0.5 * (box.max - box.min)};
-      const geometry::Pose box_pose{obstacle_point_at(m, now, 0.5 * (box.min + box.max)),
-                                    m.rotation_at(now)};
-      geometry::GjkWarmStart warm = body_walls.warm[k];
-      ec = element_pair_contact(*a.core, a.pose, a.crust, core, box_pose, 0.0, &warm);
-    }
+    geometry::GjkWarmStart warm = body_walls.warm[k];
+    const ElementContact ec = element_obstacle_contact(obstacle, body_walls.element_second[k], now,
+                                                       *a.core, a.pose, a.crust, &warm);
     if (!ec.touching) continue;
     ContactRecord r;
     r.kind = ContactKind::kBodyWall;

@@ -104,6 +104,10 @@ struct ObstacleMotion {
     return centre + rotate_inverse(rotation_at(t), point - c);
   }
   Vec3 direction_to_space(double t, const Vec3& d) const { return rotate(rotation_at(t), d); }
+  // Where the obstacle's material point that was at `point` at t = 0 is at time t.
+  Vec3 point_at(double t, const Vec3& point) const {
+    return centre + offset_at(t) + rotate(rotation_at(t), point - centre);
+  }
 };
 
 }  // namespace sanguis::dem

@@ -7,9 +7,12 @@
 #include <limits>
 #include <string>
 #include <variant>
+#include <vector>
 
 #include "core/vec3.hpp"
 #include "dem/obstacle_motion.hpp"
+#include "geometry/gjk.hpp"
+#include "geometry/shapes.hpp"
 
 namespace sanguis::dem {
 
@@ -22,10 +25,22 @@ struct AxisAlignedBoxShape {
   Vec3 min, max;  // corners [m]
 };
 
+// Any convex shapes placed in space (a cylinder, a polyhedron, the pieces of a funnel,
+// the triangles of an STL surface), each its own element with its own contacts.
+struct ObstacleElement {
+  geometry::ConvexShape shape;  // in its own frame
+  Vec3 position;                // of the element frame, space frame at t = 0 [m]
+  Quaternion orientation;       // element frame -> space at t = 0
+};
+
+struct ShapeObstacle {
+  std::vector<ObstacleElement> elements;
+};
+
 struct Obstacle {
   std::string name;
   std::int32_t material = 0;
-  std::variant<PlaneShape, AxisAlignedBoxShape> shape;
+  std::variant<PlaneShape, AxisAlignedBoxShape, ShapeObstacle> shape;
   double remove_at = std::numeric_limits<double>::infinity();  // [s]
   ObstacleMotion motion;  // shape given at t = 0; static unless a speed law is set
 
@@ -83,6 +98,22 @@ inline SphereObstacleGap sphere_gap(const AxisAlignedBoxShape& box, const Vec3& 
   }
   gap.overlap = radius + best;
   return gap;
+}
+
+// Nearest element of a shape obstacle (GJK from the centre point).
+inline SphereObstacleGap sphere_gap(const ShapeObstacle& o, const Vec3& centre, double radius) {
+  SphereObstacleGap best{-std::numeric_limits<double>::infinity(), {0.0, 0.0, -1.0}};
+  const geometry::ConvexShape point = geometry::Sphere{0.0};
+  for (const ObstacleElement& e : o.elements) {
+    const geometry::DistanceResult d =
+        geometry::gjk_distance(point, {centre, {}}, e.shape, {e.position, e.orientation});
+    const double overlap = radius - d.distance;
+    if (overlap > best.overlap) {
+      best.overlap = overlap;
+      if (d.distance > 0.0) best.normal = (d.point_b - centre) / d.distance;
+    }
+  }
+  return best;
 }
 
 // Gap of a sphere with an obstacle at its pose at time t.

@@ -39,6 +39,9 @@ DemSimulation::DemSimulation(DemSetup setup)
     }
   }
   search_ = NeighborSearch(setup_.domain, setup_.skin, r_max);
+  for (const Obstacle& o : setup_.obstacles) {
+    has_bodies_ |= std::holds_alternative<ShapeObstacle>(o.shape);  // element contacts
+  }
   for (std::size_t i = 0; i < p.size(); ++i) {
     if (p.spherical[i]) continue;
     has_bodies_ = true;
@@ -260,26 +263,8 @@ void DemSimulation::compute_forces() {
     ElementContact ec;
     if (obstacle.active(now)) {
       const ElementView a = element_view(p, shapes, i, body_walls_.element_first[k], x[i]);
-      const geometry::Pose pose{a.position, a.orientation};
-      const ObstacleMotion& m = obstacle.motion;
-      if (const auto* plane = std::get_if<PlaneShape>(&obstacle.shape)) {
-        const Vec3 point = m.is_static() ? plane->point
-                                         : m.centre + m.offset_at(now) +
-                                               rotate(m.rotation_at(now), plane->point - m.centre);
-        ec = element_plane_contact(*a.core, pose, a.crust, point,
-                                   m.direction_to_space(now, plane->normal));
-      } else {
-        const auto& box = std::get<AxisAlignedBoxShape>(obstacle.shape);
-        const geometry::ConvexShape core = geometry::Box{0.5 * (box.max - box.min)};
-        const Vec3 centre0 = 0.5 * (box.min + box.max);
-        const geometry::Pose box_pose =
-            m.is_static() ? geometry::Pose{centre0, Quaternion{}}
-                          : geometry::Pose{m.centre + m.offset_at(now) +
-                                               rotate(m.rotation_at(now), centre0 - m.centre),
-                                           m.rotation_at(now)};
-        ec =
-            element_pair_contact(*a.core, pose, a.crust, core, box_pose, 0.0, &body_walls_.warm[k]);
-      }
+      ec = element_obstacle_contact(obstacle, body_walls_.element_second[k], now, *a.core,
+                                    {a.position, a.orientation}, a.crust, &body_walls_.warm[k]);
     }
     if (!ec.touching) {
       if (h.normal.x != 0.0 || h.normal.y != 0.0 || h.normal.z != 0.0) h = ContactHistory{};
@@ -524,14 +509,30 @@ void DemSimulation::split_body_contacts() {
   BodyContactList fresh_walls;
   for (std::size_t k = 0; k < walls_.size(); ++k) {
     const std::uint32_t i = walls_.first[k], o = walls_.second[k];
-    if (p.spherical[i]) {
+    const Obstacle& obstacle = setup_.obstacles[o];
+    const auto* shaped = std::get_if<ShapeObstacle>(&obstacle.shape);
+    if (p.spherical[i] && shaped == nullptr) {
       sphere_walls.push(i, o, walls_.history[k]);
       continue;
     }
     for (std::size_t ea = 0; ea < element_count(p, shapes, i); ++ea) {
       const ElementView a = element_view(p, shapes, i, ea, p.position[i]);
-      if (sphere_gap(setup_.obstacles[o], now, a.position, a.reach).overlap > -skin) {
-        fresh_walls.push(i, o, static_cast<std::uint16_t>(ea), 0);
+      if (shaped == nullptr) {
+        if (sphere_gap(obstacle, now, a.position, a.reach).overlap > -skin) {
+          fresh_walls.push(i, o, static_cast<std::uint16_t>(ea), 0);
+        }
+        continue;
+      }
+      // Each obstacle element near the particle element is its own contact.
+      const geometry::Aabb& box_a = boxes[first_box[i] + ea];
+      for (std::size_t eb = 0; eb < shaped->elements.size(); ++eb) {
+        const ObstacleElement& e = shaped->elements[eb];
+        const geometry::Aabb b =
+            geometry::bounds(e.shape, obstacle.motion.point_at(now, e.position),
+                             obstacle.motion.rotation_at(now) * e.orientation);
+        if (boxes_meet(box_a, b, Vec3{})) {
+          fresh_walls.push(i, o, static_cast<std::uint16_t>(ea), static_cast<std::uint16_t>(eb));
+        }
       }
     }
   }
