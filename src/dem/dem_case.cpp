@@ -36,6 +36,7 @@ struct ParticleGroup {
   std::size_t material = 0;
   double r_min = 0.0, r_max = 0.0;  // spheres; for bodies both are the bounding radius
   int shape = -1;                   // index into DemSetup::shapes, -1 for spheres
+  double rate = 0.0, start = 0.0;   // pour: particles per second from `start` [s]
   bool random_orientation = true;   // bodies
   Quaternion orientation;           // bodies, when not random
   std::string arrangement;
@@ -339,7 +340,7 @@ ParticleGroup parse_group(const ConfigTable& t, std::vector<MaterialSpec>& mater
     mat.radius_min = std::min(mat.radius_min, g.r_min);
   }
 
-  g.arrangement = t.get_choice("arrangement", {"random", "lattice", "list"});
+  g.arrangement = t.get_choice("arrangement", {"random", "lattice", "list", "pour"});
   g.velocity = t.get_vec3("velocity_m_s", {});
   g.angular_velocity = t.get_vec3("angular_velocity_rad_s", {});
   g.velocity_noise = t.get_non_negative("velocity_noise_m_s", 0.0);
@@ -366,7 +367,13 @@ ParticleGroup parse_group(const ConfigTable& t, std::vector<MaterialSpec>& mater
   g.region_min = t.get_vec3("region_min_m");
   g.region_max = t.get_vec3("region_max_m");
   check_box(t, g.region_min, g.region_max, "region_max_m");
-  if (g.arrangement == "random") {
+  if (g.arrangement == "pour") {
+    g.count = t.get_int("count");
+    if (g.count <= 0) t.fail("count", "must be a positive integer");
+    if (g.r_min != g.r_max) t.fail("radius_min_m", "a 'pour' arrangement needs one radius_m");
+    g.rate = t.get_positive("rate_per_s");
+    g.start = t.get_non_negative("start_s", 0.0);
+  } else if (g.arrangement == "random") {
     g.count = t.get_int("count");
     if (g.count <= 0) t.fail("count", "must be a positive integer");
   } else {
@@ -659,11 +666,34 @@ DemCase load_dem_case(const ConfigTable& cfg, const std::filesystem::path& sourc
 
   // Build the particles (after all keys are known to be valid).
   std::mt19937_64 rng(c.seed);
+  s.pour_seed = c.seed + 0x9E3779B97F4A7C15ull;  // its own stream, for restart bit for bit
   std::vector<SphereSeed> seeds;
   std::vector<std::size_t> group_of;
   for (std::size_t gi = 0; gi < groups.size(); ++gi) {
     ParticleGroup& g = groups[gi];
     std::vector<SphereSeed> fresh;
+    if (g.arrangement == "pour") {  // inserted during the run
+      PourSource src;
+      src.material = static_cast<std::int32_t>(g.material);
+      src.species = g.shape;
+      src.radius = g.r_max;
+      src.density = *materials[g.material].density;
+      src.random_orientation = g.random_orientation;
+      src.orientation = g.orientation;
+      src.region_min = g.region_min;
+      src.region_max = g.region_max;
+      src.velocity = g.velocity;
+      src.rate = g.rate;
+      src.start = g.start;
+      src.count = g.count;
+      for (int k = 0; k < 3; ++k) {
+        if (g.region_max[k] - g.region_min[k] < 2.0 * g.r_max) {
+          g.table.fail("region_max_m", "the region is thinner than one particle");
+        }
+      }
+      s.pour.push_back(src);
+      continue;
+    }
     if (g.arrangement == "list") {
       for (const Vec3& x : g.positions) fresh.push_back({x, g.r_min});
     } else if (g.arrangement == "lattice") {
@@ -720,6 +750,10 @@ DemCase load_dem_case(const ConfigTable& cfg, const std::filesystem::path& sourc
   for (double r : s.particles.radius) {
     r_max = std::max(r_max, r);
     r_min = std::min(r_min, r);
+  }
+  for (const PourSource& src : s.pour) {
+    r_max = std::max(r_max, src.radius);
+    r_min = std::min(r_min, src.radius);
   }
   const double skin = s.skin > 0.0 ? s.skin : 0.2 * r_min;  // as DemSimulation chooses it
   for (int k = 0; k < 3; ++k) {

@@ -22,6 +22,15 @@ DemSimulation::DemSimulation(DemSetup setup)
   // Default skin: 10% of the smallest diameter; for a body, of its volume-equivalent sphere
   // (its bounding sphere can be far larger: a cross's is 3x, and the lists would swell).
   double r_max = 0.0, r_min = std::numeric_limits<double>::infinity();
+  for (const PourSource& src : setup_.pour) {  // particles to come count for the grid
+    r_max = std::max(r_max, src.radius);
+    r_min =
+        std::min(r_min, src.species >= 0
+                            ? setup_.shapes[static_cast<std::size_t>(src.species)].equivalent_radius
+                            : src.radius);
+    has_bodies_ |= src.species >= 0;
+  }
+  pour_rng_.seed(setup_.pour_seed);
   for (std::size_t i = 0; i < p.size(); ++i) {
     r_max = std::max(r_max, p.radius[i]);
     const bool body =
@@ -30,7 +39,7 @@ DemSimulation::DemSimulation(DemSetup setup)
                      body ? setup_.shapes[static_cast<std::size_t>(p.species[i])].equivalent_radius
                           : p.radius[i]);
   }
-  if (p.size() == 0) r_max = r_min = 1.0;
+  if (r_max == 0.0) r_max = r_min = 1.0;
   if (setup_.skin <= 0.0) setup_.skin = 0.2 * r_min;
   const std::size_t n_materials = setup_.contacts.materials();
   for (std::size_t i = 0; i < p.size(); ++i) {
@@ -70,12 +79,65 @@ void DemSimulation::refresh_forces() {
 void DemSimulation::step() {
   const double dt = setup_.time_step;
   ParticleStore& p = setup_.particles;
+  if (!setup_.pour.empty()) pour_particles();
   integrator_.advance(p, setup_.gravity, dt);
   ++step_;
   if (search_.needs_rebuild(p, setup_.obstacles, time())) rebuild_lists();
   compute_forces();
   integrator_.finish(p, setup_.gravity, dt);
   if (step_ % 64 == 0) check_state();
+}
+
+void DemSimulation::pour_particles() {
+  ParticleStore& p = setup_.particles;
+  const std::size_t before = p.size();
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  const double now = time();
+  for (PourSource& src : setup_.pour) {
+    if (now < src.start || src.inserted >= src.count) continue;
+    const auto due = std::min<std::int64_t>(
+        src.count, static_cast<std::int64_t>(std::floor((now - src.start) * src.rate)) + 1);
+    while (src.inserted < due) {
+      bool placed = false;
+      for (int attempt = 0; attempt < 50 && !placed; ++attempt) {
+        Vec3 x;
+        for (int k = 0; k < 3; ++k) {
+          const double lo = src.region_min[k] + src.radius, hi = src.region_max[k] - src.radius;
+          x[k] = lo + (hi - lo) * unit(pour_rng_);
+        }
+        bool free = true;
+        for (std::size_t i = 0; i < p.size() && free; ++i) {
+          const double cut = p.radius[i] + src.radius;
+          free = norm2(setup_.domain.minimum_image(p.position[i] - x)) >= cut * cut;
+        }
+        for (std::size_t o = 0; o < setup_.obstacles.size() && free; ++o) {
+          const Obstacle& ob = setup_.obstacles[o];
+          free = !ob.active(now) || sphere_gap(ob, now, x, src.radius).overlap <= 0.0;
+        }
+        if (!free) continue;
+        const auto id = static_cast<std::int64_t>(p.size());
+        if (src.species < 0) {
+          p.add_sphere(id, src.material, src.radius, src.density, x, src.velocity, {});
+        } else {
+          const ParticleShape& sh = setup_.shapes[static_cast<std::size_t>(src.species)];
+          Quaternion q = src.orientation;
+          if (src.random_orientation) {
+            q = normalized(
+                {gauss(pour_rng_), gauss(pour_rng_), gauss(pour_rng_), gauss(pour_rng_)});
+          }
+          p.add_body(id, src.material, src.species, sh.bounding_radius, src.density * sh.volume,
+                     src.density * sh.inertia_per_density, q, x, src.velocity, {});
+        }
+        placed = true;
+        ++src.inserted;
+      }
+      if (!placed) break;  // the region is full: try again next step
+    }
+  }
+  // New particles have no contact yet; the lists are rebuilt before the next forces
+  // (the particle count changed), and multistep histories start as free flight.
+  if (p.size() != before) integrator_.extend_history(p, setup_.gravity);
 }
 
 void DemSimulation::run_until(double t) {
@@ -752,6 +814,11 @@ void DemSimulation::save_checkpoint(const std::filesystem::path& file) const {
     put(out, search.reference_orientations());
     put_body_list(out, body_pairs_);
     put_body_list(out, body_walls_);
+    for (const PourSource& src : setup_.pour) put(out, src.inserted);
+    std::ostringstream rng;
+    rng << pour_rng_;
+    const std::string rng_state = rng.str();
+    put(out, std::vector<char>(rng_state.begin(), rng_state.end()));
     put(out, max_overlap_ratio_);
     put(out, touching_pairs_);
     put(out, touching_walls_);
@@ -795,6 +862,11 @@ void DemSimulation::load_checkpoint(const std::filesystem::path& file) {
     get(in, search_.reference_orientations());
     get_body_list(in, body_pairs_);
     get_body_list(in, body_walls_);
+    for (PourSource& src : setup_.pour) get(in, src.inserted);
+    std::vector<char> rng_state;
+    get(in, rng_state);
+    std::istringstream rng(std::string(rng_state.begin(), rng_state.end()));
+    rng >> pour_rng_;
     get(in, max_overlap_ratio_);
     get(in, touching_pairs_);
     get(in, touching_walls_);

@@ -3,6 +3,7 @@
 // Verlet lists are stale), contact forces with memory, integration.
 #include <cstdint>
 #include <filesystem>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -48,6 +49,24 @@ struct ContactOutcome {
   bool deep = false;  // element contact deeper than the crusts
 };
 
+// Particles poured into a box-shaped region at a given rate during the run: each is
+// placed at a random position (seeded) where its bounding sphere overlaps nothing; when
+// the region is full the insertion waits for room.
+struct PourSource {
+  std::int32_t material = 0;
+  std::int32_t species = -1;  // shape index, or -1 for spheres
+  double radius = 0.0;        // sphere radius, or the body's bounding radius [m]
+  double density = 0.0;       // [kg/m^3]
+  bool random_orientation = true;
+  Quaternion orientation;       // when not random
+  Vec3 region_min, region_max;  // [m]
+  Vec3 velocity;                // initial velocity [m/s]
+  double rate = 0.0;            // particles per second
+  double start = 0.0;           // [s]
+  std::int64_t count = 0;       // how many in all
+  std::int64_t inserted = 0;    // how many so far (state)
+};
+
 struct DemSetup {
   Domain domain;
   Vec3 gravity;            // [m/s^2]
@@ -61,7 +80,9 @@ struct DemSetup {
   std::vector<std::string> material_names;
   ContactTable contacts;
   std::vector<Obstacle> obstacles;
-  std::vector<ParticleShape> shapes;  // species table (ParticleStore::species); spheres may omit it
+  std::vector<ParticleShape> shapes;
+  std::vector<PourSource> pour;
+  std::uint64_t pour_seed = 0;  // species table (ParticleStore::species); spheres may omit it
   ParticleStore particles;
 };
 
@@ -116,6 +137,7 @@ class DemSimulation {
   void rebuild_lists();
   void build_incidence();
   void split_body_contacts();
+  void pour_particles();
   void check_state() const;
 
   DemSetup setup_;
@@ -135,7 +157,8 @@ class DemSimulation {
   BodyContactList body_pairs_, body_walls_;
   std::vector<ContactOutcome> body_pair_buffer_, body_wall_buffer_;
   std::vector<std::uint32_t> body_incident_offset_, body_incident_, body_wall_offset_;
-  std::int64_t deep_contacts_ = 0;  // element contacts whose overlap exceeded the crusts
+  std::int64_t deep_contacts_ = 0;
+  std::mt19937_64 pour_rng_;  // element contacts whose overlap exceeded the crusts
 };
 
 }  // namespace sanguis::dem

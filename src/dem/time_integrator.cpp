@@ -210,6 +210,20 @@ void TimeIntegrator::advance(ParticleStore& p, const Vec3& gravity, double dt) {
   }
 }
 
+void TimeIntegrator::extend_history(const ParticleStore& p, const Vec3& gravity) {
+  MultistepHistory& h = history_;
+  const std::size_t old = h.velocity[0].size();
+  if (old == 0 || old >= p.size()) return;  // no history yet: advance() starts it
+  for (int k = 0; k < 2; ++k) {
+    for (std::size_t i = old; i < p.size(); ++i) {
+      h.velocity[k].push_back(p.velocity[i]);
+      h.acceleration[k].push_back(gravity);
+      h.angular_velocity[k].push_back(p.angular_velocity[i]);
+      h.angular_acceleration[k].push_back({});
+    }
+  }
+}
+
 void TimeIntegrator::finish(ParticleStore& p, const Vec3& gravity, double dt) {
   if (kind_ != IntegratorKind::kLeapfrog) return;
   const std::size_t n = p.size();

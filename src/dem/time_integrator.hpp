@@ -51,6 +51,9 @@ class TimeIntegrator {
   void set_threads(int threads) { threads_ = threads < 1 ? 1 : threads; }
   void advance(ParticleStore& p, const Vec3& gravity, double dt);
   void finish(ParticleStore& p, const Vec3& gravity, double dt);
+  // Particles were appended (pouring): their multistep history is that of free flight
+  // (past velocity = current, past acceleration = gravity), the others keep theirs.
+  void extend_history(const ParticleStore& p, const Vec3& gravity);
 
   MultistepHistory& history() { return history_; }
   const MultistepHistory& history() const { return history_; }
