@@ -18,7 +18,7 @@ struct Domain {
   // Minimum image of a separation that is at most 1.5 box lengths long (true between two
   // neighbour-list builds, which wrap positions): a compare and a subtraction per axis,
   // no rounding call in the contact loop.
-  Vec3 near_image(Vec3 d) const {
+  [[gnu::always_inline]] Vec3 near_image(Vec3 d) const {
     for (int k = 0; k < 3; ++k) {
       if (periodic[static_cast<std::size_t>(k)]) {
         const double l = max[k] - min[k];
