@@ -9,6 +9,7 @@
 #include <array>
 #include <limits>
 
+#include "dem/contact_law.hpp"
 #include "dem/obstacles.hpp"
 #include "dem/particle_shape.hpp"
 #include "geometry/gjk.hpp"
@@ -124,6 +125,26 @@ inline ElementContact element_plane_contact(const geometry::ConvexShape& core,
   // On the plane of the deepest point, half-way into the overlap.
   c.point = centre - dot(centre - deepest, plane_normal) * plane_normal -
             (crust - 0.5 * c.overlap) * plane_normal;
+  return c;
+}
+
+// Kinematics of a sphere touching an obstacle (gap.overlap >= 0) at time t; `arm` gets
+// the lever arm from the centre to the contact point (midway in the overlap). Shared by
+// the force loop and the contact output.
+inline ContactKinematics sphere_wall_kinematics(const Obstacle& obstacle, double t, const Vec3& x,
+                                                const Vec3& v, const Vec3& w, double radius,
+                                                const SphereObstacleGap& gap, Vec3& arm) {
+  ContactKinematics c;
+  c.normal = gap.normal;
+  c.overlap = gap.overlap;
+  arm = (radius - 0.5 * c.overlap) * gap.normal;
+  c.relative_velocity = v + cross(w, arm);
+  if (!obstacle.motion.is_static()) c.relative_velocity -= obstacle.motion.velocity_at(t, x + arm);
+  c.relative_angular_velocity = w;
+  if (obstacle.motion.rotation.moving()) {
+    c.relative_angular_velocity -= obstacle.motion.rotation.speed_at(t) * obstacle.motion.axis;
+  }
+  c.reduced_radius = radius;
   return c;
 }
 

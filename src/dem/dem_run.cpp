@@ -259,19 +259,9 @@ std::vector<ContactRecord> touching_contacts(const DemSimulation& sim) {
     if (!obstacle.active(now) || !finite(i)) continue;
     const SphereObstacleGap gap = sphere_gap(obstacle, now, x[i], rad[i]);
     if (gap.overlap < 0.0) continue;
-    ContactKinematics c;
-    c.normal = gap.normal;
-    c.overlap = gap.overlap;
-    const Vec3 arm_i = (rad[i] - 0.5 * c.overlap) * gap.normal;
-    c.relative_velocity = v[i] + cross(w[i], arm_i);
-    if (!obstacle.motion.is_static()) {
-      c.relative_velocity -= obstacle.motion.velocity_at(now, x[i] + arm_i);
-    }
-    c.relative_angular_velocity = w[i];
-    if (obstacle.motion.rotation.moving()) {
-      c.relative_angular_velocity -= obstacle.motion.rotation.speed_at(now) * obstacle.motion.axis;
-    }
-    c.reduced_radius = rad[i];
+    Vec3 arm_i;
+    const ContactKinematics c =
+        sphere_wall_kinematics(obstacle, now, x[i], v[i], w[i], rad[i], gap, arm_i);
     ContactRecord r;
     r.kind = ContactKind::kSphereWall;
     r.first = i;

@@ -237,19 +237,9 @@ void DemSimulation::compute_forces() {
       if (h.normal.x != 0.0 || h.normal.y != 0.0 || h.normal.z != 0.0) h = ContactHistory{};
       return out;
     }
-    ContactKinematics c;
-    c.normal = gap.normal;
-    c.overlap = gap.overlap;
-    const Vec3 arm_i = (rad[i] - 0.5 * c.overlap) * gap.normal;
-    c.relative_velocity = v[i] + cross(w[i], arm_i);
-    if (!obstacle.motion.is_static()) {
-      c.relative_velocity -= obstacle.motion.velocity_at(now, x[i] + arm_i);
-    }
-    c.relative_angular_velocity = w[i];
-    if (obstacle.motion.rotation.moving()) {
-      c.relative_angular_velocity -= obstacle.motion.rotation.speed_at(now) * obstacle.motion.axis;
-    }
-    c.reduced_radius = rad[i];
+    Vec3 arm_i;
+    const ContactKinematics c =
+        sphere_wall_kinematics(obstacle, now, x[i], v[i], w[i], rad[i], gap, arm_i);
     const ContactResponse r =
         evaluate_contact(setup_.contacts.get(static_cast<std::size_t>(mat[i]),
                                              static_cast<std::size_t>(obstacle.material)),
@@ -360,10 +350,8 @@ void DemSimulation::compute_forces() {
     std::fill(p.force.begin(), p.force.end(), Vec3{});
     std::fill(p.torque.begin(), p.torque.end(), Vec3{});
     std::fill(p.coordination.begin(), p.coordination.end(), 0);
-    for (std::size_t k = 0; k < n_pairs; ++k) {
-      const ContactOutcome o = pair_outcome(k);
-      if (!o.touching) continue;
-      const std::uint32_t i = pairs_.first[k], j = pairs_.second[k];
+    const auto add_pair = [&](const ContactOutcome& o, std::uint32_t i, std::uint32_t j) {
+      if (!o.touching) return;
       f[i] += o.force;
       f[j] -= o.force;
       tq[i] += o.torque_first;
@@ -371,42 +359,26 @@ void DemSimulation::compute_forces() {
       ++coord[i];
       ++coord[j];
       ++touching_pairs;
+      deep += o.deep;
       worst = std::max(worst, o.overlap_ratio);
-    }
+    };
+    const auto add_wall = [&](const ContactOutcome& o, std::uint32_t i) {
+      if (!o.touching) return;
+      f[i] += o.force;
+      tq[i] += o.torque_first;
+      ++coord[i];
+      ++touching_walls;
+      deep += o.deep;
+      worst = std::max(worst, o.overlap_ratio);
+    };
+    for (std::size_t k = 0; k < n_pairs; ++k)
+      add_pair(pair_outcome(k), pairs_.first[k], pairs_.second[k]);
     for (std::size_t k = 0; k < n_body_pairs; ++k) {
-      const ContactOutcome o = body_pair_outcome(k);
-      if (!o.touching) continue;
-      const std::uint32_t i = body_pairs_.first[k], j = body_pairs_.second[k];
-      f[i] += o.force;
-      f[j] -= o.force;
-      tq[i] += o.torque_first;
-      tq[j] += o.torque_second;
-      ++coord[i];
-      ++coord[j];
-      ++touching_pairs;
-      deep += o.deep;
-      worst = std::max(worst, o.overlap_ratio);
+      add_pair(body_pair_outcome(k), body_pairs_.first[k], body_pairs_.second[k]);
     }
-    for (std::size_t k = 0; k < n_walls; ++k) {
-      const ContactOutcome o = wall_outcome(k);
-      if (!o.touching) continue;
-      const std::uint32_t i = walls_.first[k];
-      f[i] += o.force;
-      tq[i] += o.torque_first;
-      ++coord[i];
-      ++touching_walls;
-      worst = std::max(worst, o.overlap_ratio);
-    }
+    for (std::size_t k = 0; k < n_walls; ++k) add_wall(wall_outcome(k), walls_.first[k]);
     for (std::size_t k = 0; k < n_body_walls; ++k) {
-      const ContactOutcome o = body_wall_outcome(k);
-      if (!o.touching) continue;
-      const std::uint32_t i = body_walls_.first[k];
-      f[i] += o.force;
-      tq[i] += o.torque_first;
-      ++coord[i];
-      ++touching_walls;
-      deep += o.deep;
-      worst = std::max(worst, o.overlap_ratio);
+      add_wall(body_wall_outcome(k), body_walls_.first[k]);
     }
   } else {
     // Threads: every contact writes its own slot, then each particle sums its contacts in
