@@ -772,7 +772,8 @@ std::string describe(const DemCase& c) {
   o << "case            " << c.name << "  (" << c.source.string() << ")\n";
   o << "particles       " << s.particles.size() << "\n";
   o << "obstacles       " << s.obstacles.size() << "\n";
-  o << "threads         " << s.threads << " (results do not depend on it)\n";
+  o << "threads         " << s.threads
+    << " requested (small systems use fewer; results do not depend on it)\n";
   o << "integrator      " << to_string(s.integrator) << " (order " << order_of(s.integrator)
     << ")\n";
   o << "time step       " << s.time_step << " s  = Tc / " << c.smallest_contact_time / s.time_step
@@ -786,6 +787,17 @@ std::string describe(const DemCase& c) {
     << "] m, periodic " << s.domain.periodic[0] << s.domain.periodic[1] << s.domain.periodic[2]
     << "\n";
   o << "seed            " << c.seed << "\n";
+  for (const ParticleShape& sh : s.shapes) {
+    o << "shape           " << sh.name << ": " << sh.elements.size() << " element(s), volume "
+      << sh.volume << " m^3, equivalent radius " << sh.equivalent_radius << " m, bounding radius "
+      << sh.bounding_radius << " m, crust " << sh.smallest_crust << " m\n";
+  }
+  for (const PourSource& src : s.pour) {
+    o << "pour            " << src.count << " "
+      << (src.species < 0 ? std::string("spheres")
+                          : s.shapes[static_cast<std::size_t>(src.species)].name)
+      << " at " << src.rate << " /s from t = " << src.start << " s\n";
+  }
   for (const auto& r : c.interactions) {
     const ContactParameters& p = r.parameters;
     o << "interaction     " << r.first << " - " << r.second << (r.wall ? " (wall)" : "")
