@@ -8,7 +8,9 @@
 #include <numbers>
 #include <sstream>
 
+#include "analysis_commands.hpp"
 #include "benchmarks.hpp"
+#include "core/config.hpp"
 #include "core/error.hpp"
 #include "core/version.hpp"
 #include "dem/dem_case.hpp"
@@ -108,9 +110,22 @@ void print_params(const ParamsOptions& o) {
       "--damping-model exact_restitution to make it equal en.\n");
 }
 
-int run_command(const std::string& case_file, const std::string& output, bool restart, bool quiet,
-                int threads) {
-  dem::DemCase c = dem::load_dem_case(case_file);
+struct RunArgs {
+  std::string case_file, output;
+  bool restart = false, quiet = false;
+  int threads = 0;
+  std::int64_t seed = -1;
+  std::vector<std::string> overrides;
+};
+
+int run_command(const RunArgs& args) {
+  ConfigTable config = ConfigTable::parse_file(args.case_file);
+  for (const std::string& o : args.overrides) config.set_override(o);
+  if (args.seed >= 0) config.set_override("simulation.seed=" + std::to_string(args.seed));
+  dem::DemCase c = dem::load_dem_case(config, args.case_file);
+  const std::string& output = args.output;
+  const int threads = args.threads;
+  const bool restart = args.restart, quiet = args.quiet;
   if (threads > 0) c.setup.threads = threads;
   dem::RunOptions options;
   options.output_dir =
@@ -132,17 +147,19 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("sanguis ") + sanguis::kVersion);
   app.require_subcommand(1);
 
-  std::string case_file, output;
-  bool restart = false, quiet = false;
+  RunArgs ra;
   auto* run = app.add_subcommand("run", "run a case file");
-  run->add_option("case", case_file, "case file (TOML)")->required();
-  run->add_option("--output,-o", output, "output directory (default: output/<case name>)");
-  run->add_flag("--restart", restart, "continue from OUTPUT/checkpoint.bin");
-  run->add_flag("--quiet,-q", quiet, "no progress line");
-  int run_threads = 0;
-  run->add_option("--threads,-t", run_threads,
+  run->add_option("case", ra.case_file, "case file (TOML)")->required();
+  run->add_option("--output,-o", ra.output, "output directory (default: output/<case name>)");
+  run->add_flag("--restart", ra.restart, "continue from OUTPUT/checkpoint.bin");
+  run->add_flag("--quiet,-q", ra.quiet, "no progress line");
+  run->add_option("--threads,-t", ra.threads,
                   "OpenMP threads (default: the case's simulation.threads, else all cores)")
       ->check(CLI::Range(1, 1024));
+  run->add_option("--seed", ra.seed, "random seed (replaces simulation.seed)")
+      ->check(CLI::NonNegativeNumber);
+  run->add_option("--set", ra.overrides,
+                  "replace a case value: KEY=VALUE (TOML), e.g. interaction[0].friction=0.3");
 
   ParamsOptions po;
   auto* params = app.add_subcommand("params", "contact parameters by the procedure of §2.4");
@@ -174,6 +191,8 @@ int main(int argc, char** argv) {
   bench_cmd->add_option("--threads", bo.threads, "threads")->capture_default_str();
   bench_cmd->add_option("--seed", bo.seed, "random seed")->capture_default_str();
 
+  const auto run_analysis = app::add_analysis_commands(app);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -181,7 +200,8 @@ int main(int argc, char** argv) {
   }
 
   try {
-    if (*run) return run_command(case_file, output, restart, quiet, run_threads);
+    if (*run) return run_command(ra);
+    if (run_analysis()) return 0;
     if (*params) {
       print_params(po);
       return 0;

@@ -1,5 +1,7 @@
 #include "core/config.hpp"
 
+#include <optional>
+
 #include <toml++/toml.h>
 #include <sstream>
 
@@ -75,6 +77,62 @@ ConfigTable ConfigTable::parse_string(const std::string& text, const std::string
     why << "TOML syntax error at line " << e.source().begin.line << ", column "
         << e.source().begin.column << ": " << e.description();
     throw InputError(source_name, "", why.str());
+  }
+}
+
+void ConfigTable::set_override(const std::string& assignment) {
+  const std::string where = "--set " + assignment;
+  const std::size_t equals = assignment.find('=');
+  if (equals == std::string::npos || equals == 0) {
+    throw InputError(source_, where, "expected KEY=VALUE, e.g. simulation.seed=3");
+  }
+  const std::string path = assignment.substr(0, equals);
+  toml::table parsed;
+  try {
+    parsed = toml::parse("value = " + assignment.substr(equals + 1), std::string_view("--set"));
+  } catch (const toml::parse_error& e) {
+    throw InputError(source_, where,
+                     std::string("value is not TOML: ") + std::string(e.description()));
+  }
+  // Walk "a.b[2].c": every component but the last must name an existing table
+  // (or an element of an array of tables).
+  toml::table* table = &shared_->root;
+  std::size_t begin = 0;
+  while (true) {
+    const std::size_t dot = path.find('.', begin);
+    std::string part =
+        path.substr(begin, dot == std::string::npos ? std::string::npos : dot - begin);
+    std::optional<std::size_t> index;
+    if (const std::size_t bracket = part.find('['); bracket != std::string::npos) {
+      const std::size_t close = part.find(']', bracket);
+      if (close == std::string::npos || close + 1 != part.size()) {
+        throw InputError(source_, where, "bad index in '" + part + "'");
+      }
+      try {
+        index = std::stoul(part.substr(bracket + 1, close - bracket - 1));
+      } catch (const std::exception&) {
+        throw InputError(source_, where, "bad index in '" + part + "'");
+      }
+      part = part.substr(0, bracket);
+    }
+    if (part.empty()) throw InputError(source_, where, "empty key component");
+    if (dot == std::string::npos) {
+      if (index) throw InputError(source_, where, "the last component cannot be indexed");
+      table->insert_or_assign(part, *parsed.get("value"));
+      return;
+    }
+    toml::node* next = table->get(part);
+    if (next == nullptr) throw InputError(source_, where, "no table '" + part + "' in the case");
+    if (index) {
+      toml::array* array = next->as_array();
+      if (array == nullptr || *index >= array->size()) {
+        throw InputError(source_, where, "'" + part + "' has no element " + std::to_string(*index));
+      }
+      next = array->get(*index);
+    }
+    table = next->as_table();
+    if (table == nullptr) throw InputError(source_, where, "'" + part + "' is not a table");
+    begin = dot + 1;
   }
 }
 

@@ -37,6 +37,13 @@ class ConfigTable {
   ConfigTable& operator=(ConfigTable&&) noexcept;
   ~ConfigTable();
 
+  // Replaces (or adds) one value before the case is read, as given on the
+  // command line: "simulation.seed=4", "interaction[0].friction=0.3",
+  // "particles[1].region_max_m=[0.1, 0.04, 0.2]". The value is TOML. The
+  // parent tables must exist; array indices must be in range. Errors name the
+  // override as the key. Only on a root table.
+  void set_override(const std::string& assignment);
+
   bool has(const std::string& key) const;
 
   // Required values: missing or wrong type is an error.

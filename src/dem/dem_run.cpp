@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "core/io/atomic_file.hpp"
 #include "core/io/csv.hpp"
 #include "core/io/vtk.hpp"
 #include "core/progress.hpp"
@@ -78,6 +79,7 @@ io::PointCloud particle_cloud(const ParticleStore& p) {
   io::PointCloud cloud;
   cloud.points = p.position;
   cloud.point_data.push_back({"radius", 1, p.radius});
+  cloud.point_data.push_back({"mass", 1, p.mass});
   cloud.point_data.push_back(vector_array("velocity", p.velocity));
   cloud.point_data.push_back(vector_array("angular_velocity", p.angular_velocity));
   cloud.point_data.push_back(vector_array("force", p.force));
@@ -459,6 +461,25 @@ class SnapshotWriter {
   std::int64_t next_frame_ = 0;
 };
 
+// obstacles.csv: index, kind, removal time and name of each obstacle, so that the
+// analysis tools can name the walls of the contacts (second_id of wall contacts is
+// the obstacle index) and find the gate opening without the case file.
+void write_obstacle_table(const std::filesystem::path& path,
+                          const std::vector<Obstacle>& obstacles) {
+  io::write_file_atomically(path, [&](std::ostream& out) {
+    out << "index,type,remove_at_s,name\n";
+    for (std::size_t k = 0; k < obstacles.size(); ++k) {
+      const Obstacle& o = obstacles[k];
+      const char* type = std::holds_alternative<PlaneShape>(o.shape)            ? "plane"
+                         : std::holds_alternative<AxisAlignedBoxShape>(o.shape) ? "box"
+                                                                                : "shape";
+      char removal[32];
+      std::snprintf(removal, sizeof removal, "%.17g", o.remove_at);
+      out << k << "," << type << "," << removal << "," << o.name << "\n";
+    }
+  });
+}
+
 std::int64_t steps_for(double duration, double dt) {
   return std::max<std::int64_t>(1, std::llround(duration / dt));
 }
@@ -497,6 +518,7 @@ RunSummary run_dem_case(const DemCase& c, const RunOptions& options, std::ostrea
       c.output.checkpoint_interval > 0 ? steps_for(c.output.checkpoint_interval, dt) : 0;
   const std::int64_t settle_after = std::llround(c.stop.settle_check_after / dt);
 
+  write_obstacle_table(dir / "obstacles.csv", c.setup.obstacles);
   SnapshotWriter snapshots(dir, c.output.vtk, has_non_spherical(sim.particles()), options.restart,
                            sim.time());
   io::CsvWriter csv(csv_path, kDiagnosticColumns, options.restart && fs::exists(csv_path));

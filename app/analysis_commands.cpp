@@ -1,0 +1,440 @@
+#include "analysis_commands.hpp"
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "core/error.hpp"
+#include "core/io/atomic_file.hpp"
+#include "core/progress.hpp"
+#include "dem/analysis/analyze.hpp"
+
+extern char** environ;
+
+namespace sanguis::app {
+namespace fs = std::filesystem;
+using dem::analysis::AnalysisOptions;
+using dem::analysis::RunAnalysis;
+
+namespace {
+
+struct AnalyzeArgs {
+  std::vector<std::string> runs;
+  std::string out;
+  double time = -1.0;
+  double initial_time = -1.0;
+  double wall = NAN, floor = NAN, pixel = NAN, strong = 5.0, gravity = 9.81;
+  std::vector<double> width;
+  bool plot = false;
+};
+
+struct EnsembleArgs {
+  std::string case_file, output;
+  int seeds = 4, first_seed = 1, jobs = 0;
+  std::vector<std::string> overrides;
+  bool plot = false;
+};
+
+struct CalibrateArgs {
+  std::string case_file, output, parameter, measure;
+  std::vector<double> values;
+  double target = NAN, target_std = 0.0;
+  int seeds = 2, first_seed = 1, jobs = 0;
+  std::vector<std::string> overrides;
+};
+
+AnalysisOptions analysis_options(const AnalyzeArgs& a) {
+  AnalysisOptions o;
+  o.final_time = a.time;
+  if (a.initial_time >= 0) o.initial_time = a.initial_time;
+  if (!std::isnan(a.wall)) o.wall_x = a.wall;
+  if (!std::isnan(a.floor)) o.floor_z = a.floor;
+  if (!std::isnan(a.pixel)) o.pixel = a.pixel;
+  if (a.width.size() == 2) {
+    o.y_min = a.width[0];
+    o.y_max = a.width[1];
+  }
+  o.strong_force_ratio = a.strong;
+  o.gravity = a.gravity;
+  return o;
+}
+
+std::string source_dir() {
+  return SANGUIS_SOURCE_DIR;
+}
+
+// Draws the figures of an analysis folder (scripts/plot_analysis.py, matplotlib).
+void plot(const fs::path& dir) {
+  const std::string script = source_dir() + "/scripts/plot_analysis.py";
+  const std::string command = "/usr/bin/python3 '" + script + "' '" + dir.string() + "'";
+  if (std::system(command.c_str()) != 0) {
+    std::cerr << "sanguis: warning: plotting failed (" << command
+              << "); the CSV files are written\n";
+  }
+}
+
+RunAnalysis analyze_one(const fs::path& run, const AnalysisOptions& options, const fs::path& out,
+                        bool draw) {
+  const dem::analysis::RunOutput output(run);
+  RunAnalysis a = dem::analysis::analyze_run(output, options);
+  dem::analysis::write_analysis(a, out);
+  if (draw) plot(out);
+  return a;
+}
+
+void print_summary(const RunAnalysis& a) {
+  std::printf("%s: t0 = %.4g s, t = %.4g s, %zu particles, regime %s\n", a.run.c_str(),
+              a.initial_time, a.final_time, a.particles,
+              dem::analysis::to_string(a.regime).c_str());
+  std::printf("  L0 = %.4g m  H0 = %.4g m (q1 %.4g, q3 %.4g)  a = H0/L0 = %.3g\n",
+              a.initial_length.length, a.initial_height.mean, a.initial_height.first_quartile,
+              a.initial_height.third_quartile,
+              a.initial_length.length > 0 ? a.initial_height.mean / a.initial_length.length : 0.0);
+  std::printf("  Linf = %.4g m [%.4g, %.4g]  Hinf = %.4g m (q1 %.4g, q3 %.4g)  repose %.3g deg\n",
+              a.final_length.length, a.final_length.length_lower, a.final_length.length_upper,
+              a.final_height.mean, a.final_height.first_quartile, a.final_height.third_quartile,
+              a.repose.angle_deg);
+  if (!a.coordination.empty()) {
+    std::printf("  coordination (t0): pairs %.3f, contact points %.3f; fabric anisotropy %.3f\n",
+                a.coordination[0].second.pair_coordination,
+                a.coordination[0].second.contact_point_coordination, a.fabric.anisotropy);
+  }
+}
+
+int run_analyze(const AnalyzeArgs& args) {
+  const AnalysisOptions options = analysis_options(args);
+  std::vector<RunAnalysis> all;
+  for (const std::string& run : args.runs) {
+    const fs::path out = args.runs.size() == 1 && !args.out.empty() ? fs::path(args.out)
+                                                                    : fs::path(run) / "analysis";
+    all.push_back(analyze_one(run, options, out, args.plot));
+    print_summary(all.back());
+    std::printf("  written to %s\n", out.string().c_str());
+  }
+  if (all.size() > 1) {
+    const fs::path out = args.out.empty() ? fs::path("ensemble-analysis") : fs::path(args.out);
+    dem::analysis::write_ensemble(all, out);
+    std::printf("ensemble of %zu runs: %s\n", all.size(), (out / "ensemble.csv").string().c_str());
+  }
+  return 0;
+}
+
+// --- Running many cases at once ----------------------------------------------
+
+struct Job {
+  std::vector<std::string> argv;
+  fs::path log;
+};
+
+// Runs the jobs as child processes of this executable, at most `parallel` at a
+// time; each writes its console output to its log. Throws if any failed.
+void run_jobs(const char* self, const std::vector<Job>& jobs, int parallel) {
+  ProgressReporter progress(std::cerr, isatty(STDERR_FILENO) != 0);
+  std::map<pid_t, std::size_t> running;
+  std::size_t next = 0, done = 0;
+  std::vector<std::string> failures;
+  const auto wait_one = [&]() {
+    int status = 0;
+    const pid_t pid = waitpid(-1, &status, 0);
+    if (pid < 0) return;
+    const std::size_t k = running.at(pid);
+    running.erase(pid);
+    ++done;
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) failures.push_back(jobs[k].log.string());
+    char status_text[64];
+    std::snprintf(status_text, sizeof status_text, "%zu / %zu runs", done, jobs.size());
+    progress.update(static_cast<double>(done) / static_cast<double>(jobs.size()), status_text, 0.0);
+  };
+  while (next < jobs.size() || !running.empty()) {
+    if (next < jobs.size() && static_cast<int>(running.size()) < parallel) {
+      const Job& job = jobs[next];
+      fs::create_directories(job.log.parent_path());
+      posix_spawn_file_actions_t actions;
+      posix_spawn_file_actions_init(&actions);
+      posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, job.log.c_str(),
+                                       O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+      std::vector<char*> argv;
+      for (const std::string& a : job.argv) argv.push_back(const_cast<char*>(a.c_str()));
+      argv.push_back(nullptr);
+      pid_t pid = 0;
+      const int rc = posix_spawn(&pid, self, &actions, nullptr, argv.data(), environ);
+      posix_spawn_file_actions_destroy(&actions);
+      if (rc != 0) throw std::runtime_error(std::string("cannot start ") + self);
+      running[pid] = next++;
+    } else {
+      wait_one();
+    }
+  }
+  progress.finish(std::to_string(jobs.size()) + " runs done");
+  if (!failures.empty()) {
+    std::string list;
+    for (const auto& f : failures) list += "\n  " + f;
+    throw SimulationError(std::to_string(failures.size()) + " run(s) failed, see" + list);
+  }
+}
+
+int default_jobs(int jobs) {
+  if (jobs > 0) return jobs;
+  const long cores = sysconf(_SC_NPROCESSORS_ONLN);
+  return cores > 0 ? static_cast<int>(cores) : 1;
+}
+
+Job run_job(const std::string& self, const std::string& case_file, const fs::path& out, int seed,
+            const std::vector<std::string>& overrides) {
+  Job job;
+  job.argv = {self,      "run",       case_file, "--output", out.string(),
+              "--quiet", "--threads", "1",       "--seed",   std::to_string(seed)};
+  for (const std::string& o : overrides) {
+    job.argv.push_back("--set");
+    job.argv.push_back(o);
+  }
+  job.log = out / "console.txt";
+  return job;
+}
+
+std::string case_name(const std::string& case_file) {
+  return fs::path(case_file).stem().string();
+}
+
+int run_ensemble(const char* self, const EnsembleArgs& args) {
+  const fs::path root = args.output.empty()
+                            ? fs::path("output") / (case_name(args.case_file) + "-ensemble")
+                            : fs::path(args.output);
+  std::vector<Job> jobs;
+  std::vector<fs::path> runs;
+  for (int k = 0; k < args.seeds; ++k) {
+    const int seed = args.first_seed + k;
+    runs.push_back(root / ("seed_" + std::to_string(seed)));
+    jobs.push_back(run_job(self, args.case_file, runs.back(), seed, args.overrides));
+  }
+  std::printf("sanguis ensemble: %d runs of %s, %d at a time, into %s\n", args.seeds,
+              args.case_file.c_str(), default_jobs(args.jobs), root.string().c_str());
+  run_jobs(self, jobs, default_jobs(args.jobs));
+  std::vector<RunAnalysis> all;
+  for (const fs::path& run : runs) {
+    all.push_back(analyze_one(run, {}, run / "analysis", false));
+    print_summary(all.back());
+  }
+  dem::analysis::write_ensemble(all, root);
+  if (args.plot) plot(root);
+  std::printf("ensemble summary: %s\n", (root / "ensemble.csv").string().c_str());
+  return 0;
+}
+
+// --- Calibration ---------------------------------------------------------------
+
+struct Fit {
+  double value = NAN, std = NAN;
+  double slope = NAN;
+  bool bracketed = false;
+};
+
+// Solves m(v) = target with a weighted straight line m = a + b v through the
+// grid values around the first crossing of the target by the mean curve; the
+// uncertainty propagates the line's covariance and the target's spread.
+Fit fit_crossing(const std::vector<double>& v, const std::vector<double>& mean,
+                 const std::vector<double>& sem, double target, double target_std) {
+  Fit fit;
+  std::size_t cross = v.size();
+  for (std::size_t k = 0; k + 1 < v.size(); ++k) {
+    if ((mean[k] - target) * (mean[k + 1] - target) <= 0) {
+      cross = k;
+      break;
+    }
+  }
+  fit.bracketed = cross < v.size();
+  if (!fit.bracketed) {  // extrapolate from the nearest end
+    cross = std::abs(mean.front() - target) < std::abs(mean.back() - target) ? 0 : v.size() - 2;
+  }
+  const std::size_t lo = cross > 0 ? cross - 1 : 0;
+  const std::size_t hi = std::min(v.size() - 1, cross + 2);
+  double sw = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
+  for (std::size_t k = lo; k <= hi; ++k) {
+    const double w = 1.0 / std::max(sem[k] * sem[k], 1e-12 * (1.0 + mean[k] * mean[k]));
+    sw += w;
+    sx += w * v[k];
+    sy += w * mean[k];
+    sxx += w * v[k] * v[k];
+    sxy += w * v[k] * mean[k];
+  }
+  const double det = sw * sxx - sx * sx;
+  const double b = (sw * sxy - sx * sy) / det;
+  const double a = (sy - b * sx) / sw;
+  const double var_a = sxx / det, var_b = sw / det, cov_ab = -sx / det;
+  fit.slope = b;
+  fit.value = (target - a) / b;
+  // v* = (t - a) / b: derivatives -1/b (a), -(t - a)/b^2 (b), 1/b (t).
+  const double da = -1.0 / b, db = -(target - a) / (b * b), dt = 1.0 / b;
+  fit.std = std::sqrt(std::max(0.0, da * da * var_a + db * db * var_b + 2 * da * db * cov_ab +
+                                        dt * dt * target_std * target_std));
+  return fit;
+}
+
+double summary_value(const RunAnalysis& a, const std::string& name) {
+  for (const auto& [key, value] : dem::analysis::summary_values(a)) {
+    if (key == name) return value;
+  }
+  std::string known;
+  for (const auto& [key, value] : dem::analysis::summary_values(a)) known += " " + key;
+  throw InputError("", "--measure", "unknown measure '" + name + "'; one of:" + known);
+}
+
+int run_calibrate(const char* self, const CalibrateArgs& args) {
+  if (args.values.size() < 2) throw InputError("", "--values", "give at least two values");
+  for (std::size_t k = 1; k < args.values.size(); ++k) {
+    if (!(args.values[k] > args.values[k - 1])) {
+      throw InputError("", "--values", "values must increase");
+    }
+  }
+  const fs::path root = args.output.empty()
+                            ? fs::path("output") / (case_name(args.case_file) + "-calibrate")
+                            : fs::path(args.output);
+  std::vector<Job> jobs;
+  std::vector<std::vector<fs::path>> runs(args.values.size());
+  for (std::size_t i = 0; i < args.values.size(); ++i) {
+    std::ostringstream value;
+    value.precision(17);
+    value << args.values[i];
+    std::vector<std::string> overrides = args.overrides;
+    overrides.push_back(args.parameter + "=" + value.str());
+    for (int k = 0; k < args.seeds; ++k) {
+      const int seed = args.first_seed + k;
+      runs[i].push_back(root / ("value_" + std::to_string(i)) / ("seed_" + std::to_string(seed)));
+      jobs.push_back(run_job(self, args.case_file, runs[i].back(), seed, overrides));
+    }
+  }
+  std::printf("sanguis calibrate: %s over %zu values x %d seeds = %zu runs, %d at a time\n",
+              args.parameter.c_str(), args.values.size(), args.seeds, jobs.size(),
+              default_jobs(args.jobs));
+  run_jobs(self, jobs, default_jobs(args.jobs));
+
+  std::vector<double> mean(args.values.size()), sem(args.values.size()), sd(args.values.size());
+  std::vector<std::vector<double>> samples(args.values.size());
+  for (std::size_t i = 0; i < args.values.size(); ++i) {
+    double sum = 0, sum2 = 0;
+    for (const fs::path& run : runs[i]) {
+      const RunAnalysis a = analyze_one(run, {}, run / "analysis", false);
+      const double m = summary_value(a, args.measure);
+      samples[i].push_back(m);
+      sum += m;
+      sum2 += m * m;
+    }
+    const double n = static_cast<double>(runs[i].size());
+    mean[i] = sum / n;
+    sd[i] = n > 1 ? std::sqrt(std::max(0.0, (sum2 - n * mean[i] * mean[i]) / (n - 1))) : 0.0;
+    sem[i] = sd[i] / std::sqrt(n);
+  }
+  const Fit fit = fit_crossing(args.values, mean, sem, args.target, args.target_std);
+
+  io::write_file_atomically(root / "calibration.csv", [&](std::ostream& out) {
+    out.precision(10);
+    out << "value," << args.measure << "_mean," << args.measure << "_std,runs\n";
+    for (std::size_t i = 0; i < args.values.size(); ++i) {
+      out << args.values[i] << "," << mean[i] << "," << sd[i] << "," << samples[i].size() << "\n";
+    }
+  });
+  io::write_file_atomically(root / "calibration_result.csv", [&](std::ostream& out) {
+    out.precision(10);
+    out << "parameter,measure,target,target_std,estimate,estimate_std,bracketed,slope\n"
+        << args.parameter << "," << args.measure << "," << args.target << "," << args.target_std
+        << "," << fit.value << "," << fit.std << "," << (fit.bracketed ? 1 : 0) << "," << fit.slope
+        << "\n";
+  });
+  for (std::size_t i = 0; i < args.values.size(); ++i) {
+    std::printf("  %s = %-10.4g %s = %.4g +- %.2g\n", args.parameter.c_str(), args.values[i],
+                args.measure.c_str(), mean[i], sd[i]);
+  }
+  std::printf("%s = %.4g +- %.2g for %s = %.4g%s\n", args.parameter.c_str(), fit.value, fit.std,
+              args.measure.c_str(), args.target,
+              fit.bracketed ? "" : "  (WARNING: target outside the measured range, extrapolated)");
+  std::printf("written: %s\n", (root / "calibration_result.csv").string().c_str());
+  return 0;
+}
+
+}  // namespace
+
+std::function<bool()> add_analysis_commands(CLI::App& app) {
+  auto analyze = std::make_shared<AnalyzeArgs>();
+  auto ensemble = std::make_shared<EnsembleArgs>();
+  auto calibrate = std::make_shared<CalibrateArgs>();
+
+  auto* an = app.add_subcommand(
+      "analyze", "measure DEM run folders (run-out, heights, velocity, contact network...)");
+  an->add_option("runs", analyze->runs, "run output folders (several: also an ensemble summary)")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  an->add_option("--out", analyze->out,
+                 "output folder (default RUN/analysis; several runs: the ensemble folder)");
+  an->add_option("--time", analyze->time, "final frame time [s] (default: the last frame)");
+  an->add_option("--initial-time", analyze->initial_time,
+                 "initial frame time [s] (default: when the gate is removed, else 0)");
+  an->add_option("--wall", analyze->wall, "x of the back wall [m] (default: from the particles)");
+  an->add_option("--floor", analyze->floor, "z of the floor [m] (default: from the particles)");
+  an->add_option("--pixel", analyze->pixel, "top-view pixel size [m] (default: mean radius / 2)");
+  an->add_option("--width", analyze->width, "channel width as Y_MIN Y_MAX [m]")->expected(2);
+  an->add_option("--strong", analyze->strong, "strong network: Fc / <Fc> above this")
+      ->capture_default_str();
+  an->add_option("--gravity", analyze->gravity, "|g| [m/s^2]")->capture_default_str();
+  an->add_flag("--plot", analyze->plot, "draw PNG figures (matplotlib)");
+
+  auto* en = app.add_subcommand("ensemble", "run a case over several seeds in parallel, analyze");
+  en->add_option("case", ensemble->case_file, "case file (TOML)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  en->add_option("--seeds", ensemble->seeds, "number of runs")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  en->add_option("--first-seed", ensemble->first_seed, "seed of the first run")
+      ->capture_default_str();
+  en->add_option("--jobs,-j", ensemble->jobs, "runs at a time (default: the cores)");
+  en->add_option("--output,-o", ensemble->output, "folder (default output/<case>-ensemble)");
+  en->add_option("--set", ensemble->overrides, "override KEY=VALUE in every run");
+  en->add_flag("--plot", ensemble->plot, "draw PNG figures");
+
+  auto* ca = app.add_subcommand(
+      "calibrate", "fit one case parameter to a target measure over an ensemble of runs");
+  ca->add_option("case", calibrate->case_file, "case file (TOML)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  ca->add_option("--parameter", calibrate->parameter,
+                 "case key to vary, e.g. interaction[0].friction")
+      ->required();
+  ca->add_option("--values", calibrate->values, "increasing values to try")->required();
+  ca->add_option("--measure", calibrate->measure,
+                 "summary column of `analyze`, e.g. repose_angle_deg, runout_ratio")
+      ->required();
+  ca->add_option("--target", calibrate->target, "target value of the measure")->required();
+  ca->add_option("--target-std", calibrate->target_std, "uncertainty of the target")
+      ->capture_default_str();
+  ca->add_option("--seeds", calibrate->seeds, "runs per value")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  ca->add_option("--first-seed", calibrate->first_seed, "seed of the first run")
+      ->capture_default_str();
+  ca->add_option("--jobs,-j", calibrate->jobs, "runs at a time (default: the cores)");
+  ca->add_option("--output,-o", calibrate->output, "folder (default output/<case>-calibrate)");
+  ca->add_option("--set", calibrate->overrides, "override KEY=VALUE in every run");
+
+  const std::string self_path = fs::read_symlink("/proc/self/exe").string();
+  return [=]() {
+    if (*an) return run_analyze(*analyze) == 0;
+    if (*en) return run_ensemble(self_path.c_str(), *ensemble) == 0;
+    if (*ca) return run_calibrate(self_path.c_str(), *calibrate) == 0;
+    return false;
+  };
+}
+
+}  // namespace sanguis::app

@@ -1,0 +1,132 @@
+#include "dem/analysis/run_output.hpp"
+
+#include <algorithm>
+#include <fstream>
+#include <stdexcept>
+
+#include "core/io/vtk_reader.hpp"
+
+namespace sanguis::dem::analysis {
+namespace {
+
+std::vector<std::string> dataset_files(const std::filesystem::path& pvd) {
+  std::vector<std::string> files;
+  if (!std::filesystem::exists(pvd)) return files;
+  for (const auto& e : io::read_pvd(pvd)) files.push_back(e.dataset);
+  return files;
+}
+
+std::vector<Vec3> as_vectors(const std::vector<double>& xyz) {
+  std::vector<Vec3> v(xyz.size() / 3);
+  for (std::size_t k = 0; k < v.size(); ++k) v[k] = {xyz[3 * k], xyz[3 * k + 1], xyz[3 * k + 2]};
+  return v;
+}
+
+const std::string& file_of(const std::vector<std::string>& files, std::size_t frame,
+                           const std::string& what) {
+  if (frame >= files.size()) {
+    throw std::runtime_error("frame " + std::to_string(frame) + " has no " + what + " file");
+  }
+  return files[frame];
+}
+
+}  // namespace
+
+RunOutput::RunOutput(std::filesystem::path dir) : dir_(std::move(dir)) {
+  const auto pvd = dir_ / "particles.pvd";
+  if (!std::filesystem::exists(pvd)) {
+    throw std::runtime_error(dir_.string() +
+                             ": not a sanguis DEM output folder (no particles.pvd)");
+  }
+  for (const auto& e : io::read_pvd(pvd)) {
+    times_.push_back(e.time);
+    particle_files_.push_back(e.dataset);
+  }
+  contact_files_ = dataset_files(dir_ / "contacts.pvd");
+  branch_files_ = dataset_files(dir_ / "branches.pvd");
+  body_files_ = dataset_files(dir_ / "bodies.pvd");
+
+  std::ifstream names(dir_ / "obstacles.csv");
+  std::string line;
+  std::getline(names,
+               line);  // header: index,type,remove_at_s,name (the name last: it may hold commas)
+  while (std::getline(names, line)) {
+    std::size_t at = 0;
+    for (int comma = 0; comma < 3 && at != std::string::npos; ++comma) {
+      at = line.find(',', at);
+      if (at != std::string::npos) ++at;
+    }
+    if (at == std::string::npos) continue;
+    obstacle_names_.push_back(line.substr(at));
+  }
+}
+
+std::size_t RunOutput::frame_at(double t) const {
+  if (times_.empty()) throw std::runtime_error(dir_.string() + ": no frames");
+  if (t < 0) return times_.size() - 1;
+  const auto after = std::upper_bound(times_.begin(), times_.end(), t + 1e-12 * std::abs(t));
+  return after == times_.begin() ? 0 : static_cast<std::size_t>(after - times_.begin()) - 1;
+}
+
+ParticleFrame RunOutput::particles(std::size_t frame) const {
+  const io::PointCloud cloud =
+      io::read_point_cloud_vtu(file_of(particle_files_, frame, "particle"));
+  ParticleFrame f;
+  f.time = times_.at(frame);
+  f.position = cloud.points;
+  f.radius = io::find_array(cloud.point_data, "radius").values;
+  f.velocity = as_vectors(io::find_array(cloud.point_data, "velocity").values);
+  if (io::has_array(cloud.point_data, "mass"))
+    f.mass = io::find_array(cloud.point_data, "mass").values;
+  f.id = io::find_array(cloud.int_point_data, "id").values;
+  f.spherical = io::find_array(cloud.int_point_data, "spherical").values;
+  return f;
+}
+
+ContactPointFrame RunOutput::contacts(std::size_t frame) const {
+  const io::PointCloud cloud = io::read_point_cloud_vtu(file_of(contact_files_, frame, "contact"));
+  ContactPointFrame f;
+  f.point = cloud.points;
+  f.force = as_vectors(io::find_array(cloud.point_data, "force").values);
+  f.kind = io::find_array(cloud.int_point_data, "kind").values;
+  f.first = io::find_array(cloud.int_point_data, "first_id").values;
+  f.second = io::find_array(cloud.int_point_data, "second_id").values;
+  return f;
+}
+
+BranchFrame RunOutput::branches(std::size_t frame) const {
+  const io::PolyMesh mesh = io::read_polymesh_vtp(file_of(branch_files_, frame, "branch"));
+  BranchFrame f;
+  for (const auto& line : mesh.lines) {
+    f.from.push_back(mesh.points.at(static_cast<std::size_t>(line.front())));
+    f.to.push_back(mesh.points.at(static_cast<std::size_t>(line.back())));
+  }
+  f.force_magnitude = io::find_array(mesh.cell_data, "force_magnitude").values;
+  f.first = io::find_array(mesh.int_cell_data, "first_id").values;
+  f.second = io::find_array(mesh.int_cell_data, "second_id").values;
+  return f;
+}
+
+BodySurfaceFrame RunOutput::bodies(std::size_t frame) const {
+  BodySurfaceFrame f;
+  if (body_files_.empty()) return f;
+  const io::PolyMesh mesh = io::read_polymesh_vtp(file_of(body_files_, frame, "body"));
+  for (const auto& polygon : mesh.polygons) {
+    // Fan triangulation (the writer emits triangles; this keeps quads correct too).
+    for (std::size_t k = 1; k + 1 < polygon.size(); ++k) {
+      f.a.push_back(mesh.points.at(static_cast<std::size_t>(polygon[0])));
+      f.b.push_back(mesh.points.at(static_cast<std::size_t>(polygon[k])));
+      f.c.push_back(mesh.points.at(static_cast<std::size_t>(polygon[k + 1])));
+    }
+  }
+  return f;
+}
+
+std::string RunOutput::obstacle_name(std::int64_t index) const {
+  if (index >= 0 && static_cast<std::size_t>(index) < obstacle_names_.size()) {
+    return obstacle_names_[static_cast<std::size_t>(index)];
+  }
+  return "obstacle " + std::to_string(index);
+}
+
+}  // namespace sanguis::dem::analysis
