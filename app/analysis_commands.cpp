@@ -293,6 +293,7 @@ double summary_value(const RunAnalysis& a, const std::string& name) {
 }
 
 int run_calibrate(const char* self, const CalibrateArgs& args) {
+  (void)summary_value(RunAnalysis{}, args.measure);  // an unknown measure fails before any run
   if (args.values.size() < 2) throw InputError("", "--values", "give at least two values");
   for (std::size_t k = 1; k < args.values.size(); ++k) {
     if (!(args.values[k] > args.values[k - 1])) {
@@ -336,6 +337,20 @@ int run_calibrate(const char* self, const CalibrateArgs& args) {
     mean[i] = sum / n;
     sd[i] = n > 1 ? std::sqrt(std::max(0.0, (sum2 - n * mean[i] * mean[i]) / (n - 1))) : 0.0;
     sem[i] = sd[i] / std::sqrt(n);
+  }
+  // With a few seeds per value a per-value spread is itself very uncertain (two
+  // runs may agree by chance): weight by the spread pooled over all values.
+  double pooled_variance = 0.0, dof = 0.0;
+  for (std::size_t i = 0; i < args.values.size(); ++i) {
+    const double n = static_cast<double>(samples[i].size());
+    pooled_variance += (n - 1) * sd[i] * sd[i];
+    dof += n - 1;
+  }
+  if (dof > 0) {
+    pooled_variance /= dof;
+    for (std::size_t i = 0; i < args.values.size(); ++i) {
+      sem[i] = std::sqrt(pooled_variance / static_cast<double>(samples[i].size()));
+    }
   }
   const Fit fit = fit_crossing(args.values, mean, sem, args.target, args.target_std);
 
@@ -412,7 +427,9 @@ std::function<bool()> add_analysis_commands(CLI::App& app) {
   ca->add_option("--parameter", calibrate->parameter,
                  "case key to vary, e.g. interaction[0].friction")
       ->required();
-  ca->add_option("--values", calibrate->values, "increasing values to try")->required();
+  ca->add_option("--values", calibrate->values, "increasing values to try (a,b,c or a b c)")
+      ->required()
+      ->delimiter(',');
   ca->add_option("--measure", calibrate->measure,
                  "summary column of `analyze`, e.g. repose_angle_deg, runout_ratio")
       ->required();
@@ -428,7 +445,9 @@ std::function<bool()> add_analysis_commands(CLI::App& app) {
   ca->add_option("--output,-o", calibrate->output, "folder (default output/<case>-calibrate)");
   ca->add_option("--set", calibrate->overrides, "override KEY=VALUE in every run");
 
-  const std::string self_path = fs::read_symlink("/proc/self/exe").string();
+  // Not the resolved path: /proc/self/exe still starts this executable when its
+  // file was replaced (a rebuild) while a long study runs.
+  const std::string self_path = "/proc/self/exe";
   return [=]() {
     if (*an) return run_analyze(*analyze) == 0;
     if (*en) return run_ensemble(self_path.c_str(), *ensemble) == 0;

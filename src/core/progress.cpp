@@ -38,9 +38,13 @@ void ProgressReporter::update(double fraction, const std::string& status, double
   const double elapsed = elapsed_seconds();
   const double eta = fraction > 0 ? elapsed * (1.0 - fraction) / fraction : -1.0;
   char buf[256];
-  std::snprintf(buf, sizeof buf, "[%5.1f%%] %s  elapsed %s  ETA %s  %.3g /s", 100.0 * fraction,
-                status.c_str(), format_duration(elapsed).c_str(), format_duration(eta).c_str(),
-                elapsed > 0 ? work_units / elapsed : 0.0);
+  const int used =
+      std::snprintf(buf, sizeof buf, "[%5.1f%%] %s  elapsed %s  ETA %s", 100.0 * fraction,
+                    status.c_str(), format_duration(elapsed).c_str(), format_duration(eta).c_str());
+  if (work_units > 0 && elapsed > 0 && used > 0 && static_cast<std::size_t>(used) < sizeof buf) {
+    std::snprintf(buf + used, sizeof buf - static_cast<std::size_t>(used), "  %.3g /s",
+                  work_units / elapsed);
+  }
   if (interactive_) {
     out_ << '\r' << buf << "\x1b[K" << std::flush;
   } else {

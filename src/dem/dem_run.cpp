@@ -532,12 +532,13 @@ RunSummary run_dem_case(const DemCase& c, const RunOptions& options, std::ostrea
           << total_steps << " steps of " << dt << " s, output to " << dir.string() << "\n";
   ProgressReporter progress(std::cerr, !options.quiet && isatty(STDERR_FILENO) != 0);
   const std::int64_t first_step = sim.step_index();
-  const double n = static_cast<double>(sim.particles().size());
+  double particle_steps = 0.0;  // summed per step: pouring changes the count
 
   RunSummary summary;
   try {
     while (sim.step_index() < stop_step) {
       sim.step();
+      particle_steps += static_cast<double>(sim.particles().size());
       const std::int64_t s = sim.step_index();
       const bool output_now = s % output_every == 0;
       if (output_now) record();
@@ -553,7 +554,7 @@ RunSummary run_dem_case(const DemCase& c, const RunOptions& options, std::ostrea
         char status[128];
         std::snprintf(status, sizeof status, "t = %.4g / %.4g s", sim.time(), c.stop.end_time);
         progress.update(static_cast<double>(s) / static_cast<double>(total_steps), status,
-                        n * static_cast<double>(s - first_step));
+                        particle_steps);
       }
     }
   } catch (const SimulationError& e) {
@@ -576,8 +577,7 @@ RunSummary run_dem_case(const DemCase& c, const RunOptions& options, std::ostrea
   done.precision(4);
   done << "done: t = " << sim.time() << " s, " << summary.steps << " steps in "
        << ProgressReporter::format_duration(summary.wall_seconds) << " ("
-       << (summary.wall_seconds > 0 ? n * static_cast<double>(summary.steps) / summary.wall_seconds
-                                    : 0.0)
+       << (summary.wall_seconds > 0 ? particle_steps / summary.wall_seconds : 0.0)
        << " particle-steps/s)" << (summary.settled ? ", settled" : "");
   progress.finish(done.str());
   log << done.str() << "\n";

@@ -382,3 +382,39 @@ TEST_F(ConfigFileTest, SyntaxErrorInAFile) {
 
 }  // namespace
 }  // namespace sanguis
+
+namespace sanguis {
+namespace {
+
+TEST(ConfigOverride, ReplacesAddsAndIndexesArraysOfTables) {
+  ConfigTable c = ConfigTable::parse_string(
+      "[simulation]\nseed = 1\n[[particles]]\ncount = 5\n[[particles]]\ncount = 7\n", "case.toml");
+  c.set_override("simulation.seed=4");
+  c.set_override("particles[1].count=9");
+  c.set_override("simulation.gravity_m_s2=[0.0, 0.0, -1.0]");
+  EXPECT_EQ(c.table("simulation").get_int("seed"), 4);
+  EXPECT_EQ(c.table("simulation").get_vec3("gravity_m_s2").z, -1.0);
+  EXPECT_EQ(c.table_array("particles")[0].get_int("count"), 5);
+  EXPECT_EQ(c.table_array("particles")[1].get_int("count"), 9);
+}
+
+TEST(ConfigOverride, BadOverridesNameThemselves) {
+  ConfigTable c = ConfigTable::parse_string("[simulation]\nseed = 1\n", "case.toml");
+  const auto message = [&](const std::string& o) {
+    try {
+      c.set_override(o);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message("simulation.seed").find("KEY=VALUE"), std::string::npos);
+  EXPECT_NE(message("simulation.seed=[1,").find("not TOML"), std::string::npos);
+  EXPECT_NE(message("domain.min_m=[0,0,0]").find("no table 'domain'"), std::string::npos);
+  EXPECT_NE(message("simulation[2].seed=1").find("no element 2"), std::string::npos);
+  EXPECT_NE(message("simulation.seed[0]=1").find("cannot be indexed"), std::string::npos);
+  EXPECT_NE(message("simulation.seed=1").find("no error"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace sanguis

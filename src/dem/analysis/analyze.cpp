@@ -119,10 +119,11 @@ RunAnalysis analyze_run(const RunOutput& run, const AnalysisOptions& o) {
   a.gravity = o.gravity;
   const std::optional<double> gate_time =
       o.initial_time ? o.initial_time : first_removal_time(run.dir());
-  const std::size_t first = gate_time ? run.frame_at(*gate_time) : 0;
+  std::size_t first = gate_time ? run.frame_at(*gate_time) : 0;
   const std::size_t last = run.frame_at(o.final_time);
   if (last < first) throw std::runtime_error("the final frame comes before the initial frame");
-  const ParticleFrame initial = run.particles(first);
+  ParticleFrame initial = run.particles(first);
+  while (initial.size() == 0 && first < last) initial = run.particles(++first);  // pouring
   const ParticleFrame final = run.particles(last);
   if (initial.size() == 0) {
     throw std::runtime_error(run.dir().string() + ": the initial frame (t = " +

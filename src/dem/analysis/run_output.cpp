@@ -4,6 +4,7 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "core/error.hpp"
 #include "core/io/vtk_reader.hpp"
 
 namespace sanguis::dem::analysis {
@@ -35,8 +36,7 @@ const std::string& file_of(const std::vector<std::string>& files, std::size_t fr
 RunOutput::RunOutput(std::filesystem::path dir) : dir_(std::move(dir)) {
   const auto pvd = dir_ / "particles.pvd";
   if (!std::filesystem::exists(pvd)) {
-    throw std::runtime_error(dir_.string() +
-                             ": not a sanguis DEM output folder (no particles.pvd)");
+    throw InputError(dir_.string(), "", "not a sanguis DEM output folder (no particles.pvd)");
   }
   for (const auto& e : io::read_pvd(pvd)) {
     times_.push_back(e.time);

@@ -1,0 +1,158 @@
+// End-to-end tests of `sanguis analyze`, `ensemble` and `calibrate` on a small
+// dam break (tests/integration/data/dam-break-tiny.toml), and of `run --set`.
+#include <gtest/gtest.h>
+
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cli_harness.hpp"
+#include "core/io/vtk_reader.hpp"
+
+namespace sanguis {
+namespace {
+
+using testing_cli::CommandResult;
+using testing_cli::read_text_file;
+using testing_cli::shell_quoted;
+namespace fs = std::filesystem;
+
+const std::string kTinyCase =
+    shell_quoted(std::string(SANGUIS_SOURCE_DIR) + "/tests/integration/data/dam-break-tiny.toml");
+
+// The first data row of a CSV file as name -> value (text).
+std::map<std::string, std::string> first_row(const fs::path& file) {
+  std::istringstream in(read_text_file(file));
+  std::string header, row;
+  std::getline(in, header);
+  std::getline(in, row);
+  std::map<std::string, std::string> values;
+  std::istringstream h(header), r(row);
+  std::string name, value;
+  while (std::getline(h, name, ',') && std::getline(r, value, ',')) values[name] = value;
+  return values;
+}
+
+double number(const std::map<std::string, std::string>& row, const std::string& key) {
+  const auto it = row.find(key);
+  if (it == row.end()) throw std::runtime_error("no column " + key);
+  return std::stod(it->second);
+}
+
+class AnalysisCommandTest : public testing_cli::SanguisCommandTest {};
+
+TEST_F(AnalysisCommandTest, AnalyzeMeasuresTheCollapseOfASmallColumn) {
+  const fs::path run = dir_ / "run";
+  const CommandResult r =
+      sanguis("run " + kTinyCase + " --quiet --threads 1 -o " + shell_quoted(run.string()));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(read_text_file(run / "obstacles.csv").find("4,box,0.25,gate"), std::string::npos);
+
+  const CommandResult a = sanguis("analyze " + shell_quoted(run.string()));
+  ASSERT_EQ(a.code, 0) << a.err;
+  const fs::path out = run / "analysis";
+  const auto s = first_row(out / "summary.csv");
+  // The initial frame is the gate removal (obstacles.csv), at 0.25 s.
+  EXPECT_NEAR(number(s, "initial_time_s"), 0.25, 0.025);
+  // The column stands 16 mm long behind the gate; one pixel is half a mean radius.
+  EXPECT_NEAR(number(s, "L0_m"), 0.016, 0.002);
+  // 200 beads of 2 mm in 16 x 16 mm at a packing fraction near 0.6: H0 about 4.4 cm.
+  EXPECT_GT(number(s, "H0_m"), 0.03);
+  EXPECT_LT(number(s, "H0_m"), 0.07);
+  EXPECT_GT(number(s, "Linf_m"), 2 * number(s, "L0_m"));
+  EXPECT_LE(number(s, "Linf_20pc_m"), number(s, "Linf_m"));
+  EXPECT_GE(number(s, "Linf_1pc_m"), number(s, "Linf_m"));
+  EXPECT_LT(number(s, "Hinf_m"), number(s, "H0_m"));
+  EXPECT_EQ(number(s, "regime"), 2.0);  // collapsed
+  EXPECT_GT(number(s, "com_displacement_x_m"), 0.0);
+  // A random loose packing of frictional spheres: 3 to 6 neighbours.
+  EXPECT_GT(number(s, "pair_coordination"), 3.0);
+  EXPECT_LT(number(s, "pair_coordination"), 6.0);
+  // The walls carry the column: floor most of it, nothing pulls down.
+  const std::string walls = read_text_file(out / "walls.csv");
+  EXPECT_NE(walls.find("\"side wall, front\""), std::string::npos);
+  EXPECT_NE(walls.find("\"gate\""), std::string::npos);
+  for (const char* file : {"runout.csv", "height.csv", "velocity.csv", "force_pdf.csv",
+                           "fabric.csv", "coordination.csv", "strong_network.vtp"}) {
+    EXPECT_TRUE(fs::exists(out / file)) << file;
+  }
+  const io::PolyMesh strong = io::read_polymesh_vtp(out / "strong_network.vtp");
+  const io::PolyMesh all = io::read_polymesh_vtp(run / "contacts" / "branches_00000010.vtp");
+  EXPECT_LT(strong.lines.size(), all.lines.size());
+}
+
+TEST_F(AnalysisCommandTest, AnalyzeRefusesAFolderThatIsNotARun) {
+  const CommandResult a = sanguis("analyze " + shell_quoted(dir_.string()));
+  EXPECT_EQ(a.code, 2);
+  EXPECT_NE(a.err.find("not a sanguis DEM output folder"), std::string::npos) << a.err;
+}
+
+TEST_F(AnalysisCommandTest, EnsembleRunsSeedsInParallelAndAggregates) {
+  const fs::path root = dir_ / "ens";
+  const CommandResult e = sanguis("ensemble " + kTinyCase + " --seeds 2 --jobs 2 -o " +
+                                  shell_quoted(root.string()) + " --set simulation.end_time_s=0.3");
+  ASSERT_EQ(e.code, 0) << e.err << e.out;
+  const std::string table = read_text_file(root / "ensemble.csv");
+  EXPECT_NE(table.find("Linf_m,"), std::string::npos);
+  EXPECT_NE(table.find("fraction_collapsed,"), std::string::npos);
+  // Different seeds, different packings.
+  EXPECT_NE(read_text_file(root / "seed_1" / "particles" / "particles_00000000.vtu"),
+            read_text_file(root / "seed_2" / "particles" / "particles_00000000.vtu"));
+  EXPECT_NE(read_text_file(root / "seed_2" / "run.log").find("seed            2"),
+            std::string::npos);
+}
+
+// Friction against run-out: two values bracket a target, the estimate lies
+// between them; a measure that does not exist is refused with the list.
+TEST_F(AnalysisCommandTest, CalibrateFitsAParameterToATarget) {
+  const fs::path root = dir_ / "cal";
+  const std::string common = "calibrate " + kTinyCase +
+                             " --parameter interaction[0].friction --values 0.1,0.8 --seeds 1 "
+                             "--jobs 2 --set simulation.end_time_s=0.45 -o " +
+                             shell_quoted(root.string());
+  const CommandResult bad = sanguis(common + " --measure nonsense --target 1");
+  EXPECT_EQ(bad.code, 2) << bad.err;
+  EXPECT_NE(bad.err.find("runout_ratio"), std::string::npos) << bad.err;
+
+  CommandResult c = sanguis(common + " --measure Linf_m --target 0.05");
+  ASSERT_EQ(c.code, 0) << c.err << c.out;
+  std::istringstream table(read_text_file(root / "calibration.csv"));
+  std::string line;
+  std::vector<double> runout;
+  std::getline(table, line);
+  while (std::getline(table, line)) {
+    runout.push_back(std::stod(line.substr(line.find(',') + 1)));
+  }
+  ASSERT_EQ(runout.size(), 2u);
+  EXPECT_GT(runout[0], runout[1]);  // more friction, shorter run-out
+  const double target = 0.5 * (runout[0] + runout[1]);
+  std::ostringstream exact;
+  exact.precision(17);
+  exact << target;
+  c = sanguis(common + " --measure Linf_m --target " + exact.str());
+  ASSERT_EQ(c.code, 0) << c.err;
+  const auto result = first_row(root / "calibration_result.csv");
+  EXPECT_EQ(number(result, "bracketed"), 1.0);
+  // A straight line through the two points: the midpoint of the values.
+  EXPECT_NEAR(number(result, "estimate"), 0.45, 1e-6);
+}
+
+TEST_F(AnalysisCommandTest, RunSetOverridesAreStrict) {
+  const fs::path out = dir_ / "o";
+  CommandResult r = sanguis("run " + kTinyCase + " -q -o " + shell_quoted(out.string()) +
+                            " --set interaction[0].frictionn=0.3");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("frictionn"), std::string::npos) << r.err;
+  r = sanguis("run " + kTinyCase + " -q -o " + shell_quoted(out.string()) +
+              " --set interaction[7].friction=0.3");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("no element 7"), std::string::npos) << r.err;
+  r = sanguis("run " + kTinyCase + " -q -o " + shell_quoted(out.string()) +
+              " --set simulation.end_time_s=-1");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_FALSE(fs::exists(out));
+}
+
+}  // namespace
+}  // namespace sanguis
