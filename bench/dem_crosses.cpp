@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "benchmarks.hpp"
+#include "memory_usage.hpp"
 #include "dem/simulation.hpp"
 #include "geometry/mass_properties.hpp"
 
@@ -92,6 +93,7 @@ dem::DemSetup dem_crosses_setup(const BenchOptions& o) {
 std::string run_dem_crosses(const BenchOptions& o) {
   if (o.particles <= 0 || o.steps <= 0)
     throw std::invalid_argument("particles and steps must be > 0");
+  const std::int64_t rss_before = resident_bytes();
   dem::DemSimulation sim(dem_crosses_setup(o));
   const auto start = std::chrono::steady_clock::now();
   for (std::int64_t s = 0; s < o.steps; ++s) sim.step();
@@ -107,7 +109,11 @@ std::string run_dem_crosses(const BenchOptions& o) {
        << ",\"element_pair_candidates\":" << sim.body_contacts().size()
        << ",\"element_contacts\":" << d.particle_contacts
        << ",\"wall_contacts\":" << d.wall_contacts
-       << ",\"max_overlap_over_radius\":" << d.max_overlap_ratio << "}";
+       << ",\"max_overlap_over_radius\":" << d.max_overlap_ratio
+       << ",\"peak_rss_mb\":" << static_cast<double>(peak_resident_bytes()) / 1048576.0
+       << ",\"bytes_per_particle\":"
+       << static_cast<double>(peak_resident_bytes() - rss_before) / static_cast<double>(o.particles)
+       << "}";
   return json.str();
 }
 

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "benchmarks.hpp"
+#include "memory_usage.hpp"
 #include "dem/simulation.hpp"
 
 namespace sanguis::bench {
@@ -78,6 +79,7 @@ dem::DemSetup dem_spheres_setup(const BenchOptions& o) {
 std::string run_dem_spheres(const BenchOptions& o) {
   if (o.particles <= 0 || o.steps <= 0)
     throw std::invalid_argument("particles and steps must be > 0");
+  const std::int64_t rss_before = resident_bytes();
   dem::DemSimulation sim(dem_spheres_setup(o));
   const auto start = std::chrono::steady_clock::now();
   for (std::int64_t s = 0; s < o.steps; ++s) sim.step();
@@ -89,7 +91,11 @@ std::string run_dem_spheres(const BenchOptions& o) {
        << ",\"steps\":" << o.steps << ",\"threads\":" << o.threads << ",\"seconds\":" << seconds
        << ",\"particle_steps_per_s\":"
        << static_cast<double>(o.particles) * static_cast<double>(o.steps) / seconds
-       << ",\"neighbor_rebuilds\":" << sim.neighbor_search().rebuild_count() - 1 << "}";
+       << ",\"neighbor_rebuilds\":" << sim.neighbor_search().rebuild_count() - 1
+       << ",\"peak_rss_mb\":" << static_cast<double>(peak_resident_bytes()) / 1048576.0
+       << ",\"bytes_per_particle\":"
+       << static_cast<double>(peak_resident_bytes() - rss_before) / static_cast<double>(o.particles)
+       << "}";
   return json.str();
 }
 

@@ -13,7 +13,8 @@ Reference: Lajeunesse, Monnier & Homsy, Phys. Fluids 17 (2005), quasi-2D channel
 scaling the thesis' sphere simulations reproduce.
 Checks (tolerances fixed before running): every point within 35 % of the Lajeunesse
 curve (linear branch below a = 2.3, power branch above); the log-log slope between the
-two tallest columns within [0.45, 0.9] (2/3 expected).
+two tallest columns within [0.45, 0.9] (2/3 expected); the mean coordination number of
+the columns at the gate opening within 20 % of the thesis' 5.6 (§3.3.3).
 
 Writes validation/dem/results/dam_break_scaling.json and
 docs/validation/figures/dam_break_scaling.png. `--quick`: one seed, two gate positions.
@@ -105,6 +106,12 @@ def main():
         checks.append({"quantity": "log-log slope, two tallest columns", "measured": round(slope, 3),
                        "thesis": "2/3 (a > 3)", "tolerance": "[0.45, 0.9]",
                        "pass": 0.45 <= slope <= 0.9})
+
+    # §3.3.3: a column of spheres has 2 x 41971 / 15000 = 5.6 contacts per particle.
+    z = sum(p["pair_coordination"] for p in points) / len(points)
+    checks.append({"quantity": "coordination number of the column (pairs, at the gate opening)",
+                   "measured": round(z, 3), "thesis": "5.6 (§3.3.3, 15000 spheres)",
+                   "tolerance": "±20 %", "pass": abs(z / 5.6 - 1.0) <= 0.2})
 
     os.makedirs(os.path.dirname(FIGURE), exist_ok=True)
     fig, ax = plt.subplots(figsize=(6, 4.2))

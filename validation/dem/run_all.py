@@ -28,8 +28,9 @@ REPORT = os.path.join(ROOT, "docs", "validation", "dem.md")
 
 
 def scripts():
+    # Modules shared by the scripts start with '_'.
     return sorted(p for p in glob.glob(os.path.join(HERE, "*.py"))
-                  if os.path.basename(p) != "run_all.py")
+                  if os.path.basename(p) != "run_all.py" and not os.path.basename(p).startswith("_"))
 
 
 def cpu_model():

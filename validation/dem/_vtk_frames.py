@@ -1,0 +1,41 @@
+"""Reads the particle frames that sanguis writes (VTK XML, binary base64, UInt64
+headers, Float64 / Int64 arrays) into numpy arrays. Shared by the validation
+scripts; not a general VTK reader."""
+import base64
+import re
+import xml.etree.ElementTree as ET
+
+import numpy as np
+
+_ARRAY = re.compile(r'<DataArray([^>]*)>\s*([A-Za-z0-9+/=\s]*?)\s*</DataArray>', re.S)
+
+
+def _attributes(text):
+    return dict(re.findall(r'(\w+)="([^"]*)"', text))
+
+
+def read_arrays(path):
+    """Every Float64/Int64 DataArray of a .vtu/.vtp file, by name (points: 'Points')."""
+    with open(path) as f:
+        text = f.read()
+    arrays = {}
+    for attrs, payload in _ARRAY.findall(text):
+        a = _attributes(attrs)
+        kind = {"Float64": "<f8", "Int64": "<i8"}.get(a.get("type"))
+        if kind is None:
+            continue
+        raw = base64.b64decode("".join(payload.split()))
+        count = int(np.frombuffer(raw[:8], "<u8")[0])
+        values = np.frombuffer(raw[8:8 + count], kind)
+        components = int(a.get("NumberOfComponents", "1"))
+        arrays[a["Name"]] = values.reshape(-1, components) if components > 1 else values
+    return arrays
+
+
+def read_pvd(path):
+    """(time, absolute dataset path) of every frame of a .pvd index."""
+    import os
+    root = ET.parse(path).getroot()
+    base = os.path.dirname(os.path.abspath(path))
+    return [(float(d.get("timestep")), os.path.join(base, d.get("file")))
+            for d in root.iter("DataSet")]
