@@ -1,0 +1,245 @@
+#include "membrane/bending.hpp"
+
+#include <array>
+#include <cmath>
+#include <stdexcept>
+
+#include "core/parallel.hpp"
+
+namespace sanguis::membrane {
+
+namespace {
+
+// A right-handed orthonormal frame (t1, t2, n).
+struct LocalFrame {
+  Vec3 t1, t2, n;
+};
+
+LocalFrame frame_around(const Vec3& n) {
+  // Start from the coordinate axis least aligned with n.
+  const Vec3 axis = std::fabs(n.x) < std::fabs(n.y)
+                        ? (std::fabs(n.x) < std::fabs(n.z) ? Vec3{1, 0, 0} : Vec3{0, 0, 1})
+                        : (std::fabs(n.y) < std::fabs(n.z) ? Vec3{0, 1, 0} : Vec3{0, 0, 1});
+  const Vec3 c = cross(n, axis);
+  const Vec3 t1 = c / norm(c);
+  return {t1, cross(n, t1), n};
+}
+
+// Least-squares fit of f(u, v) = A u^2 + B u v + C v^2 + D u + E v through the
+// origin, by the normal equations in coordinates scaled by the neighbours'
+// RMS distance (keeps them well conditioned). With fewer than five
+// neighbours the linear terms are dropped (D = E = 0).
+struct QuadraticFit {
+  double a = 0.0, b = 0.0, c = 0.0, d = 0.0, e = 0.0;
+};
+
+template <std::size_t N>
+bool solve_in_place(std::array<std::array<double, N + 1>, N>& m) {
+  for (std::size_t col = 0; col < N; ++col) {
+    std::size_t pivot = col;
+    for (std::size_t r = col + 1; r < N; ++r)
+      if (std::fabs(m[r][col]) > std::fabs(m[pivot][col])) pivot = r;
+    if (!(std::fabs(m[pivot][col]) > 0.0)) return false;
+    std::swap(m[col], m[pivot]);
+    for (std::size_t r = col + 1; r < N; ++r) {
+      const double f = m[r][col] / m[col][col];
+      for (std::size_t k = col; k <= N; ++k) m[r][k] -= f * m[col][k];
+    }
+  }
+  for (std::size_t col = N; col-- > 0;) {
+    double s = m[col][N];
+    for (std::size_t k = col + 1; k < N; ++k) s -= m[col][k] * m[k][N];
+    m[col][N] = s / m[col][col];
+  }
+  return true;
+}
+
+// uv[k] = (u, v) of neighbour k, values[k] = fitted quantity; `length_scale`
+// is the power of the scale carried by the values (1 for heights, 0 for
+// curvature values).
+template <typename Sample>
+QuadraticFit fit_quadratic(std::size_t count, Sample&& sample, int value_length_power) {
+  double h2 = 0.0;
+  for (std::size_t k = 0; k < count; ++k) {
+    const auto [u, v, f] = sample(k);
+    h2 += u * u + v * v;
+  }
+  const double s = std::sqrt(static_cast<double>(count) / h2);  // 1 / RMS distance
+  const double value_scale = value_length_power == 1 ? s : 1.0;
+  QuadraticFit q;
+  if (count >= 5) {
+    std::array<std::array<double, 6>, 5> m{};
+    for (std::size_t k = 0; k < count; ++k) {
+      const auto [u0, v0, f0] = sample(k);
+      const double u = u0 * s, v = v0 * s, f = f0 * value_scale;
+      const std::array<double, 5> row{u * u, u * v, v * v, u, v};
+      for (std::size_t i = 0; i < 5; ++i) {
+        for (std::size_t j = 0; j < 5; ++j) m[i][j] += row[i] * row[j];
+        m[i][5] += row[i] * f;
+      }
+    }
+    if (!solve_in_place<5>(m)) throw std::runtime_error("paraboloid fit: singular one-ring");
+    q = {m[0][5], m[1][5], m[2][5], m[3][5], m[4][5]};
+  } else {
+    std::array<std::array<double, 4>, 3> m{};
+    for (std::size_t k = 0; k < count; ++k) {
+      const auto [u0, v0, f0] = sample(k);
+      const double u = u0 * s, v = v0 * s, f = f0 * value_scale;
+      const std::array<double, 3> row{u * u, u * v, v * v};
+      for (std::size_t i = 0; i < 3; ++i) {
+        for (std::size_t j = 0; j < 3; ++j) m[i][j] += row[i] * row[j];
+        m[i][3] += row[i] * f;
+      }
+    }
+    if (!solve_in_place<3>(m)) throw std::runtime_error("paraboloid fit: singular one-ring");
+    q = {m[0][3], m[1][3], m[2][3], 0.0, 0.0};
+  }
+  // Back to unscaled coordinates: f = (1/value_scale) (A^ s^2 u^2 + ... + D^ s u + ...).
+  const double k2 = s * s / value_scale, k1 = s / value_scale;
+  return {q.a * k2, q.b * k2, q.c * k2, q.d * k1, q.e * k1};
+}
+
+Vec3 area_weighted_normal(std::size_t i, const std::vector<Triangle>& triangles,
+                          const MeshTopology& topology, std::span<const Vec3> x) {
+  Vec3 n;
+  for (const auto& c : topology.corners(i)) {
+    const auto& t = triangles[c.triangle];
+    n += cross(x[t[1]] - x[t[0]], x[t[2]] - x[t[0]]);
+  }
+  return n / norm(n);
+}
+
+struct NodeCurvature {
+  LocalFrame frame;  // final frame (normal = corrected normal of the last fit)
+  QuadraticFit height;
+  double kappa = 0.0, kappa_g = 0.0;
+};
+
+NodeCurvature fit_curvature(std::size_t i, const std::vector<Triangle>& triangles,
+                            const MeshTopology& topology, std::span<const Vec3> x,
+                            int normal_iterations) {
+  const auto ring = topology.ring(i);
+  const Vec3 xi = x[i];
+  NodeCurvature r;
+  Vec3 n = area_weighted_normal(i, triangles, topology, x);
+  for (int iteration = 0;; ++iteration) {
+    r.frame = frame_around(n);
+    r.height = fit_quadratic(
+        ring.size(),
+        [&](std::size_t k) {
+          const Vec3 d = x[ring[k]] - xi;
+          return std::array<double, 3>{dot(d, r.frame.t1), dot(d, r.frame.t2), dot(d, r.frame.n)};
+        },
+        1);
+    // Normal of the fitted surface at the node: (-D, -E, 1) in the frame.
+    const Vec3 corrected = r.frame.n - r.height.d * r.frame.t1 - r.height.e * r.frame.t2;
+    n = corrected / norm(corrected);
+    if (iteration >= normal_iterations) break;
+  }
+  const auto& h = r.height;
+  const double w2 = 1.0 + h.d * h.d + h.e * h.e;
+  const double w = std::sqrt(w2);
+  // Monge patch: h_uu = 2A, h_uv = B, h_vv = 2C; minus sign: kappa > 0 on a sphere.
+  r.kappa =
+      -((1.0 + h.e * h.e) * 2.0 * h.a - 2.0 * h.d * h.e * h.b + (1.0 + h.d * h.d) * 2.0 * h.c) /
+      (2.0 * w2 * w);
+  r.kappa_g = (4.0 * h.a * h.c - h.b * h.b) / (w2 * w2);
+  return r;
+}
+
+// Surface Laplacian at the node of the function sampled on the one-ring, in
+// the Monge patch of the height fit (formula in bending.hpp).
+double fit_laplace_beltrami(std::size_t i, const MeshTopology& topology, std::span<const Vec3> x,
+                            const NodeCurvature& c, std::span<const double> values) {
+  const auto ring = topology.ring(i);
+  const Vec3 xi = x[i];
+  const QuadraticFit f = fit_quadratic(
+      ring.size(),
+      [&](std::size_t k) {
+        const Vec3 d = x[ring[k]] - xi;
+        return std::array<double, 3>{dot(d, c.frame.t1), dot(d, c.frame.t2),
+                                     values[ring[k]] - values[i]};
+      },
+      0);
+  const auto& h = c.height;
+  const double w2 = 1.0 + h.d * h.d + h.e * h.e;
+  // Inverse metric g^ab = delta_ab - h_a h_b / W^2.
+  const double g00 = 1.0 - h.d * h.d / w2, g01 = -h.d * h.e / w2, g11 = 1.0 - h.e * h.e / w2;
+  const double f_uu = 2.0 * f.a, f_uv = f.b, f_vv = 2.0 * f.c;
+  const double h_uu = 2.0 * h.a, h_uv = h.b, h_vv = 2.0 * h.c;
+  const double grad_dot = (h.d * f.d + h.e * f.e) / w2;
+  return g00 * (f_uu - h_uu * grad_dot) + 2.0 * g01 * (f_uv - h_uv * grad_dot) +
+         g11 * (f_vv - h_vv * grad_dot);
+}
+
+double mixed_area_at(std::size_t i, const std::vector<Triangle>& triangles,
+                     const MeshTopology& topology, std::span<const Vec3> x) {
+  double area = 0.0;
+  for (const auto& c : topology.corners(i)) {
+    const auto& t = triangles[c.triangle];
+    const Vec3 p = x[t[c.corner]], q = x[t[(c.corner + 1) % 3]], r = x[t[(c.corner + 2) % 3]];
+    const double twice = norm(cross(q - p, r - p));
+    const double dot_p = dot(q - p, r - p), dot_q = dot(p - q, r - q), dot_r = dot(p - r, q - r);
+    if (dot_p < 0.0) {
+      area += 0.25 * twice;  // obtuse at this node: A/2
+    } else if (dot_q < 0.0 || dot_r < 0.0) {
+      area += 0.125 * twice;  // obtuse elsewhere: A/4
+    } else {
+      // Voronoi share: (|pr|^2 cot q + |pq|^2 cot r) / 8, cot = dot / |cross|.
+      area += (norm2(r - p) * dot_q + norm2(q - p) * dot_r) / (8.0 * twice);
+    }
+  }
+  return area;
+}
+
+}  // namespace
+
+std::vector<double> mixed_voronoi_areas(const std::vector<Triangle>& triangles,
+                                        const MeshTopology& topology,
+                                        std::span<const Vec3> positions) {
+  std::vector<double> a(positions.size());
+  for (std::size_t i = 0; i < a.size(); ++i)
+    a[i] = mixed_area_at(i, triangles, topology, positions);
+  return a;
+}
+
+void compute_surface_geometry(const std::vector<Triangle>& triangles, const MeshTopology& topology,
+                              std::span<const Vec3> positions, int normal_iterations,
+                              SurfaceGeometry& g, int threads) {
+  const std::size_t n = positions.size();
+  if (topology.node_count() != n)
+    throw std::invalid_argument("compute_surface_geometry: topology and positions differ in size");
+  g.normal.resize(n);
+  g.mean_curvature.resize(n);
+  g.gaussian_curvature.resize(n);
+  g.laplace_beltrami.resize(n);
+  g.area.resize(n);
+  // Pass 1: fits of the height (kappa needed at all neighbours before pass 2).
+  parallel_for(n, threads, [&](std::size_t i) {
+    const NodeCurvature c = fit_curvature(i, triangles, topology, positions, normal_iterations);
+    const Vec3 corrected = c.frame.n - c.height.d * c.frame.t1 - c.height.e * c.frame.t2;
+    g.normal[i] = corrected / norm(corrected);
+    g.mean_curvature[i] = c.kappa;
+    g.gaussian_curvature[i] = c.kappa_g;
+    g.area[i] = mixed_area_at(i, triangles, topology, positions);
+  });
+  // Pass 2: second fit, on the curvature values, in the frame of the last
+  // height fit (recomputed: cheaper than storing it).
+  parallel_for(n, threads, [&](std::size_t i) {
+    const NodeCurvature c = fit_curvature(i, triangles, topology, positions, normal_iterations);
+    g.laplace_beltrami[i] = fit_laplace_beltrami(i, topology, positions, c, g.mean_curvature);
+  });
+}
+
+void add_bending_forces(const HelfrichParameters& p, const std::vector<Triangle>& triangles,
+                        const MeshTopology& topology, std::span<const Vec3> positions,
+                        std::span<Vec3> forces, SurfaceGeometry& g, int threads) {
+  compute_surface_geometry(triangles, topology, positions, p.normal_iterations, g, threads);
+  parallel_for(positions.size(), threads, [&](std::size_t i) {
+    const double f = helfrich_force_density(p, g.mean_curvature[i], g.gaussian_curvature[i],
+                                            g.laplace_beltrami[i]);
+    forces[i] += (f * g.area[i]) * g.normal[i];
+  });
+}
+
+}  // namespace sanguis::membrane
