@@ -3,6 +3,7 @@
 #include <array>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 #include "core/parallel.hpp"
 
@@ -26,73 +27,79 @@ LocalFrame frame_around(const Vec3& n) {
 }
 
 // Least-squares fit of f(u, v) = A u^2 + B u v + C v^2 + D u + E v through the
-// origin, by the normal equations in coordinates scaled by the neighbours'
-// RMS distance (keeps them well conditioned). With fewer than five
-// neighbours the linear terms are dropped (D = E = 0).
+// origin, by the normal equations (symmetric positive definite: Cholesky) in
+// coordinates scaled by the neighbours' RMS distance, which keeps them well
+// conditioned. With fewer than five neighbours the linear terms are dropped
+// (D = E = 0).
 struct QuadraticFit {
   double a = 0.0, b = 0.0, c = 0.0, d = 0.0, e = 0.0;
 };
 
+// Largest one-ring handled (fixed-size local buffers, no allocation per node).
+constexpr std::size_t kMaxValence = 32;
+
+struct Sample {
+  double u = 0.0, v = 0.0, f = 0.0;
+};
+
+// Solves M c = r for symmetric positive definite M (lower triangle used).
 template <std::size_t N>
-bool solve_in_place(std::array<std::array<double, N + 1>, N>& m) {
-  for (std::size_t col = 0; col < N; ++col) {
-    std::size_t pivot = col;
-    for (std::size_t r = col + 1; r < N; ++r)
-      if (std::fabs(m[r][col]) > std::fabs(m[pivot][col])) pivot = r;
-    if (!(std::fabs(m[pivot][col]) > 0.0)) return false;
-    std::swap(m[col], m[pivot]);
-    for (std::size_t r = col + 1; r < N; ++r) {
-      const double f = m[r][col] / m[col][col];
-      for (std::size_t k = col; k <= N; ++k) m[r][k] -= f * m[col][k];
+bool cholesky_solve(std::array<std::array<double, N>, N>& m, std::array<double, N>& r) {
+  for (std::size_t j = 0; j < N; ++j) {
+    double diag = m[j][j];
+    for (std::size_t k = 0; k < j; ++k) diag -= m[j][k] * m[j][k];
+    if (!(diag > 0.0)) return false;
+    m[j][j] = std::sqrt(diag);
+    for (std::size_t i = j + 1; i < N; ++i) {
+      double s = m[i][j];
+      for (std::size_t k = 0; k < j; ++k) s -= m[i][k] * m[j][k];
+      m[i][j] = s / m[j][j];
     }
   }
-  for (std::size_t col = N; col-- > 0;) {
-    double s = m[col][N];
-    for (std::size_t k = col + 1; k < N; ++k) s -= m[col][k] * m[k][N];
-    m[col][N] = s / m[col][col];
+  for (std::size_t i = 0; i < N; ++i) {  // L y = r
+    double s = r[i];
+    for (std::size_t k = 0; k < i; ++k) s -= m[i][k] * r[k];
+    r[i] = s / m[i][i];
+  }
+  for (std::size_t i = N; i-- > 0;) {  // L^T c = y
+    double s = r[i];
+    for (std::size_t k = i + 1; k < N; ++k) s -= m[k][i] * r[k];
+    r[i] = s / m[i][i];
   }
   return true;
 }
 
-// uv[k] = (u, v) of neighbour k, values[k] = fitted quantity; `length_scale`
-// is the power of the scale carried by the values (1 for heights, 0 for
-// curvature values).
-template <typename Sample>
-QuadraticFit fit_quadratic(std::size_t count, Sample&& sample, int value_length_power) {
-  double h2 = 0.0;
+template <std::size_t N>
+std::array<double, N> least_squares(const Sample* samples, std::size_t count, double s,
+                                    double value_scale) {
+  std::array<std::array<double, N>, N> m{};
+  std::array<double, N> r{};
   for (std::size_t k = 0; k < count; ++k) {
-    const auto [u, v, f] = sample(k);
-    h2 += u * u + v * v;
+    const double u = samples[k].u * s, v = samples[k].v * s, f = samples[k].f * value_scale;
+    std::array<double, 5> row{u * u, u * v, v * v, u, v};
+    for (std::size_t i = 0; i < N; ++i) {
+      for (std::size_t j = 0; j <= i; ++j) m[i][j] += row[i] * row[j];
+      r[i] += row[i] * f;
+    }
   }
+  if (!cholesky_solve<N>(m, r)) throw std::runtime_error("paraboloid fit: singular one-ring");
+  return r;
+}
+
+// `value_length_power`: 1 when the values are lengths (heights), 0 otherwise.
+QuadraticFit fit_quadratic(const Sample* samples, std::size_t count, int value_length_power) {
+  double h2 = 0.0;
+  for (std::size_t k = 0; k < count; ++k)
+    h2 += samples[k].u * samples[k].u + samples[k].v * samples[k].v;
   const double s = std::sqrt(static_cast<double>(count) / h2);  // 1 / RMS distance
   const double value_scale = value_length_power == 1 ? s : 1.0;
   QuadraticFit q;
   if (count >= 5) {
-    std::array<std::array<double, 6>, 5> m{};
-    for (std::size_t k = 0; k < count; ++k) {
-      const auto [u0, v0, f0] = sample(k);
-      const double u = u0 * s, v = v0 * s, f = f0 * value_scale;
-      const std::array<double, 5> row{u * u, u * v, v * v, u, v};
-      for (std::size_t i = 0; i < 5; ++i) {
-        for (std::size_t j = 0; j < 5; ++j) m[i][j] += row[i] * row[j];
-        m[i][5] += row[i] * f;
-      }
-    }
-    if (!solve_in_place<5>(m)) throw std::runtime_error("paraboloid fit: singular one-ring");
-    q = {m[0][5], m[1][5], m[2][5], m[3][5], m[4][5]};
+    const auto c = least_squares<5>(samples, count, s, value_scale);
+    q = {c[0], c[1], c[2], c[3], c[4]};
   } else {
-    std::array<std::array<double, 4>, 3> m{};
-    for (std::size_t k = 0; k < count; ++k) {
-      const auto [u0, v0, f0] = sample(k);
-      const double u = u0 * s, v = v0 * s, f = f0 * value_scale;
-      const std::array<double, 3> row{u * u, u * v, v * v};
-      for (std::size_t i = 0; i < 3; ++i) {
-        for (std::size_t j = 0; j < 3; ++j) m[i][j] += row[i] * row[j];
-        m[i][3] += row[i] * f;
-      }
-    }
-    if (!solve_in_place<3>(m)) throw std::runtime_error("paraboloid fit: singular one-ring");
-    q = {m[0][3], m[1][3], m[2][3], 0.0, 0.0};
+    const auto c = least_squares<3>(samples, count, s, value_scale);
+    q = {c[0], c[1], c[2], 0.0, 0.0};
   }
   // Back to unscaled coordinates: f = (1/value_scale) (A^ s^2 u^2 + ... + D^ s u + ...).
   const double k2 = s * s / value_scale, k1 = s / value_scale;
@@ -120,17 +127,17 @@ NodeCurvature fit_curvature(std::size_t i, const std::vector<Triangle>& triangle
                             int normal_iterations) {
   const auto ring = topology.ring(i);
   const Vec3 xi = x[i];
+  std::array<Vec3, kMaxValence> offset;
+  for (std::size_t k = 0; k < ring.size(); ++k) offset[k] = x[ring[k]] - xi;
+  std::array<Sample, kMaxValence> samples;
   NodeCurvature r;
   Vec3 n = area_weighted_normal(i, triangles, topology, x);
   for (int iteration = 0;; ++iteration) {
     r.frame = frame_around(n);
-    r.height = fit_quadratic(
-        ring.size(),
-        [&](std::size_t k) {
-          const Vec3 d = x[ring[k]] - xi;
-          return std::array<double, 3>{dot(d, r.frame.t1), dot(d, r.frame.t2), dot(d, r.frame.n)};
-        },
-        1);
+    for (std::size_t k = 0; k < ring.size(); ++k)
+      samples[k] = {dot(offset[k], r.frame.t1), dot(offset[k], r.frame.t2),
+                    dot(offset[k], r.frame.n)};
+    r.height = fit_quadratic(samples.data(), ring.size(), 1);
     // Normal of the fitted surface at the node: (-D, -E, 1) in the frame.
     const Vec3 corrected = r.frame.n - r.height.d * r.frame.t1 - r.height.e * r.frame.t2;
     n = corrected / norm(corrected);
@@ -153,14 +160,12 @@ double fit_laplace_beltrami(std::size_t i, const MeshTopology& topology, std::sp
                             const NodeCurvature& c, std::span<const double> values) {
   const auto ring = topology.ring(i);
   const Vec3 xi = x[i];
-  const QuadraticFit f = fit_quadratic(
-      ring.size(),
-      [&](std::size_t k) {
-        const Vec3 d = x[ring[k]] - xi;
-        return std::array<double, 3>{dot(d, c.frame.t1), dot(d, c.frame.t2),
-                                     values[ring[k]] - values[i]};
-      },
-      0);
+  std::array<Sample, kMaxValence> samples;
+  for (std::size_t k = 0; k < ring.size(); ++k) {
+    const Vec3 d = x[ring[k]] - xi;
+    samples[k] = {dot(d, c.frame.t1), dot(d, c.frame.t2), values[ring[k]] - values[i]};
+  }
+  const QuadraticFit f = fit_quadratic(samples.data(), ring.size(), 0);
   const auto& h = c.height;
   const double w2 = 1.0 + h.d * h.d + h.e * h.e;
   // Inverse metric g^ab = delta_ab - h_a h_b / W^2.
@@ -209,11 +214,16 @@ void compute_surface_geometry(const std::vector<Triangle>& triangles, const Mesh
   const std::size_t n = positions.size();
   if (topology.node_count() != n)
     throw std::invalid_argument("compute_surface_geometry: topology and positions differ in size");
+  if (topology.max_valence() > kMaxValence)
+    throw std::invalid_argument("compute_surface_geometry: a node has " +
+                                std::to_string(topology.max_valence()) + " neighbours (at most " +
+                                std::to_string(kMaxValence) + ")");
   g.normal.resize(n);
   g.mean_curvature.resize(n);
   g.gaussian_curvature.resize(n);
   g.laplace_beltrami.resize(n);
   g.area.resize(n);
+  g.fit.resize(n);
   // Pass 1: fits of the height (kappa needed at all neighbours before pass 2).
   parallel_for(n, threads, [&](std::size_t i) {
     const NodeCurvature c = fit_curvature(i, triangles, topology, positions, normal_iterations);
@@ -222,11 +232,16 @@ void compute_surface_geometry(const std::vector<Triangle>& triangles, const Mesh
     g.mean_curvature[i] = c.kappa;
     g.gaussian_curvature[i] = c.kappa_g;
     g.area[i] = mixed_area_at(i, triangles, topology, positions);
+    g.fit[i] = {c.frame.t1, c.frame.t2, c.frame.n,  c.height.a,
+                c.height.b, c.height.c, c.height.d, c.height.e};
   });
   // Pass 2: second fit, on the curvature values, in the frame of the last
-  // height fit (recomputed: cheaper than storing it).
+  // height fit.
   parallel_for(n, threads, [&](std::size_t i) {
-    const NodeCurvature c = fit_curvature(i, triangles, topology, positions, normal_iterations);
+    const ParaboloidFit& f = g.fit[i];
+    NodeCurvature c;
+    c.frame = {f.t1, f.t2, f.n};
+    c.height = {f.a, f.b, f.c, f.d, f.e};
     g.laplace_beltrami[i] = fit_laplace_beltrami(i, topology, positions, c, g.mean_curvature);
   });
 }

@@ -52,6 +52,13 @@ struct HelfrichParameters {
   int normal_iterations = 4;         // normal corrections of the paraboloid fit
 };
 
+// The last height fit at a node: its frame (t1, t2, n: n the normal the fit
+// was made around) and the paraboloid h(u, v) = a u^2 + b u v + c v^2 + d u + e v.
+struct ParaboloidFit {
+  Vec3 t1, t2, n;
+  double a = 0.0, b = 0.0, c = 0.0, d = 0.0, e = 0.0;
+};
+
 // Local differential geometry at every node.
 struct SurfaceGeometry {
   std::vector<Vec3> normal;                // outward unit normal (from the fit)
@@ -59,6 +66,7 @@ struct SurfaceGeometry {
   std::vector<double> gaussian_curvature;  // kappa_g, 1/R^2 on a sphere
   std::vector<double> laplace_beltrami;    // Delta_s (kappa - kappa0) = Delta_s kappa
   std::vector<double> area;                // mixed Voronoi area A_i
+  std::vector<ParaboloidFit> fit;          // the height fits (reused by the second fit)
 };
 
 // Mixed Voronoi areas (Meyer et al. 2003) of every node; they sum to the area.
