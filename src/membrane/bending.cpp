@@ -42,45 +42,85 @@ struct Sample {
   double u = 0.0, v = 0.0, f = 0.0;
 };
 
-// Solves M c = r for symmetric positive definite M (lower triangle used).
+// Solves M c = r for symmetric positive definite M (lower triangle used) by
+// an L D L^T factorisation: one division per column and no square root, the
+// latency that dominates these tiny systems.
 template <std::size_t N>
 bool cholesky_solve(std::array<std::array<double, N>, N>& m, std::array<double, N>& r) {
+  std::array<double, N> inv_d{};
   for (std::size_t j = 0; j < N; ++j) {
-    double diag = m[j][j];
-    for (std::size_t k = 0; k < j; ++k) diag -= m[j][k] * m[j][k];
-    if (!(diag > 0.0)) return false;
-    m[j][j] = std::sqrt(diag);
+    double d = m[j][j];
+    for (std::size_t k = 0; k < j; ++k) d -= m[j][k] * m[j][k] * m[k][k];
+    if (!(d > 0.0)) return false;
+    m[j][j] = d;
+    inv_d[j] = 1.0 / d;
     for (std::size_t i = j + 1; i < N; ++i) {
       double s = m[i][j];
-      for (std::size_t k = 0; k < j; ++k) s -= m[i][k] * m[j][k];
-      m[i][j] = s / m[j][j];
+      for (std::size_t k = 0; k < j; ++k) s -= m[i][k] * m[j][k] * m[k][k];
+      m[i][j] = s * inv_d[j];
     }
   }
-  for (std::size_t i = 0; i < N; ++i) {  // L y = r
-    double s = r[i];
-    for (std::size_t k = 0; k < i; ++k) s -= m[i][k] * r[k];
-    r[i] = s / m[i][i];
-  }
-  for (std::size_t i = N; i-- > 0;) {  // L^T c = y
-    double s = r[i];
-    for (std::size_t k = i + 1; k < N; ++k) s -= m[k][i] * r[k];
-    r[i] = s / m[i][i];
-  }
+  for (std::size_t i = 0; i < N; ++i)  // L y = r
+    for (std::size_t k = 0; k < i; ++k) r[i] -= m[i][k] * r[k];
+  for (std::size_t i = 0; i < N; ++i) r[i] *= inv_d[i];  // D z = y
+  for (std::size_t i = N; i-- > 0;)                      // L^T c = z
+    for (std::size_t k = i + 1; k < N; ++k) r[i] -= m[k][i] * r[k];
   return true;
 }
 
+// The normal matrix of the rows (u^2, u v, v^2, u, v) holds only the twelve
+// moments sum u^i v^j with 2 <= i + j <= 4: accumulate those, then fill it.
 template <std::size_t N>
 std::array<double, N> least_squares(const Sample* samples, std::size_t count, double s,
                                     double value_scale) {
-  std::array<std::array<double, N>, N> m{};
-  std::array<double, N> r{};
+  double u4 = 0, u3v = 0, u2v2 = 0, uv3 = 0, v4 = 0, u3 = 0, u2v = 0, uv2 = 0, v3 = 0, u2 = 0,
+         uv = 0, v2 = 0;
+  double fu2 = 0, fuv = 0, fv2 = 0, fu = 0, fv = 0;
   for (std::size_t k = 0; k < count; ++k) {
     const double u = samples[k].u * s, v = samples[k].v * s, f = samples[k].f * value_scale;
-    std::array<double, 5> row{u * u, u * v, v * v, u, v};
-    for (std::size_t i = 0; i < N; ++i) {
-      for (std::size_t j = 0; j <= i; ++j) m[i][j] += row[i] * row[j];
-      r[i] += row[i] * f;
-    }
+    const double uu = u * u, uvk = u * v, vv = v * v;
+    u4 += uu * uu;
+    u3v += uu * uvk;
+    u2v2 += uu * vv;
+    uv3 += uvk * vv;
+    v4 += vv * vv;
+    u3 += uu * u;
+    u2v += uu * v;
+    uv2 += u * vv;
+    v3 += vv * v;
+    u2 += uu;
+    uv += uvk;
+    v2 += vv;
+    fu2 += uu * f;
+    fuv += uvk * f;
+    fv2 += vv * f;
+    fu += u * f;
+    fv += v * f;
+  }
+  std::array<std::array<double, N>, N> m{};
+  std::array<double, N> r{};
+  // Lower triangle only (cholesky_solve reads no more).
+  m[0][0] = u4;
+  m[1][0] = u3v;
+  m[1][1] = u2v2;
+  m[2][0] = u2v2;
+  m[2][1] = uv3;
+  m[2][2] = v4;
+  r[0] = fu2;
+  r[1] = fuv;
+  r[2] = fv2;
+  if constexpr (N == 5) {
+    m[3][0] = u3;
+    m[3][1] = u2v;
+    m[3][2] = uv2;
+    m[3][3] = u2;
+    m[4][0] = u2v;
+    m[4][1] = uv2;
+    m[4][2] = v3;
+    m[4][3] = uv;
+    m[4][4] = v2;
+    r[3] = fu;
+    r[4] = fv;
   }
   if (!cholesky_solve<N>(m, r)) throw std::runtime_error("paraboloid fit: singular one-ring");
   return r;
