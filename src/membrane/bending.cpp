@@ -146,13 +146,11 @@ QuadraticFit fit_quadratic(const Sample* samples, std::size_t count, int value_l
   return {q.a * k2, q.b * k2, q.c * k2, q.d * k1, q.e * k1};
 }
 
-Vec3 area_weighted_normal(std::size_t i, const std::vector<Triangle>& triangles,
-                          const MeshTopology& topology, std::span<const Vec3> x) {
+// Initial normal: the area-weighted mean of the incident triangle normals.
+Vec3 area_weighted_normal(std::size_t i, const MeshTopology& topology,
+                          std::span<const SurfaceGeometry::TriangleShare> share) {
   Vec3 n;
-  for (const auto& c : topology.corners(i)) {
-    const auto& t = triangles[c.triangle];
-    n += cross(x[t[1]] - x[t[0]], x[t[2]] - x[t[0]]);
-  }
+  for (const auto& c : topology.corners(i)) n += share[c.triangle].twice_area_normal;
   return n / norm(n);
 }
 
@@ -162,8 +160,8 @@ struct NodeCurvature {
   double kappa = 0.0, kappa_g = 0.0;
 };
 
-NodeCurvature fit_curvature(std::size_t i, const std::vector<Triangle>& triangles,
-                            const MeshTopology& topology, std::span<const Vec3> x,
+NodeCurvature fit_curvature(std::size_t i, const MeshTopology& topology, std::span<const Vec3> x,
+                            std::span<const SurfaceGeometry::TriangleShare> share,
                             int normal_iterations) {
   const auto ring = topology.ring(i);
   const Vec3 xi = x[i];
@@ -171,7 +169,7 @@ NodeCurvature fit_curvature(std::size_t i, const std::vector<Triangle>& triangle
   for (std::size_t k = 0; k < ring.size(); ++k) offset[k] = x[ring[k]] - xi;
   std::array<Sample, kMaxValence> samples;
   NodeCurvature r;
-  Vec3 n = area_weighted_normal(i, triangles, topology, x);
+  Vec3 n = area_weighted_normal(i, topology, share);
   for (int iteration = 0;; ++iteration) {
     r.frame = frame_around(n);
     for (std::size_t k = 0; k < ring.size(); ++k)
@@ -217,34 +215,44 @@ double fit_laplace_beltrami(std::size_t i, const MeshTopology& topology, std::sp
          g11 * (f_vv - h_vv * grad_dot);
 }
 
-double mixed_area_at(std::size_t i, const std::vector<Triangle>& triangles,
-                     const MeshTopology& topology, std::span<const Vec3> x) {
-  double area = 0.0;
-  for (const auto& c : topology.corners(i)) {
-    const auto& t = triangles[c.triangle];
-    const Vec3 p = x[t[c.corner]], q = x[t[(c.corner + 1) % 3]], r = x[t[(c.corner + 2) % 3]];
-    const double twice = norm(cross(q - p, r - p));
-    const double dot_p = dot(q - p, r - p), dot_q = dot(p - q, r - q), dot_r = dot(p - r, q - r);
-    if (dot_p < 0.0) {
-      area += 0.25 * twice;  // obtuse at this node: A/2
-    } else if (dot_q < 0.0 || dot_r < 0.0) {
-      area += 0.125 * twice;  // obtuse elsewhere: A/4
-    } else {
-      // Voronoi share: (|pr|^2 cot q + |pq|^2 cot r) / 8, cot = dot / |cross|.
-      area += (norm2(r - p) * dot_q + norm2(q - p) * dot_r) / (8.0 * twice);
-    }
-  }
-  return area;
+// Mixed Voronoi share (Meyer et al. 2003) of corner p of triangle (p, q, r).
+double corner_mixed_area(const Vec3& p, const Vec3& q, const Vec3& r) {
+  const double twice = norm(cross(q - p, r - p));
+  const double dot_p = dot(q - p, r - p), dot_q = dot(p - q, r - q), dot_r = dot(p - r, q - r);
+  if (dot_p < 0.0) return 0.25 * twice;                  // obtuse at p: A/2
+  if (dot_q < 0.0 || dot_r < 0.0) return 0.125 * twice;  // obtuse elsewhere: A/4
+  // Voronoi share: (|pr|^2 cot q + |pq|^2 cot r) / 8, cot = dot / |cross|.
+  return (norm2(r - p) * dot_q + norm2(q - p) * dot_r) / (8.0 * twice);
+}
+
+SurfaceGeometry::TriangleShare triangle_share(const Triangle& t, std::span<const Vec3> x) {
+  const Vec3 a = x[t[0]], b = x[t[1]], c = x[t[2]];
+  return {cross(b - a, c - a),
+          {corner_mixed_area(a, b, c), corner_mixed_area(b, c, a), corner_mixed_area(c, a, b)}};
 }
 
 }  // namespace
 
+void validate(const HelfrichParameters& p) {
+  if (!(p.bending_modulus >= 0.0))
+    throw std::invalid_argument("bending modulus Eb must be >= 0, got " +
+                                std::to_string(p.bending_modulus));
+  if (!std::isfinite(p.reference_curvature))
+    throw std::invalid_argument("reference curvature must be finite");
+  if (p.normal_iterations < 0 || p.normal_iterations > 20)
+    throw std::invalid_argument("normal iterations must be in [0, 20], got " +
+                                std::to_string(p.normal_iterations));
+}
+
 std::vector<double> mixed_voronoi_areas(const std::vector<Triangle>& triangles,
                                         const MeshTopology& topology,
                                         std::span<const Vec3> positions) {
+  std::vector<SurfaceGeometry::TriangleShare> share(triangles.size());
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    share[t] = triangle_share(triangles[t], positions);
   std::vector<double> a(positions.size());
   for (std::size_t i = 0; i < a.size(); ++i)
-    a[i] = mixed_area_at(i, triangles, topology, positions);
+    for (const auto& c : topology.corners(i)) a[i] += share[c.triangle].corner_area[c.corner];
   return a;
 }
 
@@ -264,14 +272,23 @@ void compute_surface_geometry(const std::vector<Triangle>& triangles, const Mesh
   g.laplace_beltrami.resize(n);
   g.area.resize(n);
   g.fit.resize(n);
+  g.triangle_share.resize(triangles.size());
+  // Pass 0: per-triangle normals and corner areas, gathered below in corner order.
+  parallel_for(triangles.size(), threads, [&](std::size_t t) {
+    g.triangle_share[t] = triangle_share(triangles[t], positions);
+  });
   // Pass 1: fits of the height (kappa needed at all neighbours before pass 2).
   parallel_for(n, threads, [&](std::size_t i) {
-    const NodeCurvature c = fit_curvature(i, triangles, topology, positions, normal_iterations);
+    const NodeCurvature c =
+        fit_curvature(i, topology, positions, g.triangle_share, normal_iterations);
     const Vec3 corrected = c.frame.n - c.height.d * c.frame.t1 - c.height.e * c.frame.t2;
     g.normal[i] = corrected / norm(corrected);
     g.mean_curvature[i] = c.kappa;
     g.gaussian_curvature[i] = c.kappa_g;
-    g.area[i] = mixed_area_at(i, triangles, topology, positions);
+    double area = 0.0;
+    for (const auto& corner : topology.corners(i))
+      area += g.triangle_share[corner.triangle].corner_area[corner.corner];
+    g.area[i] = area;
     g.fit[i] = {c.frame.t1, c.frame.t2, c.frame.n,  c.height.a,
                 c.height.b, c.height.c, c.height.d, c.height.e};
   });

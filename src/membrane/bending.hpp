@@ -37,6 +37,7 @@
 //    reference curvature quoted in that convention enters here negated.
 //    Check on a sphere: E_B = 8 pi Eb (1 - kappa0 R)^2, -dE/dR / (4 pi R^2)
 //    = 4 Eb kappa0 (1 - kappa0 R)/R^2, which is the formula above.
+#include <array>
 #include <span>
 #include <vector>
 
@@ -59,6 +60,10 @@ struct ParaboloidFit {
   double a = 0.0, b = 0.0, c = 0.0, d = 0.0, e = 0.0;
 };
 
+// Checks Eb >= 0 and 0 <= normal_iterations <= 20; std::invalid_argument
+// naming the value otherwise.
+void validate(const HelfrichParameters& parameters);
+
 // Local differential geometry at every node.
 struct SurfaceGeometry {
   std::vector<Vec3> normal;                // outward unit normal (from the fit)
@@ -67,6 +72,13 @@ struct SurfaceGeometry {
   std::vector<double> laplace_beltrami;    // Delta_s (kappa - kappa0) = Delta_s kappa
   std::vector<double> area;                // mixed Voronoi area A_i
   std::vector<ParaboloidFit> fit;          // the height fits (reused by the second fit)
+  // Per triangle, computed once and gathered by its three nodes: twice its
+  // area times its unit normal, and the mixed-area share of each corner.
+  struct TriangleShare {
+    Vec3 twice_area_normal;
+    std::array<double, 3> corner_area{};
+  };
+  std::vector<TriangleShare> triangle_share;
 };
 
 // Mixed Voronoi areas (Meyer et al. 2003) of every node; they sum to the area.

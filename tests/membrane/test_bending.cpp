@@ -129,6 +129,13 @@ TEST(MembraneBending, BiconcaveCellAgreesWithTheExactGeometry) {
   EXPECT_GE(order(e320.kappa_g.l2, e5120.kappa_g.l2), 1.5);
 }
 
+TEST(MembraneBending, ParametersAreChecked) {
+  EXPECT_NO_THROW(validate(HelfrichParameters{2e-19, -2.09 / 3.91e-6, 4}));
+  EXPECT_THROW(validate(HelfrichParameters{-1.0, 0.0, 4}), std::invalid_argument);
+  EXPECT_THROW(validate(HelfrichParameters{1.0, 0.0, -1}), std::invalid_argument);
+  EXPECT_THROW(validate(HelfrichParameters{1.0, NAN, 4}), std::invalid_argument);
+}
+
 TEST(MembraneBending, GeometryIsFrameInvariantAndThreadIndependent) {
   TriangleMesh m = icosphere(3);
   map_to_biconcave(m, {});
