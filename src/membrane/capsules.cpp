@@ -40,6 +40,8 @@ void CapsuleSet::compute_capsule(std::size_t c, const ElasticLaw& law,
 
 void CapsuleSet::compute_forces(const ElasticLaw& law,
                                 const std::optional<HelfrichParameters>& bending, int threads) {
+  validate(law);  // once per call: cheap next to the force loops
+  if (bending) validate(*bending);
   threads = std::max(threads, 1);
   if (capsule_count_ >= static_cast<std::size_t>(threads) && threads > 1) {
     workspaces_.resize(static_cast<std::size_t>(threads));

@@ -56,6 +56,7 @@ class CapsuleSet {
   const std::vector<Vec3>& all_forces() const { return forces_; }
 
   // Overwrites the forces with elastic (+ bending if given) nodal forces.
+  // Checks the parameters first (std::invalid_argument naming the value).
   void compute_forces(const ElasticLaw& law, const std::optional<HelfrichParameters>& bending,
                       int threads);
 

@@ -46,6 +46,7 @@ TEST(CapsuleSet, PlacesPreInflatedCapsules) {
   const auto f = set.forces(0);
   for (std::size_t i = 0; i < x.size(); ++i) EXPECT_LT(dot(f[i], x[i]), 0.0);
   EXPECT_THROW(CapsuleSet(unit_sphere(1), 0.0, placements), std::invalid_argument);
+  EXPECT_THROW(set.compute_forces(SkalakLaw{-1.0, 10.0}, std::nullopt, 1), std::invalid_argument);
 }
 
 TEST(CapsuleSet, ForcesDoNotDependOnTheThreadCount) {
