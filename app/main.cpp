@@ -183,13 +183,18 @@ int main(int argc, char** argv) {
   bench::BenchOptions bo;
   std::string bench_name;
   auto* bench_cmd = app.add_subcommand("bench", "throughput benchmarks (one JSON line)");
-  bench_cmd->add_option("name", bench_name, "benchmark: dem-spheres | dem-crosses")->required();
+  bench_cmd->add_option("name", bench_name, "benchmark: dem-spheres | dem-crosses | membrane")
+      ->required();
   auto* particles_opt = bench_cmd->add_option(
       "--particles", bo.particles, "number of particles (dem-spheres 32000, dem-crosses 3000)");
-  auto* steps_opt =
-      bench_cmd->add_option("--steps", bo.steps, "time steps (dem-spheres 2000, dem-crosses 500)");
+  auto* steps_opt = bench_cmd->add_option(
+      "--steps", bo.steps, "time steps (dem-spheres 2000, dem-crosses 500, membrane 20)");
   bench_cmd->add_option("--threads", bo.threads, "threads")->capture_default_str();
   bench_cmd->add_option("--seed", bo.seed, "random seed")->capture_default_str();
+  bench_cmd->add_option("--triangles", bo.triangles, "membrane: triangles per capsule (20*4^k)")
+      ->capture_default_str();
+  bench_cmd->add_option("--capsules", bo.capsules, "membrane: number of capsules")
+      ->capture_default_str();
 
   const auto run_analysis = app::add_analysis_commands(app);
 
@@ -215,9 +220,13 @@ int main(int argc, char** argv) {
         if (!particles_given) bo.particles = 3000;
         if (!steps_given) bo.steps = 500;
         std::cout << bench::run_dem_crosses(bo) << std::endl;
+      } else if (bench_name == "membrane") {
+        if (!steps_given) bo.steps = 20;
+        std::cout << bench::run_membrane(bo) << std::endl;
       } else {
-        throw InputError("", "bench",
-                         "unknown benchmark '" + bench_name + "' (dem-spheres, dem-crosses)");
+        throw InputError(
+            "", "bench",
+            "unknown benchmark '" + bench_name + "' (dem-spheres, dem-crosses, membrane)");
       }
       return 0;
     }

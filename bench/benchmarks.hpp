@@ -12,6 +12,8 @@ struct BenchOptions {
   std::int64_t steps = 2000;
   int threads = 1;
   std::uint64_t seed = 4928459;
+  std::int64_t triangles = 5120;  // membrane: triangles per capsule (20 * 4^k)
+  std::int64_t capsules = 100;    // membrane: number of capsules
 };
 
 // dem-spheres: 32,000 spheres on a tilted chute, Table 2.1 contact parameters,
@@ -21,5 +23,11 @@ std::string run_dem_spheres(const BenchOptions& options);
 // dem-crosses: a column of crosses (thesis §3.2.2, Table 3.1) behind the gate of the
 // 64 x 30 cm dam-break box, stacked flat at random angles so that they touch.
 std::string run_dem_crosses(const BenchOptions& options);
+
+// membrane: elastic (Skalak, C = 10) and Helfrich bending nodal forces of
+// `capsules` biconcave red blood cells of `triangles` triangles each, slightly
+// deformed; one step = one force evaluation of every capsule. Reports
+// seconds_per_step (default 20 steps, after one untimed warm-up evaluation).
+std::string run_membrane(const BenchOptions& options);
 
 }  // namespace sanguis::bench
