@@ -165,6 +165,15 @@ bool has_non_spherical(const ParticleStore& p) {
   return std::any_of(p.spherical.begin(), p.spherical.end(), [](std::uint8_t s) { return s == 0; });
 }
 
+// Whether the run has (or will have, by pouring) non-spherical particles: then it
+// writes bodies.pvd from its first frame, so that every particle frame has its
+// body surfaces.
+bool has_bodies(const DemSetup& s, const ParticleStore& p) {
+  return has_non_spherical(p) ||
+         std::any_of(s.pour.begin(), s.pour.end(),
+                     [](const PourSource& src) { return src.species >= 0; });
+}
+
 io::PolyMesh body_mesh(const std::vector<ParticleShape>& shapes, const ParticleStore& p) {
   io::PolyMesh mesh;
   io::IntDataArray ids{"id", 1, {}}, material{"material", 1, {}}, species{"species", 1, {}};
@@ -519,8 +528,8 @@ RunSummary run_dem_case(const DemCase& c, const RunOptions& options, std::ostrea
   const std::int64_t settle_after = std::llround(c.stop.settle_check_after / dt);
 
   write_obstacle_table(dir / "obstacles.csv", c.setup.obstacles);
-  SnapshotWriter snapshots(dir, c.output.vtk, has_non_spherical(sim.particles()), options.restart,
-                           sim.time());
+  SnapshotWriter snapshots(dir, c.output.vtk, has_bodies(sim.setup(), sim.particles()),
+                           options.restart, sim.time());
   io::CsvWriter csv(csv_path, kDiagnosticColumns, options.restart && fs::exists(csv_path));
   const auto record = [&]() {
     snapshots.write(sim);
@@ -584,7 +593,7 @@ RunSummary run_dem_case(const DemCase& c, const RunOptions& options, std::ostrea
   console << "outputs:\n"
           << "  ParaView    " << (dir / "particles.pvd").string()
           << "  (and obstacles.pvd, contacts.pvd, branches.pvd"
-          << (has_non_spherical(sim.particles()) ? ", bodies.pvd" : "") << ")\n"
+          << (has_bodies(sim.setup(), sim.particles()) ? ", bodies.pvd" : "") << ")\n"
           << "  diagnostics " << csv_path.string() << "\n"
           << "  log         " << (dir / "run.log").string() << "\n"
           << "  checkpoint  " << checkpoint.string() << "\n";

@@ -152,12 +152,14 @@ TriangleMesh read_obj(const std::filesystem::path& path) {
 }
 
 void write_vtp(const std::filesystem::path& path, const TriangleMesh& mesh,
-               const std::vector<MeshField>& triangle_fields) {
+               const std::vector<MeshField>& triangle_fields,
+               const std::vector<MeshField>& node_fields) {
   io::PolyMesh poly;
   poly.points = mesh.positions;
   poly.polygons.reserve(mesh.triangle_count());
   for (const auto& t : mesh.triangles) poly.polygons.push_back({t[0], t[1], t[2]});
   for (const auto& f : triangle_fields) poly.cell_data.push_back({f.name, f.components, f.values});
+  for (const auto& f : node_fields) poly.point_data.push_back({f.name, f.components, f.values});
   io::write_polymesh_vtp(path, poly);
 }
 

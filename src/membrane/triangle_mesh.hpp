@@ -80,15 +80,15 @@ void write_obj(const std::filesystem::path& path, const TriangleMesh& mesh);
 TriangleMesh read_obj(const std::filesystem::path& path);
 
 // Optional data written with a mesh to .vtp: one value (or 3-vector) per
-// triangle. (io::PolyMesh carries cell data only; per-node fields wait for
-// point data there.)
+// triangle (principal tensions...) or per node (forces, curvatures...).
 struct MeshField {
   std::string name;
   int components = 1;          // 1 or 3
-  std::vector<double> values;  // components * triangle count
+  std::vector<double> values;  // components * triangle (or node) count
 };
 
 void write_vtp(const std::filesystem::path& path, const TriangleMesh& mesh,
-               const std::vector<MeshField>& triangle_fields = {});
+               const std::vector<MeshField>& triangle_fields = {},
+               const std::vector<MeshField>& node_fields = {});
 
 }  // namespace sanguis::membrane

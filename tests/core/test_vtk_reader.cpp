@@ -52,12 +52,18 @@ TEST(VtkReader, PolyMeshRoundTripsLinesPolygonsAndCellData) {
   mesh.polygons = {{0, 1, 2}, {1, 2, 3, 0}};
   mesh.cell_data = {{"force_magnitude", 1, {1.5, 2.5, 3.5}}};
   mesh.int_cell_data = {{"first_id", 1, {4, 5, 6}}};
+  mesh.point_data = {{"force_magnitude", 3, {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12}}};
   write_polymesh_vtp(dir / "m.vtp", mesh);
   const PolyMesh back = read_polymesh_vtp(dir / "m.vtp");
   EXPECT_EQ(back.lines, mesh.lines);
   EXPECT_EQ(back.polygons, mesh.polygons);
   EXPECT_EQ(find_array(back.cell_data, "force_magnitude").values, mesh.cell_data[0].values);
   EXPECT_EQ(find_array(back.int_cell_data, "first_id").values, mesh.int_cell_data[0].values);
+  // Point arrays may share a name with a cell array.
+  EXPECT_EQ(find_array(back.point_data, "force_magnitude").values, mesh.point_data[0].values);
+  mesh.point_data[0].values.pop_back();
+  EXPECT_THROW(write_polymesh_vtp(dir / "bad.vtp", mesh), std::invalid_argument);
+  EXPECT_FALSE(std::filesystem::exists(dir / "bad.vtp"));
 }
 
 TEST(VtkReader, PvdListsFramesRelativeToItsFolder) {

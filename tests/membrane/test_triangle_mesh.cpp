@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include "core/io/vtk_reader.hpp"
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -125,4 +127,17 @@ TEST(TriangleMesh, WritesVtpWithTriangleData) {
   EXPECT_NE(text.find("Name=\"tension\""), std::string::npos);
   std::filesystem::remove(path);
   EXPECT_THROW(write_vtp(path, m, {{"bad", 1, {1.0}}}), std::invalid_argument);
+}
+
+TEST(TriangleMesh, WritesVtpWithNodeData) {
+  const TriangleMesh m = icosphere(1);
+  const auto path = temp_path("nodes.vtp");
+  std::vector<double> force(3 * m.node_count());
+  for (std::size_t k = 0; k < force.size(); ++k) force[k] = static_cast<double>(k);
+  write_vtp(path, m, {}, {{"force", 3, force}});
+  const io::PolyMesh back = io::read_polymesh_vtp(path);
+  EXPECT_EQ(io::find_array(back.point_data, "force").values, force);
+  EXPECT_EQ(back.polygons.size(), m.triangle_count());
+  std::filesystem::remove(path);
+  EXPECT_THROW(write_vtp(path, m, {}, {{"force", 3, {1.0}}}), std::invalid_argument);
 }

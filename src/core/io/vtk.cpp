@@ -389,12 +389,17 @@ void write_polymesh_vtp(const std::filesystem::path& path, const PolyMesh& mesh)
   std::set<std::string> names_seen;
   check_attribute_arrays(path, "cell data", cell_count, mesh.cell_data, names_seen);
   check_attribute_arrays(path, "cell data", cell_count, mesh.int_cell_data, names_seen);
+  std::set<std::string> point_names_seen;  // point and cell arrays may share a name
+  check_attribute_arrays(path, "point data", point_count, mesh.point_data, point_names_seen);
 
   write_file_atomically(path, [&](std::ostream& out) {
     write_file_header(out, "PolyData");
     out << "    <Piece NumberOfPoints=\"" << point_count
         << "\" NumberOfVerts=\"0\" NumberOfLines=\"" << mesh.lines.size()
         << "\" NumberOfStrips=\"0\" NumberOfPolys=\"" << mesh.polygons.size() << "\">\n";
+    if (!mesh.point_data.empty()) {
+      write_attribute_section(out, "      ", "PointData", mesh.point_data, {});
+    }
     write_attribute_section(out, "      ", "CellData", mesh.cell_data, mesh.int_cell_data);
     write_points(out, "      ", mesh.points);
     write_cell_array(out, "      ", "Lines", mesh.lines);

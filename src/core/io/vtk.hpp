@@ -69,6 +69,9 @@ struct PolyMesh {
   std::vector<std::vector<std::int64_t>> lines;
   std::vector<DataArray> cell_data;
   std::vector<IntDataArray> int_cell_data;
+  // Per-point arrays (e.g. nodal forces and curvatures of a membrane): one tuple
+  // per entry of `points`.
+  std::vector<DataArray> point_data;
 };
 
 // Writes a PolyData (.vtp) with the mesh's lines and polygons.

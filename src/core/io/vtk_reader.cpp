@@ -227,6 +227,9 @@ PolyMesh read_polymesh_vtp(const std::filesystem::path& path) {
   mesh.polygons = read_cells(text, "Polys", path);
   split_attributes(section_arrays(text, "CellData", path), mesh.cell_data, mesh.int_cell_data);
   check_tuples(path, mesh.lines.size() + mesh.polygons.size(), mesh.cell_data, mesh.int_cell_data);
+  std::vector<IntDataArray> int_point_data;  // our writer writes none
+  split_attributes(section_arrays(text, "PointData", path), mesh.point_data, int_point_data);
+  check_tuples(path, mesh.points.size(), mesh.point_data, int_point_data);
   return mesh;
 }
 

@@ -1,6 +1,7 @@
 #include "dem/analysis/run_output.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <stdexcept>
 
@@ -44,7 +45,10 @@ RunOutput::RunOutput(std::filesystem::path dir) : dir_(std::move(dir)) {
   }
   contact_files_ = dataset_files(dir_ / "contacts.pvd");
   branch_files_ = dataset_files(dir_ / "branches.pvd");
-  body_files_ = dataset_files(dir_ / "bodies.pvd");
+  if (std::filesystem::exists(dir_ / "bodies.pvd")) {
+    for (const auto& e : io::read_pvd(dir_ / "bodies.pvd"))
+      body_files_.emplace_back(e.time, e.dataset);
+  }
 
   std::ifstream names(dir_ / "obstacles.csv");
   std::string line;
@@ -110,7 +114,16 @@ BranchFrame RunOutput::branches(std::size_t frame) const {
 BodySurfaceFrame RunOutput::bodies(std::size_t frame) const {
   BodySurfaceFrame f;
   if (body_files_.empty()) return f;
-  const io::PolyMesh mesh = io::read_polymesh_vtp(file_of(body_files_, frame, "body"));
+  const double t = times_.at(frame);
+  const auto match = std::find_if(body_files_.begin(), body_files_.end(), [&](const auto& entry) {
+    return std::abs(entry.first - t) <= 1e-9 * std::max(1.0, std::abs(t));
+  });
+  if (match == body_files_.end()) {
+    throw std::runtime_error(dir_.string() +
+                             ": no body surfaces (bodies.pvd) at t = " + std::to_string(t) +
+                             " s, the time of particle frame " + std::to_string(frame));
+  }
+  const io::PolyMesh mesh = io::read_polymesh_vtp(match->second);
   for (const auto& polygon : mesh.polygons) {
     // Fan triangulation (the writer emits triangles; this keeps quads correct too).
     for (std::size_t k = 1; k + 1 < polygon.size(); ++k) {

@@ -65,6 +65,8 @@ class RunOutput {
   ContactPointFrame contacts(std::size_t frame) const;
   BranchFrame branches(std::size_t frame) const;
   bool has_bodies() const { return !body_files_.empty(); }
+  // The body surfaces written at the time of `frame`; throws when the run has
+  // bodies but none at that time (a body frame missing: the top view would be wrong).
   BodySurfaceFrame bodies(std::size_t frame) const;
   // Obstacle names by index (obstacles.csv); "obstacle K" when the file is absent.
   std::string obstacle_name(std::int64_t index) const;
@@ -73,7 +75,8 @@ class RunOutput {
  private:
   std::filesystem::path dir_;
   std::vector<double> times_;
-  std::vector<std::string> particle_files_, contact_files_, branch_files_, body_files_;
+  std::vector<std::string> particle_files_, contact_files_, branch_files_;
+  std::vector<std::pair<double, std::string>> body_files_;  // by time: may start later
   std::vector<std::string> obstacle_names_;
 };
 
