@@ -5,10 +5,13 @@
 
 #include <cstring>
 #include <filesystem>
+#include <sstream>
 #include <string>
 
 #include "core/config.hpp"
+#include "core/io/vtk_reader.hpp"
 #include "dem/dem_case.hpp"
+#include "dem/dem_run.hpp"
 
 namespace sanguis::dem {
 namespace {
@@ -100,6 +103,28 @@ TEST(Pouring, RestartInTheMiddleOfThePourIsBitForBit) {
   const auto& b = resumed.particles().position;
   EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(Vec3)), 0);
   std::filesystem::remove(file);
+}
+
+// The bodies poured during a run have their surfaces in every frame, from the first
+// (empty) one on, so that the frames of bodies.pvd match those of particles.pvd.
+TEST(Pouring, RunWritesBodySurfacesFromTheFirstFrame) {
+  const auto dir = std::filesystem::temp_directory_path() / "sanguis_test_pour_bodies";
+  std::filesystem::remove_all(dir);
+  DemCase c = pour_case();
+  c.stop.end_time = 0.05;
+  c.output.interval = 0.01;
+  RunOptions options;
+  options.output_dir = dir;
+  options.quiet = true;
+  std::ostringstream console;
+  run_dem_case(c, options, console);
+  const auto particles = io::read_pvd(dir / "particles.pvd");
+  const auto bodies = io::read_pvd(dir / "bodies.pvd");
+  ASSERT_EQ(bodies.size(), particles.size());
+  for (std::size_t k = 0; k < bodies.size(); ++k) EXPECT_EQ(bodies[k].time, particles[k].time);
+  EXPECT_TRUE(io::read_polymesh_vtp(bodies.front().dataset).polygons.empty());
+  EXPECT_FALSE(io::read_polymesh_vtp(bodies.back().dataset).polygons.empty());
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

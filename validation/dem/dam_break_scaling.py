@@ -88,6 +88,12 @@ def main():
             s["gate_m"] = l0
             points.append(s)
     elapsed = time.time() - t0
+    if args.reuse:  # the wall-clock span of the runs on disk
+        logs = [os.path.join(RUNS, d, f"seed_{k + 1}", "run.log") for d in os.listdir(RUNS)
+                for k in range(seeds)]
+        logs = [f for f in logs if os.path.exists(f)]
+        first = min(os.path.getmtime(os.path.join(os.path.dirname(f), "obstacles.csv")) for f in logs)
+        elapsed = max(os.path.getmtime(f) for f in logs) - first
 
     checks = []
     rows = []
