@@ -2,7 +2,7 @@
 """Flow behaviour of a cross column against the tangential parameters (thesis §3.4.3,
 Fig. 3.17), on a reduced grid.
 
-The settled 400-cross column of validation/dem/crosses_memory.py (its pour, Table 3.1
+The settled 300-cross column of validation/dem/crosses_memory.py (its pour, Table 3.1
 parameters; run first if absent) is continued from its checkpoint after the gate opens
 with other tangential parameters kt and gamma_t (both interactions), for 0.6 s, two
 runs at a time. Each run is classified as in Fig. 3.17:
@@ -44,8 +44,8 @@ RESULTS = os.path.join(ROOT, "validation", "dem", "results")
 POUR = os.path.join(RESULTS, "runs", "crosses_memory", "pour")
 RUNS = os.path.join(RESULTS, "runs", "crosses_tangential_map")
 FIGURE = os.path.join(ROOT, "docs", "validation", "figures", "crosses_tangential_map.png")
-GATE_TIME = 1.6
-DURATION = 0.6
+GATE_TIME = 2.4
+DURATION = 0.5
 KT = [1e1, 3e2, 1e5]        # N/m
 GAMMA = [1e0, 1e3, 1e5]     # 1/s
 QUICK = [(3e2, 1e3), (1e5, 1e5)]
@@ -163,7 +163,7 @@ def main():
         "title": "Cross column: flow regime against kt and γt",
         "thesis": "§3.4.3, Fig. 3.17",
         "description": (
-            "The settled 400-cross column of the memory case continued after the gate opens "
+            "The settled 300-cross column of the memory case continued after the gate opens "
             f"with other tangential parameters (both interactions) for {DURATION} s; regions "
             "as in Fig. 3.17 (1 base-driven collapse, 2 top-driven collapse, 3 stable), "
             "top/bottom from the displacement of the top and bottom quarters one τc after "

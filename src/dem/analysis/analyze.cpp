@@ -42,31 +42,47 @@ struct Extent {
   double x_min = std::numeric_limits<double>::infinity(), x_max = -x_min;
   double y_min = x_min, y_max = -x_min, z_min = x_min;
   double mean_radius = 0.0;
+  double pixel = 0.0;  // default pixel size
 };
 
-Extent extent_of(const ParticleFrame& p) {
+// Extent of what a top view sees: spheres by their radius, bodies by their
+// surface triangles (their bounding radius would reach through the walls).
+Extent extent_of(const ParticleFrame& p, const BodySurfaceFrame& bodies) {
   Extent e;
+  const auto include = [&](const Vec3& lo, const Vec3& hi) {
+    e.x_min = std::min(e.x_min, lo.x);
+    e.x_max = std::max(e.x_max, hi.x);
+    e.y_min = std::min(e.y_min, lo.y);
+    e.y_max = std::max(e.y_max, hi.y);
+    e.z_min = std::min(e.z_min, lo.z);
+  };
+  bool any_body = false;
   for (std::size_t k = 0; k < p.size(); ++k) {
-    const Vec3& x = p.position[k];
     const double r = p.radius[k];
-    e.x_min = std::min(e.x_min, x.x - r);
-    e.x_max = std::max(e.x_max, x.x + r);
-    e.y_min = std::min(e.y_min, x.y - r);
-    e.y_max = std::max(e.y_max, x.y + r);
-    e.z_min = std::min(e.z_min, x.z - r);
     e.mean_radius += r;
+    if (!p.spherical.empty() && p.spherical[k] == 0) {
+      any_body = true;
+      continue;
+    }
+    include(p.position[k] - Vec3{r, r, r}, p.position[k] + Vec3{r, r, r});
+  }
+  for (std::size_t t = 0; t < bodies.size(); ++t) {
+    for (const Vec3& v : {bodies.a[t], bodies.b[t], bodies.c[t]}) include(v, v);
   }
   if (p.size() > 0) e.mean_radius /= static_cast<double>(p.size());
+  // Pixels resolve a sphere with a few across its radius; a body's arms are much
+  // thinner than its bounding radius (a cross: 2 mm arms, 13.5 mm radius).
+  e.pixel = (any_body ? 0.1 : 0.5) * e.mean_radius;
   return e;
 }
 
-TopViewRaster top_view(const RunOutput& run, std::size_t frame, const ParticleFrame& particles,
+TopViewRaster top_view(const ParticleFrame& particles, const BodySurfaceFrame& bodies,
                        const RunAnalysis& a) {
   // Long enough for any run-out: up to the farthest particle of this frame.
-  const Extent e = extent_of(particles);
+  const Extent e = extent_of(particles, bodies);
   TopViewRaster raster(a.wall_x, std::max(e.x_max, a.wall_x + a.pixel) + a.pixel, a.y_min, a.y_max,
                        a.pixel);
-  raster.add_frame(particles, run.bodies(frame));
+  raster.add_frame(particles, bodies);
   return raster;
 }
 
@@ -135,15 +151,16 @@ RunAnalysis analyze_run(const RunOutput& run, const AnalysisOptions& o) {
 
   // The union of both frames' extents: a dam break keeps its back wall and
   // width, a heap spreads from its pouring region.
-  const Extent e0 = extent_of(initial), e1 = extent_of(final);
+  const BodySurfaceFrame initial_bodies = run.bodies(first), final_bodies = run.bodies(last);
+  const Extent e0 = extent_of(initial, initial_bodies), e1 = extent_of(final, final_bodies);
   a.wall_x = o.wall_x.value_or(std::min(e0.x_min, e1.x_min));
   a.floor_z = o.floor_z.value_or(std::min(e0.z_min, e1.z_min));
   a.y_min = o.y_min.value_or(std::min(e0.y_min, e1.y_min));
   a.y_max = o.y_max.value_or(std::max(e0.y_max, e1.y_max));
-  a.pixel = o.pixel.value_or(0.5 * e0.mean_radius);
+  a.pixel = o.pixel.value_or(e0.pixel);
 
-  const TopViewRaster before = top_view(run, first, initial, a);
-  const TopViewRaster after = top_view(run, last, final, a);
+  const TopViewRaster before = top_view(initial, initial_bodies, a);
+  const TopViewRaster after = top_view(final, final_bodies, a);
   a.initial_length = measure_runout(before);
   a.final_length = measure_runout(after);
   a.initial_height = measure_height(before, a.floor_z);
