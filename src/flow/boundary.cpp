@@ -1,0 +1,91 @@
+#include "flow/boundary.hpp"
+
+#include <algorithm>
+
+namespace sanguis::flow {
+
+std::array<BcKind, 6> uniform_kinds(const Forest& forest, BcKind kind) {
+  std::array<BcKind, 6> kinds{};
+  for (int d = 0; d < 3; ++d) {
+    const BcKind k = forest.spec().periodic[static_cast<std::size_t>(d)] ? BcKind::Periodic : kind;
+    kinds[static_cast<std::size_t>(face_index(d, 0))] = k;
+    kinds[static_cast<std::size_t>(face_index(d, 1))] = k;
+  }
+  return kinds;
+}
+
+namespace {
+
+/// Cell (i,j,k) with the coordinate along d replaced by `n`.
+std::array<int, 3> along(int d, int n, int t1, int t2) {
+  std::array<int, 3> c{};
+  c[static_cast<std::size_t>(d)] = n;
+  c[static_cast<std::size_t>((d + 1) % 3)] = t1;
+  c[static_cast<std::size_t>((d + 2) % 3)] = t2;
+  return c;
+}
+
+void fill_face(const Block& block, BlockField& field, int blk, int d, int side, BcKind kind,
+               const FaceValue* value, int width) {
+  const BlockLayout& L = field.layout();
+  const int b = L.cells;
+  double* data = field.block(blk);
+  const double h = block.length / b;
+  for (int m = 0; m < width; ++m) {
+    const int ghost = side == 0 ? -1 - m : b + m;
+    const int mirror = side == 0 ? m : b - 1 - m;
+    for (int t2 = -width; t2 < b + width; ++t2) {
+      for (int t1 = -width; t1 < b + width; ++t1) {
+        const auto g = along(d, ghost, t1, t2);
+        const auto s = along(d, mirror, t1, t2);
+        const double inner = data[L.index(s[0], s[1], s[2])];
+        double& out = data[L.index(g[0], g[1], g[2])];
+        if (kind == BcKind::Neumann) {
+          out = inner;
+        } else if (value == nullptr || !*value) {
+          out = -inner;
+        } else {
+          Vec3 x = block.lower;
+          for (int e = 0; e < 3; ++e) {
+            x[e] += (static_cast<double>(s[static_cast<std::size_t>(e)]) + 0.5) * h;
+          }
+          x[d] = block.lower[d] + (side == 0 ? 0.0 : block.length);
+          out = 2.0 * (*value)(x)-inner;
+        }
+      }
+    }
+  }
+}
+
+void fill_all(const Forest& forest, BlockField& field, const std::array<BcKind, 6>& kinds,
+              const std::array<FaceValue, 6>* values, int width) {
+  width = std::min({width, field.cells(), kGhost});
+  forest.for_each_block([&](int blk) {
+    const Block& block = forest.block(blk);
+    for (int d = 0; d < 3; ++d) {
+      for (int side = 0; side < 2; ++side) {
+        std::array<int, 3> o{0, 0, 0};
+        o[static_cast<std::size_t>(d)] = side == 0 ? -1 : 1;
+        const Neighbour nb =
+            block.neighbours[static_cast<std::size_t>(neighbour_slot(o[0], o[1], o[2]))];
+        if (nb.link != Link::Boundary) continue;
+        const auto f = static_cast<std::size_t>(face_index(d, side));
+        fill_face(block, field, blk, d, side, kinds[f], values ? &(*values)[f] : nullptr, width);
+      }
+    }
+  });
+}
+
+}  // namespace
+
+void fill_boundary_ghosts(const Forest& forest, BlockField& field, const ScalarBoundary& bc,
+                          int width, bool homogeneous) {
+  fill_all(forest, field, bc.kind, homogeneous ? nullptr : &bc.value, width);
+}
+
+void fill_boundary_ghosts(const Forest& forest, BlockField& field,
+                          const std::array<BcKind, 6>& kinds, int width) {
+  fill_all(forest, field, kinds, nullptr, width);
+}
+
+}  // namespace sanguis::flow
