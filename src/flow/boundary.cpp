@@ -78,6 +78,44 @@ void fill_all(const Forest& forest, BlockField& field, const std::array<BcKind, 
 
 }  // namespace
 
+void fill_face_field_ghosts(const Forest& forest, FaceField& uf, int width) {
+  const int b = uf[0].cells();
+  width = std::min({width, b, kGhost});
+  const BlockLayout& L = uf[0].layout();
+  forest.for_each_block([&](int blk) {
+    const Block& block = forest.block(blk);
+    for (int d = 0; d < 3; ++d) {
+      for (int side = 0; side < 2; ++side) {
+        std::array<int, 3> o{0, 0, 0};
+        o[static_cast<std::size_t>(d)] = side == 0 ? -1 : 1;
+        if (block.neighbours[static_cast<std::size_t>(neighbour_slot(o[0], o[1], o[2]))].link !=
+            Link::Boundary) {
+          continue;
+        }
+        for (int e = 0; e < 3; ++e) {
+          double* data = uf[static_cast<std::size_t>(e)].block(blk);
+          for (int m = 0; m < width; ++m) {
+            int ghost = side == 0 ? -1 - m : b + m;
+            int mirror = side == 0 ? m : b - 1 - m;
+            if (e == d) {
+              // Normal component: faces beyond the boundary face copy it.
+              if (side == 1) ++ghost;
+              mirror = side == 0 ? 0 : b;
+            }
+            for (int t2 = -width; t2 < b + width; ++t2)
+              for (int t1 = -width; t1 < b + width; ++t1) {
+                const auto g = along(d, ghost, t1, t2);
+                const auto src = along(d, mirror, t1, t2);
+                if (g[static_cast<std::size_t>(d)] >= b + kGhost) continue;
+                data[L.index(g[0], g[1], g[2])] = data[L.index(src[0], src[1], src[2])];
+              }
+          }
+        }
+      }
+    }
+  });
+}
+
 void fill_boundary_ghosts(const Forest& forest, BlockField& field, const ScalarBoundary& bc,
                           int width, bool homogeneous) {
   fill_all(forest, field, bc.kind, homogeneous ? nullptr : &bc.value, width);

@@ -49,4 +49,10 @@ void fill_boundary_ghosts(const Forest& forest, BlockField& field, const ScalarB
 void fill_boundary_ghosts(const Forest& forest, BlockField& field,
                           const std::array<BcKind, 6>& kinds, int width);
 
+/// Zero-gradient extrapolation of a face field into the ghost cells beyond
+/// domain faces (`width` layers). The faces on the domain boundary itself
+/// (slot 0 of a lower face, slot b of an upper face of the normal component)
+/// are kept: they carry the boundary condition.
+void fill_face_field_ghosts(const Forest& forest, FaceField& uf, int width);
+
 }  // namespace sanguis::flow

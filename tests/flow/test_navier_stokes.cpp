@@ -1,0 +1,162 @@
+// Navier-Stokes on a forest of blocks: Taylor-Green vortex (second-order
+// convergence), plane Poiseuille (flow rate), Couette at Re = 0.01 with the
+// implicit viscous step (exact linear profile, stable), exact divergence of
+// the face velocity.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "flow/navier_stokes.hpp"
+#include "poisson_problems.hpp"
+
+namespace sanguis::flow {
+namespace {
+
+using testing::cell_centre;
+using testing::kPi;
+
+std::array<FlowBoundary, 6> all_periodic() {
+  std::array<FlowBoundary, 6> bcs{};
+  for (auto& bc : bcs) bc.kind = FlowBoundaryKind::Periodic;
+  return bcs;
+}
+
+/// Channel periodic in x and z, walls at y = 0 and y = H (the upper one moving with `lid`).
+std::array<FlowBoundary, 6> channel(double lid) {
+  auto bcs = all_periodic();
+  bcs[face_index(1, 0)].kind = FlowBoundaryKind::Wall;
+  bcs[face_index(1, 1)].kind = FlowBoundaryKind::Wall;
+  bcs[face_index(1, 1)].wall_velocity = {lid, 0.0, 0.0};
+  return bcs;
+}
+
+/// Taylor-Green vortex in the unit square (periodic, one block thick in z),
+/// max velocity error at t_end with dt proportional to h.
+double taylor_green_error(int cells, double nu, double t_end) {
+  ForestSpec spec;
+  spec.block_cells = 8;
+  spec.trees = {cells / 8, cells / 8, 1};
+  spec.tree_length = 1.0 / (cells / 8);
+  spec.periodic = {true, true, true};
+  const Forest forest(spec);
+  NavierStokesOptions options;
+  options.viscous_theta = 0.5;
+  options.pressure.tolerance = 1e-10;
+  options.viscous.tolerance = 1e-10;
+  NavierStokes ns(forest, all_periodic(), Fluid{1.0, nu}, options);
+  auto exact = [nu](const Vec3& x, double t) {
+    const double decay = std::exp(-8.0 * kPi * kPi * nu * t);
+    return Vec3{std::sin(2 * kPi * x.x) * std::cos(2 * kPi * x.y) * decay,
+                -std::cos(2 * kPi * x.x) * std::sin(2 * kPi * x.y) * decay, 0.0};
+  };
+  ns.set_velocity([&](const Vec3& x) { return exact(x, 0.0); });
+  const double h = 1.0 / cells;
+  const int steps = static_cast<int>(std::lround(t_end / (0.25 * h)));
+  const double dt = t_end / steps;
+  for (int s = 0; s < steps; ++s) ns.step(dt);
+  EXPECT_LT(ns.max_divergence(), 1e-7);
+  double error = 0.0;
+  for (int blk = 0; blk < forest.local_blocks(); ++blk)
+    for (int k = 0; k < 8; ++k)
+      for (int j = 0; j < 8; ++j)
+        for (int i = 0; i < 8; ++i) {
+          const Vec3 e = exact(cell_centre(forest, blk, i, j, k), ns.time());
+          for (int c = 0; c < 3; ++c)
+            error = std::max(error, std::abs(ns.velocity()[c](blk, i, j, k) - e[c]));
+        }
+  return forest.max(error);
+}
+
+TEST(FlowNavierStokes, TaylorGreenVortexConvergesAtSecondOrder) {
+  const double e16 = taylor_green_error(16, 0.01, 0.25);
+  const double e32 = taylor_green_error(32, 0.01, 0.25);
+  const double order = std::log2(e16 / e32);
+  std::printf(
+      "Taylor-Green (nu 0.01, t 0.25, dt = h/4): max error 16^2 %.3e, 32^2 %.3e, order %.2f\n", e16,
+      e32, order);
+  EXPECT_GT(order, 1.8);
+}
+
+/// Mean over x and z of u_x at cell row j of the channel (y cells = 16).
+std::vector<double> profile(const Forest& forest, const NavierStokes& ns, int rows) {
+  std::vector<double> sum(static_cast<std::size_t>(rows), 0.0),
+      count(static_cast<std::size_t>(rows), 0.0);
+  const int b = forest.block_cells();
+  for (int blk = 0; blk < forest.local_blocks(); ++blk)
+    for (int k = 0; k < b; ++k)
+      for (int j = 0; j < b; ++j)
+        for (int i = 0; i < b; ++i) {
+          const auto row = static_cast<std::size_t>(forest.block(blk).coord[1] * b + j);
+          sum[row] += ns.velocity()[0](blk, i, j, k);
+          count[row] += 1.0;
+        }
+  for (std::size_t r = 0; r < sum.size(); ++r) sum[r] = forest.sum(sum[r]) / forest.sum(count[r]);
+  return sum;
+}
+
+Forest make_channel_forest() {
+  ForestSpec spec;
+  spec.trees = {1, 2, 1};
+  spec.tree_length = 0.5;  // H = 1, 16 cells across
+  spec.periodic = {true, false, true};
+  return Forest(spec);
+}
+
+TEST(FlowNavierStokes, PlanePoiseuilleFlowRateWithinHalfAPercentAt16CellsAcross) {
+  const Forest forest = make_channel_forest();
+  const double G = 2.0, mu = 1.0, H = 1.0;  // body force density (= -dp/dx), viscosity
+  NavierStokesOptions options;
+  options.dt_max = 0.01;
+  options.viscous.tolerance = 1e-10;
+  NavierStokes ns(forest, channel(0.0), Fluid{1.0, mu}, options);
+  ns.set_velocity([](const Vec3&) { return Vec3{}; });
+  ns.set_body_force([G](const Vec3&) { return Vec3{G, 0.0, 0.0}; });
+  for (int s = 0; s < 300; ++s) ns.step(ns.stable_dt());  // 3 diffusion times H^2 rho/mu
+  const auto u = profile(forest, ns, 16);
+  const double h = H / 16;
+  double flow_rate = 0.0, worst = 0.0;
+  for (int j = 0; j < 16; ++j) {
+    const double y = (j + 0.5) * h;
+    flow_rate += u[static_cast<std::size_t>(j)] * h;
+    worst = std::max(worst, std::abs(u[static_cast<std::size_t>(j)] - G / (2 * mu) * y * (H - y)));
+  }
+  const double exact = G * H * H * H / (12 * mu);
+  std::printf("Poiseuille: flow rate %.6f exact %.6f (rel. error %.2e), max profile error %.2e\n",
+              flow_rate, exact, std::abs(flow_rate / exact - 1), worst);
+  EXPECT_LT(std::abs(flow_rate / exact - 1.0), 5e-3);
+  EXPECT_LT(ns.max_divergence(), 1e-8);
+}
+
+TEST(FlowNavierStokes, CouetteAtReynolds0p01IsExactlyLinearAndStable) {
+  const Forest forest = make_channel_forest();
+  const double U = 1.0, H = 1.0, rho = 1.0;
+  const double mu = rho * U * H / 0.01;  // Re = rho U H / mu = 0.01
+  const double dt = 1e-3 * H / U;        // shear rate x dt = 1e-3
+  NavierStokes ns(forest, channel(U), Fluid{rho, mu});
+  ns.set_velocity([](const Vec3&) { return Vec3{}; });
+  // The diffusion time H^2 rho / mu = 0.01 = 10 dt: 500 steps reach steady
+  // state, at a viscous number mu dt / (rho h^2) = 25.6 (explicit limit 1/6).
+  double worst = 0.0;
+  for (int s = 0; s < 500; ++s) ns.step(dt);
+  const auto u = profile(forest, ns, 16);
+  for (int j = 0; j < 16; ++j) {
+    const double y = (j + 0.5) / 16.0 * H;
+    worst = std::max(worst, std::abs(u[static_cast<std::size_t>(j)] - U * y / H));
+  }
+  double vmax = 0.0;
+  for (int blk = 0; blk < forest.local_blocks(); ++blk)
+    for (int k = 0; k < 8; ++k)
+      for (int j = 0; j < 8; ++j)
+        for (int i = 0; i < 8; ++i)
+          vmax = std::max({vmax, std::abs(ns.velocity()[1](blk, i, j, k)),
+                           std::abs(ns.velocity()[2](blk, i, j, k))});
+  std::printf(
+      "Couette Re 0.01: max deviation from the linear profile %.2e (U = 1), cross flow %.2e\n",
+      worst, vmax);
+  EXPECT_LT(worst, 1e-6);
+  EXPECT_LT(forest.max(vmax), 1e-10);
+}
+
+}  // namespace
+}  // namespace sanguis::flow
