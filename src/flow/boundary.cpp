@@ -42,15 +42,31 @@ void fill_face(const Block& block, BlockField& field, int blk, int d, int side, 
         double& out = data[L.index(g[0], g[1], g[2])];
         if (kind == BcKind::Neumann) {
           out = inner;
-        } else if (value == nullptr || !*value) {
-          out = -inner;
+        } else if (value == nullptr) {
+          out = -inner;  // homogeneous (multigrid corrections): linear closure
+        } else if (!*value) {
+          if (m == 0 && b >= 2) {
+            const auto s1 = along(d, side == 0 ? 1 : b - 2, t1, t2);
+            out = (-6.0 * inner + data[L.index(s1[0], s1[1], s1[2])]) / 3.0;
+          } else {
+            out = -inner;
+          }
         } else {
           Vec3 x = block.lower;
           for (int e = 0; e < 3; ++e) {
             x[e] += (static_cast<double>(s[static_cast<std::size_t>(e)]) + 0.5) * h;
           }
           x[d] = block.lower[d] + (side == 0 ? 0.0 : block.length);
-          out = 2.0 * (*value)(x)-inner;
+          const double g = (*value)(x);
+          if (m == 0 && b >= 2) {
+            // Quadratic through the face value and the two first cells:
+            // exact for parabolic profiles (third-order boundary closure).
+            const auto s1 = along(d, side == 0 ? 1 : b - 2, t1, t2);
+            const double next = data[L.index(s1[0], s1[1], s1[2])];
+            out = (8.0 * g - 6.0 * inner + next) / 3.0;
+          } else {
+            out = 2.0 * g - inner;
+          }
         }
       }
     }

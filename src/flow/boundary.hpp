@@ -4,9 +4,12 @@
 // boundary (after Forest::exchange has filled those facing other blocks).
 //
 // Face numbering: face 2*d + side, d = 0,1,2 (x,y,z), side 0 = lower, 1 = upper.
-// Dirichlet (value g on the face): ghost(-1-m) = 2 g - interior(m), so the
-// face value, the average of the two cells beside the face, is g (second
-// order). Neumann (zero normal gradient): ghost(-1-m) = interior(m).
+// Dirichlet (value g on the face): the first ghost is the quadratic through
+// g and the first two interior cells, ghost(-1) = (8 g - 6 u(0) + u(1)) / 3,
+// so parabolic profiles (Poiseuille) are reproduced exactly; the second
+// ghost is linear, ghost(-2) = 2 g - u(1). Homogeneous fills (multigrid
+// corrections on coarse levels) use the linear ghost(-1-m) = -u(m).
+// Neumann (zero normal gradient): ghost(-1-m) = interior(m).
 
 #include <array>
 #include <cstdint>

@@ -17,12 +17,15 @@ struct BlockCoefficients {
   std::array<const double*, 3> beta;
 };
 
-/// The new value of cell c under Gauss-Seidel for eq. (1).
+/// The new value of cell c under Gauss-Seidel for eq. (1). `implicit`
+/// (times inv_h2) is added to the diagonal and, times the old value, to the
+/// numerator: the part of the ghost values that depends on the cell itself
+/// (quadratic Dirichlet closure), treated implicitly.
 inline double relaxed_value(const double* x, double rhs, const BlockCoefficients& k,
-                            std::ptrdiff_t c, const std::array<std::ptrdiff_t, 3>& s,
-                            double inv_h2) {
-  double num = rhs;
-  double den = k.alpha[c];
+                            std::ptrdiff_t c, const std::array<std::ptrdiff_t, 3>& s, double inv_h2,
+                            double implicit = 0.0) {
+  double num = rhs + implicit * inv_h2 * x[c];
+  double den = k.alpha[c] + implicit * inv_h2;
   for (int d = 0; d < 3; ++d) {
     const double lo = k.beta[D(d)][c];
     const double hi = k.beta[D(d)][c + s[D(d)]];
@@ -306,11 +309,38 @@ void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const Sc
             {lv.beta[0].block(blk), lv.beta[1].block(blk), lv.beta[2].block(blk)}};
         double* xb = x.block(blk);
         const double* rb = rhs.block(blk);
+        // Dirichlet faces of this block with the quadratic closure (finest level):
+        // ghost = (8 g - 6 x0 + x1)/3 depends on x0 with weight -2.
+        std::array<bool, 6> dirichlet{};
+        bool any = false;
+        if (bc != nullptr) {
+          for (int d = 0; d < 3; ++d)
+            for (int side = 0; side < 2; ++side) {
+              std::array<int, 3> o{0, 0, 0};
+              o[D(d)] = side == 0 ? -1 : 1;
+              const bool on =
+                  block.neighbours[D(neighbour_slot(o[0], o[1], o[2]))].link == Link::Boundary &&
+                  kinds_[D(face_index(d, side))] == BcKind::Dirichlet;
+              dirichlet[D(face_index(d, side))] = on;
+              any = any || on;
+            }
+        }
         for (int kk = 0; kk < b; ++kk)
           for (int j = 0; j < b; ++j)
             for (int i = ((kk + j + parity + colour) & 1); i < b; i += 2) {
               const std::ptrdiff_t c = L.index(i, j, kk);
-              xb[c] += omega_ * (relaxed_value(xb, rb[c], k, c, s, inv_h2) - xb[c]);
+              double implicit = 0.0;
+              if (any) {
+                const std::array<int, 3> n{i, j, kk};
+                for (int d = 0; d < 3; ++d) {
+                  if (dirichlet[D(face_index(d, 0))] && n[D(d)] == 0)
+                    implicit += 2.0 * k.beta[D(d)][c];
+                  if (dirichlet[D(face_index(d, 1))] && n[D(d)] == b - 1) {
+                    implicit += 2.0 * k.beta[D(d)][c + s[D(d)]];
+                  }
+                }
+              }
+              xb[c] += omega_ * (relaxed_value(xb, rb[c], k, c, s, inv_h2, implicit) - xb[c]);
             }
       });
     }

@@ -352,8 +352,11 @@ void NavierStokes::advect(double dt) {
           const double un = uf[D(d)][c];
           const int n = d == 0 ? i : (d == 1 ? j : k);
           double value;
-          if ((n == 0 && dirichlet_lo) || (n == b && dirichlet_hi)) {
-            value = 0.5 * (f[c] + f[c - s[D(d)]]);  // the boundary value itself
+          if (n == 0 && dirichlet_lo) {
+            // The boundary value itself, from the quadratic ghost closure.
+            value = (3.0 * f[c - s[D(d)]] + 6.0 * f[c] - f[c + s[D(d)]]) / 8.0;
+          } else if (n == b && dirichlet_hi) {
+            value = (3.0 * f[c] + 6.0 * f[c - s[D(d)]] - f[c - 2 * s[D(d)]]) / 8.0;
           } else {
             const std::ptrdiff_t up = un > 0.0 ? c - s[D(d)] : c;
             std::array<double, 3> vt{};

@@ -101,10 +101,13 @@ TEST(FlowForest, DirichletAndNeumannGhostsReproduceTheFaceValue) {
     const Block& block = forest.block(blk);
     if (block.coord[0] == 0) {
       const double y = block.lower.y + 1.5 * block.length / 4;
-      EXPECT_DOUBLE_EQ(0.5 * (field(blk, -1, 1, 1) + field(blk, 0, 1, 1)), 3.0 + y);
+      // Quadratic closure: the face value from the ghost and two interior cells.
+      EXPECT_DOUBLE_EQ(
+          (3 * field(blk, -1, 1, 1) + 6 * field(blk, 0, 1, 1) - field(blk, 1, 1, 1)) / 8, 3.0 + y);
+      EXPECT_DOUBLE_EQ(0.5 * (field(blk, -2, 1, 1) + field(blk, 1, 1, 1)), 3.0 + y);
     }
     if (block.coord[0] == 1) {
-      EXPECT_DOUBLE_EQ(field(blk, 4, 1, 1), -1.0);
+      EXPECT_DOUBLE_EQ(field(blk, 4, 1, 1), -5.0 / 3.0);
     }
     if (block.coord[2] == 1) {
       EXPECT_DOUBLE_EQ(field(blk, 1, 1, 5), 1.0);
