@@ -166,13 +166,16 @@ int main(int argc, char** argv) {
   bench::BenchOptions bo;
   std::string bench_name;
   auto* bench_cmd = app.add_subcommand("bench", "throughput benchmarks (one JSON line)");
-  bench_cmd->add_option("name", bench_name, "benchmark: dem-spheres | dem-crosses")->required();
+  bench_cmd->add_option("name", bench_name, "benchmark: dem-spheres | dem-crosses | flow-cavity")
+      ->required();
   auto* particles_opt = bench_cmd->add_option(
       "--particles", bo.particles, "number of particles (dem-spheres 32000, dem-crosses 3000)");
   auto* steps_opt =
       bench_cmd->add_option("--steps", bo.steps, "time steps (dem-spheres 2000, dem-crosses 500)");
   bench_cmd->add_option("--threads", bo.threads, "threads")->capture_default_str();
   bench_cmd->add_option("--seed", bo.seed, "random seed")->capture_default_str();
+  bench_cmd->add_option("--cells-per-side", bo.cells_per_side, "flow-cavity: cells per edge")
+      ->capture_default_str();
 
   try {
     app.parse(argc, argv);
@@ -195,9 +198,13 @@ int main(int argc, char** argv) {
         if (!particles_given) bo.particles = 3000;
         if (!steps_given) bo.steps = 500;
         std::cout << bench::run_dem_crosses(bo) << std::endl;
+      } else if (bench_name == "flow-cavity") {
+        if (!steps_given) bo.steps = 20;
+        std::cout << bench::run_flow_cavity(bo) << std::endl;
       } else {
-        throw InputError("", "bench",
-                         "unknown benchmark '" + bench_name + "' (dem-spheres, dem-crosses)");
+        throw InputError(
+            "", "bench",
+            "unknown benchmark '" + bench_name + "' (dem-spheres, dem-crosses, flow-cavity)");
       }
       return 0;
     }
