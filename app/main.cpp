@@ -9,11 +9,14 @@
 #include <sstream>
 
 #include "benchmarks.hpp"
+#include "core/config.hpp"
 #include "core/error.hpp"
 #include "core/version.hpp"
 #include "dem/dem_case.hpp"
 #include "dem/dem_run.hpp"
 #include "dem/parameter_procedure.hpp"
+#include "flow/flow_case.hpp"
+#include "flow/flow_run.hpp"
 
 namespace {
 
@@ -110,7 +113,23 @@ void print_params(const ParamsOptions& o) {
 
 int run_command(const std::string& case_file, const std::string& output, bool restart, bool quiet,
                 int threads) {
-  dem::DemCase c = dem::load_dem_case(case_file);
+  const ConfigTable cfg = ConfigTable::parse_file(case_file);
+  if (flow::is_flow_case(cfg)) {
+    flow::FlowCase fc = flow::load_flow_case(cfg, case_file);
+    if (threads > 0) fc.forest.threads = threads;
+    flow::FlowRunOptions options;
+    options.output_dir =
+        output.empty() ? std::filesystem::path("output") / fc.name : std::filesystem::path(output);
+    options.restart = restart;
+    options.quiet = quiet;
+    if (std::filesystem::exists(options.output_dir) &&
+        !std::filesystem::is_directory(options.output_dir)) {
+      throw InputError(options.output_dir.string(), "--output", "exists and is not a directory");
+    }
+    flow::run_flow_case(fc, options, std::cout);
+    return 0;
+  }
+  dem::DemCase c = dem::load_dem_case(cfg, case_file);
   if (threads > 0) c.setup.threads = threads;
   dem::RunOptions options;
   options.output_dir =
