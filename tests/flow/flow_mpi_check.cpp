@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "flow/mpi_session.hpp"
+#include "flow/navier_stokes.hpp"
 #include "poisson_problems.hpp"
 
 namespace {
@@ -61,10 +62,49 @@ int check(bool periodic) {
   return diff <= 1e-11 ? 0 : 1;
 }
 
+/// Ten steps of the Re = 100 cavity (16^3, 8 blocks) on the shared forest and alone.
+int check_navier_stokes() {
+  auto run = [](MPI_Comm comm) {
+    ForestSpec spec;
+    spec.level = 1;
+    spec.comm = comm;
+    const Forest forest(spec);
+    std::array<FlowBoundary, 6> bcs{};
+    bcs[face_index(1, 1)].wall_velocity = {1.0, 0.0, 0.0};
+    NavierStokesOptions options;
+    options.pressure.tolerance = 1e-10;
+    options.viscous.tolerance = 1e-10;
+    NavierStokes ns(forest, bcs, Fluid{1.0, 0.01}, options);
+    ns.set_velocity([](const sanguis::Vec3&) { return sanguis::Vec3{}; });
+    for (int s = 0; s < 10; ++s) ns.step(0.02);
+    std::array<std::vector<double>, 4> values;
+    for (int c = 0; c < 3; ++c)
+      values[static_cast<std::size_t>(c)] =
+          gathered(forest, ns.velocity()[static_cast<std::size_t>(c)]);
+    values[3] = gathered(forest, ns.pressure());
+    return values;
+  };
+  const auto shared = run(MPI_COMM_WORLD);
+  const auto alone = run(MPI_COMM_SELF);
+  double diff = 0.0, scale = 0.0;
+  for (std::size_t f = 0; f < 4; ++f)
+    for (std::size_t i = 0; i < shared[f].size(); ++i) {
+      diff = std::max(diff, std::abs(shared[f][i] - alone[f][i]));
+      scale = std::max(scale, std::abs(alone[f][i]));
+    }
+  const auto& session = MpiSession::ensure();
+  if (session.rank() == 0) {
+    std::printf(
+        "cavity 16^3, 10 steps: %d ranks vs 1: max difference of u and p %.3e (max |value| %.3f)\n",
+        session.size(), diff, scale);
+  }
+  return diff <= 1e-11 ? 0 : 1;
+}
+
 }  // namespace
 
 int main() {
   MpiSession::ensure();
-  const int failures = check(true) + check(false);
+  const int failures = check(true) + check(false) + check_navier_stokes();
   return failures == 0 ? 0 : 1;
 }
