@@ -1,5 +1,6 @@
 #include "flow/multigrid.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -32,7 +33,7 @@ inline double relaxed_value(const double* x, double rhs, const BlockCoefficients
     num += inv_h2 * (lo * x[c - s[D(d)]] + hi * x[c + s[D(d)]]);
     den += inv_h2 * (lo + hi);
   }
-  return num / den;
+  return den > 0.0 ? num / den : x[c];  // a cell cut off on all sides (solid) keeps its value
 }
 
 /// (A x)_c = alpha x_c - div(beta grad x)_c, eq. (1).
@@ -75,6 +76,7 @@ Multigrid::Multigrid(const Forest& forest, const std::array<BcKind, 6>& kinds)
     level.res = BlockField(n, b);
     level.alpha = BlockField(n, b);
     level.beta = make_vector_field(n, b);
+    level.active = BlockField(n, b);
     levels_.push_back(std::move(level));
   }
   set_coefficients(nullptr, nullptr);
@@ -134,7 +136,47 @@ void Multigrid::set_coefficients(const BlockField* alpha, const FaceField* beta)
   bool dirichlet = false;
   for (const BcKind k : kinds_) dirichlet = dirichlet || k == BcKind::Dirichlet;
   singular_ = !has_alpha_ && !dirichlet;
+  compute_activity();
   build_coarse_operator();
+}
+
+void Multigrid::compute_activity() {
+  Level& fine = levels_.front();
+  const int b = fine.cells;
+  const BlockLayout L = fine.alpha.layout();
+  forest_.for_each_block([&](int blk) {
+    for (int k = 0; k < b; ++k)
+      for (int j = 0; j < b; ++j)
+        for (int i = 0; i < b; ++i) {
+          const std::ptrdiff_t c = L.index(i, j, k);
+          double open = fine.alpha.block(blk)[c];
+          for (int d = 0; d < 3; ++d) {
+            open += fine.beta[D(d)].block(blk)[c] + fine.beta[D(d)].block(blk)[c + L.stride(d)];
+          }
+          fine.active.block(blk)[c] = open > 0.0 ? 1.0 : 0.0;
+        }
+  });
+  for (std::size_t m = 1; m < levels_.size(); ++m) {
+    const Level& f = levels_[m - 1];
+    Level& c = levels_[m];
+    const int bc = c.cells;
+    forest_.for_each_block([&](int blk) {
+      for (int k = 0; k < bc; ++k)
+        for (int j = 0; j < bc; ++j)
+          for (int i = 0; i < bc; ++i) {
+            double any = 0.0;
+            for (int dk = 0; dk < 2; ++dk)
+              for (int dj = 0; dj < 2; ++dj)
+                for (int di = 0; di < 2; ++di)
+                  any = std::max(any, f.active(blk, 2 * i + di, 2 * j + dj, 2 * k + dk));
+            c.active(blk, i, j, k) = any;
+          }
+    });
+  }
+  for (Level& level : levels_) {
+    forest_.exchange(level.active, 1);
+    fill_boundary_ghosts(forest_, level.active, uniform_kinds(forest_, BcKind::Neumann), 1);
+  }
 }
 
 void Multigrid::build_coarse_operator() {
@@ -143,6 +185,7 @@ void Multigrid::build_coarse_operator() {
   coarse_h_ = forest_.spec().tree_length / static_cast<double>(std::int64_t{1} << level);
   const auto [nx, ny, nz] = coarse_n_;
   coarse_alpha_.assign(static_cast<std::size_t>(nx * ny * nz), 0.0);
+  coarse_active_.assign(static_cast<std::size_t>(nx * ny * nz), 0.0);
   for (int d = 0; d < 3; ++d) {
     auto n = coarse_n_;
     n[D(d)] += 1;
@@ -153,6 +196,8 @@ void Multigrid::build_coarse_operator() {
     const Block& block = forest_.block(blk);
     const auto& p = block.coord;
     coarse_alpha_[static_cast<std::size_t>((p[2] * ny + p[1]) * nx + p[0])] = c.alpha(blk, 0, 0, 0);
+    coarse_active_[static_cast<std::size_t>((p[2] * ny + p[1]) * nx + p[0])] =
+        c.active(blk, 0, 0, 0);
     for (int d = 0; d < 3; ++d) {
       auto n = coarse_n_;
       n[D(d)] += 1;
@@ -173,6 +218,8 @@ void Multigrid::build_coarse_operator() {
   }
   MPI_Allreduce(MPI_IN_PLACE, coarse_alpha_.data(), static_cast<int>(coarse_alpha_.size()),
                 MPI_DOUBLE, MPI_SUM, forest_.comm());
+  MPI_Allreduce(MPI_IN_PLACE, coarse_active_.data(), static_cast<int>(coarse_active_.size()),
+                MPI_DOUBLE, MPI_SUM, forest_.comm());
   for (auto& beta : coarse_beta_) {
     MPI_Allreduce(MPI_IN_PLACE, beta.data(), static_cast<int>(beta.size()), MPI_DOUBLE, MPI_SUM,
                   forest_.comm());
@@ -192,11 +239,18 @@ void Multigrid::coarse_solve() {
   }
   MPI_Allreduce(MPI_IN_PLACE, rhs.data(), static_cast<int>(cells), MPI_DOUBLE, MPI_SUM,
                 forest_.comm());
+  // Inactive cells (closed on all sides) are left out: zero rows, zero values.
+  double active_cells = 0.0;
+  for (std::size_t i = 0; i < cells; ++i) {
+    rhs[i] *= coarse_active_[i];
+    active_cells += coarse_active_[i];
+  }
   auto remove_mean = [&](std::vector<double>& v) {
+    if (active_cells == 0.0) return;
     double sum = 0.0;
-    for (const double e : v) sum += e;
-    const double m = sum / static_cast<double>(v.size());
-    for (double& e : v) e -= m;
+    for (std::size_t i = 0; i < cells; ++i) sum += coarse_active_[i] * v[i];
+    const double m = sum / active_cells;
+    for (std::size_t i = 0; i < cells; ++i) v[i] -= coarse_active_[i] * m;
   };
   if (singular_) remove_mean(rhs);
 
@@ -270,6 +324,7 @@ void Multigrid::coarse_solve() {
     }
     if (singular_) remove_mean(r);
     const double rr_new = dot(r, r);
+    if (rr_new == 0.0) break;
     for (std::size_t i = 0; i < cells; ++i) p[i] = r[i] + (rr_new / rr) * p[i];
     rr = rr_new;
   }
@@ -361,12 +416,13 @@ void Multigrid::compute_residual(int level, BlockField& x, const BlockField& rhs
         lv.alpha.block(blk), {lv.beta[0].block(blk), lv.beta[1].block(blk), lv.beta[2].block(blk)}};
     const double* xb = x.block(blk);
     const double* fb = rhs.block(blk);
+    const double* ab = lv.active.block(blk);
     double* rb = r.block(blk);
     for (int kk = 0; kk < b; ++kk)
       for (int j = 0; j < b; ++j)
         for (int i = 0; i < b; ++i) {
           const std::ptrdiff_t c = L.index(i, j, kk);
-          rb[c] = fb[c] - applied(xb, k, c, s, inv_h2);
+          rb[c] = (fb[c] - applied(xb, k, c, s, inv_h2)) * ab[c];
         }
   });
 }
@@ -404,14 +460,17 @@ void Multigrid::vcycle(int level, BlockField& x, const BlockField& rhs, const Sc
         for (int i = 0; i < b; ++i) {
           const int ci = i >> 1, cj = j >> 1, ck = k >> 1;
           const int si = (i & 1) ? 1 : -1, sj = (j & 1) ? 1 : -1, sk = (k & 1) ? 1 : -1;
-          double value = 0.0;
+          double value = 0.0, weight = 0.0;
           for (int dk = 0; dk < 2; ++dk)
             for (int dj = 0; dj < 2; ++dj)
               for (int di = 0; di < 2; ++di) {
-                const double w = (di ? 0.25 : 0.75) * (dj ? 0.25 : 0.75) * (dk ? 0.25 : 0.75);
-                value += w * coarse.x(blk, ci + di * si, cj + dj * sj, ck + dk * sk);
+                const int ii = ci + di * si, jj = cj + dj * sj, kk = ck + dk * sk;
+                const double w = (di ? 0.25 : 0.75) * (dj ? 0.25 : 0.75) * (dk ? 0.25 : 0.75) *
+                                 coarse.active(blk, ii, jj, kk);
+                value += w * coarse.x(blk, ii, jj, kk);
+                weight += w;
               }
-          x(blk, i, j, k) += value;
+          if (weight > 0.0) x(blk, i, j, k) += value / weight;
         }
   });
   smooth(level, x, rhs, bc, post_sweeps_);
@@ -430,13 +489,17 @@ double Multigrid::rms(const BlockField& f) const {
 
 double Multigrid::mean(const BlockField& f) const {
   const int b = f.cells();
-  double local = 0.0;
+  const BlockField& active = levels_.front().active;
+  double local = 0.0, count = 0.0;
   for (int blk = 0; blk < forest_.local_blocks(); ++blk)
     for (int k = 0; k < b; ++k)
       for (int j = 0; j < b; ++j)
-        for (int i = 0; i < b; ++i) local += f(blk, i, j, k);
-  const double cells = static_cast<double>(forest_.global_blocks()) * b * b * b;
-  return forest_.sum(local) / cells;
+        for (int i = 0; i < b; ++i) {
+          local += active(blk, i, j, k) * f(blk, i, j, k);
+          count += active(blk, i, j, k);
+        }
+  const double cells = forest_.sum(count);
+  return cells > 0.0 ? forest_.sum(local) / cells : 0.0;
 }
 
 void Multigrid::residual(BlockField& x, const BlockField& rhs, const ScalarBoundary& bc,
@@ -452,11 +515,12 @@ MultigridReport Multigrid::solve(BlockField& x, const BlockField& rhs, const Sca
   const BlockField* source = &rhs;
   BlockField shifted;
   const int b = rhs.cells();
+  const BlockField& active = levels_.front().active;
   auto shift_interior = [&](BlockField& f, double by) {
     forest_.for_each_block([&](int blk) {
       for (int k = 0; k < b; ++k)
         for (int j = 0; j < b; ++j)
-          for (int i = 0; i < b; ++i) f(blk, i, j, k) -= by;
+          for (int i = 0; i < b; ++i) f(blk, i, j, k) -= by * active(blk, i, j, k);
     });
   };
   if (singular_) {
@@ -471,7 +535,7 @@ MultigridReport Multigrid::solve(BlockField& x, const BlockField& rhs, const Sca
   compute_residual(0, x, *source, &bc, fine.res);
   report.residuals.push_back(rms(fine.res));
   const double scale = report.rhs_norm > 0.0 ? report.rhs_norm : report.residuals.front();
-  const double target = options.tolerance * scale;
+  const double target = std::max(options.tolerance * scale, options.absolute_tolerance);
   report.converged = report.residuals.back() <= target;
   while (!report.converged && report.cycles < options.max_cycles) {
     vcycle(0, x, *source, &bc);

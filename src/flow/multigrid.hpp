@@ -15,6 +15,10 @@
 // forest's own grid of blocks, gathered on every rank and solved there by
 // conjugate gradients (identical on every rank). Boundary values are applied
 // on the finest level only; corrections carry homogeneous conditions.
+// Cells closed on all faces with alpha = 0 (solid cells of a mask) are
+// inactive: they keep their value, and the prolongation interpolates from
+// active coarse cells only (renormalised weights), so that masked walls act
+// as Neumann boundaries on every level.
 
 #include <array>
 #include <vector>
@@ -33,6 +37,9 @@ struct MultigridOptions {
   /// Over-relaxation of the red-black Gauss-Seidel sweeps (1.15: about 15x
   /// residual reduction per V(2,2) cycle on the 3D Poisson problem, against 9x at 1).
   double relaxation = 1.15;
+  /// Also stop when |r|_2 <= absolute_tolerance (a floor above round-off for
+  /// right-hand sides that are round-off themselves).
+  double absolute_tolerance = 0.0;
 };
 
 struct MultigridReport {
@@ -72,6 +79,7 @@ class Multigrid {
     int cells = 0;  ///< cells per block edge at this level
     BlockField x, rhs, res, alpha;
     FaceField beta;
+    BlockField active;  ///< 1 where the cell takes part (some open face or alpha > 0), else 0
   };
   void fill_ghosts(int level, BlockField& x, const ScalarBoundary* bc) const;
   void smooth(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc,
@@ -82,7 +90,8 @@ class Multigrid {
   void coarse_solve();
   void build_coarse_operator();
   double rms(const BlockField& f) const;
-  double mean(const BlockField& f) const;
+  double mean(const BlockField& f) const;  ///< over the active cells of the finest level
+  void compute_activity();
 
   const Forest& forest_;
   std::array<BcKind, 6> kinds_;
@@ -93,6 +102,7 @@ class Multigrid {
   // The grid of blocks, one cell each, gathered on every rank.
   std::array<std::int64_t, 3> coarse_n_{};
   std::vector<double> coarse_alpha_;
+  std::vector<double> coarse_active_;
   std::array<std::vector<double>, 3> coarse_beta_;  ///< (n_d + 1) faces along d
   double coarse_h_ = 1.0;
   int pre_sweeps_ = 2;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 #include <vector>
 
@@ -144,6 +145,9 @@ NavierStokes::NavierStokes(const Forest& forest, const std::array<FlowBoundary, 
   phi_ = BlockField(n, b);
   mu_ = BlockField(n, b);
   mu_.fill(fluid.viscosity);
+  solid_ = BlockField(n, b);
+  open_ = make_vector_field(n, b);
+  for (auto& f : open_) f.fill(1.0);
   const auto vk = velocity_kinds(boundaries_);
   for (int c = 0; c < 3; ++c) {
     ScalarBoundary& bc = velocity_bc_[D(c)];
@@ -205,6 +209,7 @@ void NavierStokes::set_velocity(const std::function<Vec3(const Vec3&)>& u0, doub
       });
     }
   });
+  clear_solid_cells(u_);
   fill_velocity_ghosts(u_);
 }
 
@@ -235,6 +240,67 @@ void NavierStokes::set_viscosity(const std::function<double(const Vec3&)>& mu) {
     });
   });
   viscosity_changed_ = true;
+}
+
+void NavierStokes::set_solid(const std::function<bool(const Vec3&)>& solid) {
+  const int b = forest_.block_cells();
+  bool any = false;
+  for (int blk = 0; blk < forest_.local_blocks(); ++blk) {
+    const Block& block = forest_.block(blk);
+    const double h = block.length / b;
+    for_each_cell(b, [&](int i, int j, int k) {
+      const bool inside = solid({block.lower.x + (i + 0.5) * h, block.lower.y + (j + 0.5) * h,
+                                 block.lower.z + (k + 0.5) * h});
+      solid_(blk, i, j, k) = inside ? 1.0 : 0.0;
+      any = any || inside;
+    });
+  }
+  has_solids_ = forest_.max(any ? 1.0 : 0.0) > 0.0;
+  fill_scalar_neumann(solid_, 1);
+  forest_.for_each_block([&](int blk) {
+    const BlockLayout L = solid_.layout();
+    const double* sb = solid_.block(blk);
+    for (int d = 0; d < 3; ++d) {
+      double* ob = open_[D(d)].block(blk);
+      for_each_face(b, d, [&](int i, int j, int k) {
+        const std::ptrdiff_t c = L.index(i, j, k);
+        ob[c] = (sb[c] == 0.0 && sb[c - L.stride(d)] == 0.0) ? 1.0 : 0.0;
+      });
+    }
+  });
+  // Solid cells leave the pressure problem: all their faces are closed
+  // (beta = 0), so the multigrid treats them as inactive.
+  pressure_mg_.set_coefficients(nullptr, has_solids_ ? &open_ : nullptr);
+  viscosity_changed_ = true;
+  clear_solid_cells(u_);
+  close_solid_faces(uf_);
+}
+
+void NavierStokes::close_solid_faces(FaceField& uf) const {
+  if (!has_solids_) return;
+  const int b = forest_.block_cells();
+  forest_.for_each_block([&](int blk) {
+    for (int d = 0; d < 3; ++d) {
+      const double* ob = open_[D(d)].block(blk);
+      double* out = uf[D(d)].block(blk);
+      for_each_face(b, d, [&](int i, int j, int k) {
+        const std::ptrdiff_t c = solid_.layout().index(i, j, k);
+        out[c] *= ob[c];
+      });
+    }
+  });
+}
+
+void NavierStokes::clear_solid_cells(VectorField& u) const {
+  if (!has_solids_) return;
+  const int b = forest_.block_cells();
+  forest_.for_each_block([&](int blk) {
+    for_each_cell(b, [&](int i, int j, int k) {
+      if (solid_(blk, i, j, k) != 0.0) {
+        for (auto& comp : u) comp(blk, i, j, k) = 0.0;
+      }
+    });
+  });
 }
 
 void NavierStokes::fill_velocity_ghosts(VectorField& u, int width) {
@@ -324,6 +390,7 @@ void NavierStokes::predict_face_velocity(double dt) {
     }
   });
   set_boundary_faces(uf_);
+  close_solid_faces(uf_);
 }
 
 void NavierStokes::advect(double dt) {
@@ -389,15 +456,31 @@ void NavierStokes::update_viscous_coefficients(double dt) {
   FaceField beta = make_vector_field(n, b);
   const double scale = options_.viscous_theta * dt / fluid_.density;
   forest_.for_each_block([&](int blk) {
+    const BlockLayout L = mu_.layout();
+    const double* mu = mu_.block(blk);
     for (int d = 0; d < 3; ++d) {
-      const std::ptrdiff_t s = mu_.layout().stride(d);
-      const double* mu = mu_.block(blk);
+      const std::ptrdiff_t s = L.stride(d);
+      const double* open = open_[D(d)].block(blk);
       double* out = beta[D(d)].block(blk);
       for_each_face(b, d, [&](int i, int j, int k) {
-        const std::ptrdiff_t c = mu_.layout().index(i, j, k);
-        out[c] = scale * 0.5 * (mu[c] + mu[c - s]);
+        const std::ptrdiff_t c = L.index(i, j, k);
+        out[c] = open[c] * scale * 0.5 * (mu[c] + mu[c - s]);
       });
     }
+    if (!has_solids_) return;
+    // No-slip on the faces of solid cells: a fluid cell there gets the wall
+    // flux 2 mu (0 - u)/h implicitly (alpha), the solid cell keeps u = 0.
+    const double h = forest_.block(blk).length / b;
+    for_each_cell(b, [&](int i, int j, int k) {
+      const std::ptrdiff_t c = L.index(i, j, k);
+      if (solid_.block(blk)[c] != 0.0) return;
+      double walls = 0.0;
+      for (int d = 0; d < 3; ++d) {
+        const double* open = open_[D(d)].block(blk);
+        walls += (1.0 - open[c]) + (1.0 - open[c + L.stride(d)]);
+      }
+      alpha.block(blk)[c] += walls * 2.0 * scale * mu[c] / (h * h);
+    });
   });
   viscous_mg_.set_coefficients(&alpha, &beta);
   viscous_dt_ = dt;
@@ -423,8 +506,12 @@ void NavierStokes::viscous_step(double dt, StepReport& report) {
           double lap = 0.0;
           for (int d = 0; d < 3; ++d) {
             const std::ptrdiff_t s = L.stride(d);
-            lap += 0.5 * (mu[c + s] + mu[c]) * (u[c + s] - u[c]) -
-                   0.5 * (mu[c] + mu[c - s]) * (u[c] - u[c - s]);
+            const double open_lo = open_[D(d)].block(blk)[c];
+            const double open_hi = open_[D(d)].block(blk)[c + s];
+            lap += open_hi * 0.5 * (mu[c + s] + mu[c]) * (u[c + s] - u[c]) -
+                   open_lo * 0.5 * (mu[c] + mu[c - s]) * (u[c] - u[c - s]);
+            // No-slip faces of solid neighbours: 2 mu (0 - u)/h.
+            if (solid_.block(blk)[c] == 0.0) lap -= (2.0 - open_lo - open_hi) * 2.0 * mu[c] * u[c];
           }
           out[c] += (1.0 - theta) * dt / fluid_.density * lap / (h * h);
         });
@@ -444,7 +531,13 @@ void NavierStokes::viscous_step(double dt, StepReport& report) {
     });
     const auto r = viscous_mg_.solve(u, rhs, velocity_bc_[D(comp)], options_.viscous);
     report.viscous_cycles += r.cycles;
-    if (!r.converged) throw SimulationError("navier-stokes: viscous solve did not converge");
+    if (!r.converged) {
+      std::ostringstream what;
+      what << "navier-stokes: viscous solve did not converge: RMS residual " << r.residuals.front()
+           << " -> " << r.residuals.back() << " in " << r.cycles << " V-cycles, RMS rhs "
+           << r.rhs_norm;
+      throw SimulationError(what.str());
+    }
     forest_.for_each_block([&](int blk) {
       for_each_cell(b, [&](int i, int j, int k) { u(blk, i, j, k) -= dt * g(blk, i, j, k); });
     });
@@ -467,6 +560,7 @@ void NavierStokes::face_average_plus_acceleration(double dt) {
     }
   });
   set_boundary_faces(uf_);
+  close_solid_faces(uf_);
 }
 
 MultigridReport NavierStokes::project(BlockField& phi) {
@@ -484,17 +578,36 @@ MultigridReport NavierStokes::project(BlockField& phi) {
       rhs.block(blk)[c] = -div / h;
     });
   });
-  MultigridReport report = pressure_mg_.solve(phi, rhs, pressure_bc_, options_.pressure);
-  if (!report.converged) throw SimulationError("navier-stokes: projection did not converge");
+  // A floor above round-off: |div uf| ~ 1e-12 max|uf|/h is exact enough.
+  double rate = 0.0;
+  for (int blk = 0; blk < forest_.local_blocks(); ++blk) {
+    const double h = forest_.block(blk).length / b;
+    for (int d = 0; d < 3; ++d) {
+      for_each_face(b, d, [&](int i, int j, int k) {
+        rate = std::max(rate, std::abs(uf_[D(d)](blk, i, j, k)) / h);
+      });
+    }
+  }
+  MultigridOptions options = options_.pressure;
+  options.absolute_tolerance = std::max(options.absolute_tolerance, 1e-12 * forest_.max(rate));
+  MultigridReport report = pressure_mg_.solve(phi, rhs, pressure_bc_, options);
+  if (!report.converged) {
+    std::ostringstream what;
+    what << "navier-stokes: projection did not converge: RMS residual " << report.residuals.front()
+         << " -> " << report.residuals.back() << " in " << report.cycles << " V-cycles, RMS rhs "
+         << report.rhs_norm << ", tolerance " << options_.pressure.tolerance;
+    throw SimulationError(what.str());
+  }
   forest_.for_each_block([&](int blk) {
     const double h = forest_.block(blk).length / b;
     const double* pb = phi.block(blk);
     for (int d = 0; d < 3; ++d) {
       const std::ptrdiff_t s = L.stride(d);
       double* out = uf_[D(d)].block(blk);
+      const double* open = open_[D(d)].block(blk);
       for_each_face(b, d, [&](int i, int j, int k) {
         const std::ptrdiff_t c = L.index(i, j, k);
-        out[c] -= (pb[c] - pb[c - s]) / h;
+        out[c] -= open[c] * (pb[c] - pb[c - s]) / h;
       });
     }
   });
@@ -556,14 +669,21 @@ StepReport NavierStokes::step(double dt) {
       for (int d = 0; d < 3; ++d) {
         const std::ptrdiff_t s = L.stride(d);
         const double* a = accel_[D(d)].block(blk);
+        const double* open = open_[D(d)].block(blk);
         const double grad_lo = (pb[c] - pb[c - s]) / (h * dt);
         const double grad_hi = (pb[c + s] - pb[c]) / (h * dt);
-        const double gd = 0.5 * ((a[c] - grad_lo) + (a[c + s] - grad_hi));
+        // Average over the faces open to the flow (both, away from solids).
+        const double weight = open[c] + open[c + s];
+        const double gd =
+            weight > 0.0
+                ? (open[c] * (a[c] - grad_lo) + open[c + s] * (a[c + s] - grad_hi)) / weight
+                : 0.0;
         g_[D(d)].block(blk)[c] = gd;
         u_[D(d)].block(blk)[c] += dt * gd;
       }
     });
   });
+  clear_solid_cells(u_);
   time_ += dt;
   return report;
 }

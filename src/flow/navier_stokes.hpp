@@ -87,6 +87,12 @@ class NavierStokes {
   /// Dynamic viscosity mu(x) (Pa s) per cell.
   void set_viscosity(const std::function<double(const Vec3&)>& mu);
 
+  /// Solid cells (cell masks aligned with the grid): solid(x) at cell
+  /// centres. Solid cells hold no flow; their faces with fluid cells are
+  /// no-slip walls (linear closure) closed to the flow. Call before set_velocity.
+  void set_solid(const std::function<bool(const Vec3&)>& solid);
+  [[nodiscard]] const BlockField& solid() const { return solid_; }
+
   /// Largest stable step: min(dt_max, cfl h / max|uf|).
   [[nodiscard]] double stable_dt() const;
   /// Advances by dt.
@@ -127,6 +133,8 @@ class NavierStokes {
   void fill_face_ghosts(FaceField& uf);
   void fill_scalar_neumann(BlockField& f, int width);
   void update_viscous_coefficients(double dt);
+  void close_solid_faces(FaceField& uf) const;
+  void clear_solid_cells(VectorField& u) const;
 
   const Forest& forest_;
   std::array<FlowBoundary, 6> boundaries_;
@@ -150,6 +158,10 @@ class NavierStokes {
   Multigrid viscous_mg_;
   double viscous_dt_ = -1.0;  ///< dt the viscous coefficients were built for
   bool viscosity_changed_ = true;
+  bool has_solids_ = false;
+  BlockField solid_;  ///< 1 in solid cells, 0 in fluid cells
+  FaceField
+      open_;  ///< 1 on faces between two fluid cells (or fluid and the domain boundary), else 0
   MultigridReport pressure_report_;
 };
 

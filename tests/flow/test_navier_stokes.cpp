@@ -162,5 +162,62 @@ TEST(FlowNavierStokes, CouetteAtReynolds0p01IsExactlyLinearAndStable) {
   EXPECT_LT(forest.max(vmax), 1e-10);
 }
 
+/// Channel of height 1 between two solid slabs (cell masks) in a periodic box
+/// 0.5 x 1.5 x 0.5, driven by a body force: flow rate relative error and the
+/// largest velocity inside the solids.
+std::pair<double, double> masked_channel(int level) {
+  ForestSpec spec;
+  spec.trees = {1, 3, 1};
+  spec.tree_length = 0.5;
+  spec.level = level;
+  spec.periodic = {true, true, true};
+  const Forest forest(spec);
+  const double G = 2.0, mu = 1.0;
+  NavierStokesOptions options;
+  options.dt_max = 0.01;
+  options.viscous.tolerance = 1e-10;
+  options.pressure.tolerance = 1e-10;
+  NavierStokes ns(forest, all_periodic(), Fluid{1.0, mu}, options);
+  auto solid = [](const Vec3& x) { return x.y < 0.25 || x.y > 1.25; };
+  ns.set_solid(solid);
+  ns.set_velocity([](const Vec3&) { return Vec3{}; });
+  ns.set_body_force([G](const Vec3&) { return Vec3{G, 0.0, 0.0}; });
+  for (int s = 0; s < 300; ++s) ns.step(ns.stable_dt());
+  const int b = forest.block_cells();
+  const double h = forest.block(0).length / b;
+  double flux = 0.0, inside = 0.0, area = 0.0;
+  for (int blk = 0; blk < forest.local_blocks(); ++blk)
+    for (int k = 0; k < b; ++k)
+      for (int j = 0; j < b; ++j)
+        for (int i = 0; i < b; ++i) {
+          const Vec3 x = cell_centre(forest, blk, i, j, k);
+          const double u = ns.velocity()[0](blk, i, j, k);
+          if (solid(x)) {
+            inside = std::max({inside, std::abs(u), std::abs(ns.velocity()[1](blk, i, j, k))});
+          } else {
+            flux += u * h * h * h;  // volume integral of u = flow rate x length x depth
+          }
+          area += h * h * h;
+        }
+  const double length_depth = 0.5 * 0.5;
+  const double rate = forest.sum(flux) / length_depth;
+  const double exact = G / (12 * mu);
+  EXPECT_LT(ns.max_divergence(), 1e-7);
+  return {rate / exact - 1.0, forest.max(inside)};
+}
+
+TEST(FlowNavierStokes, SolidCellMasksActAsNoSlipWallsAtSecondOrder) {
+  const auto [e16, inside16] = masked_channel(0);
+  const auto [e32, inside32] = masked_channel(1);
+  std::printf(
+      "channel between solid masks: flow rate error %.3e (16 across), %.3e (32), order %.2f; "
+      "max velocity in solids %.1e\n",
+      e16, e32, std::log2(std::abs(e16 / e32)), std::max(inside16, inside32));
+  EXPECT_LT(std::abs(e16), 0.01);
+  EXPECT_GT(std::log2(std::abs(e16 / e32)), 1.8);
+  EXPECT_EQ(inside16, 0.0);
+  EXPECT_EQ(inside32, 0.0);
+}
+
 }  // namespace
 }  // namespace sanguis::flow
