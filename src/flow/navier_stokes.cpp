@@ -661,10 +661,23 @@ StepReport NavierStokes::step(double dt) {
   report.pressure_reduction = pressure_report_.mean_reduction();
   const BlockLayout L = p_.layout();
   forest_.for_each_block([&](int blk) {
-    const double h = forest_.block(blk).length / b;
+    const Block& block = forest_.block(blk);
+    const double h = block.length / b;
     const double* pb = phi.block(blk);
+    // Faces where the velocity is prescribed (walls, inflow): the pressure
+    // condition there (Neumann) only keeps uf fixed; their gradient is not
+    // the fluid's, so g comes from the interior face beside them.
+    std::array<bool, 6> prescribed{};
+    for (int d = 0; d < 3; ++d)
+      for (int side = 0; side < 2; ++side) {
+        const FlowBoundaryKind kind = boundaries_[D(face_index(d, side))].kind;
+        prescribed[D(face_index(d, side))] =
+            on_boundary(block, d, side) &&
+            (kind == FlowBoundaryKind::Wall || kind == FlowBoundaryKind::Inflow);
+      }
     for_each_cell(b, [&](int i, int j, int k) {
       const std::ptrdiff_t c = L.index(i, j, k);
+      const std::array<int, 3> n{i, j, k};
       p_.block(blk)[c] = pb[c] * rho / dt;
       for (int d = 0; d < 3; ++d) {
         const std::ptrdiff_t s = L.stride(d);
@@ -672,12 +685,15 @@ StepReport NavierStokes::step(double dt) {
         const double* open = open_[D(d)].block(blk);
         const double grad_lo = (pb[c] - pb[c - s]) / (h * dt);
         const double grad_hi = (pb[c + s] - pb[c]) / (h * dt);
-        // Average over the faces open to the flow (both, away from solids).
-        const double weight = open[c] + open[c + s];
+        // Average over the faces open to the flow (both, away from solids
+        // and prescribed boundaries).
+        const double open_lo = (n[D(d)] == 0 && prescribed[D(face_index(d, 0))]) ? 0.0 : open[c];
+        const double open_hi =
+            (n[D(d)] == b - 1 && prescribed[D(face_index(d, 1))]) ? 0.0 : open[c + s];
+        const double weight = open_lo + open_hi;
         const double gd =
-            weight > 0.0
-                ? (open[c] * (a[c] - grad_lo) + open[c + s] * (a[c + s] - grad_hi)) / weight
-                : 0.0;
+            weight > 0.0 ? (open_lo * (a[c] - grad_lo) + open_hi * (a[c + s] - grad_hi)) / weight
+                         : 0.0;
         g_[D(d)].block(blk)[c] = gd;
         u_[D(d)].block(blk)[c] += dt * gd;
       }

@@ -219,5 +219,59 @@ TEST(FlowNavierStokes, SolidCellMasksActAsNoSlipWallsAtSecondOrder) {
   EXPECT_EQ(inside32, 0.0);
 }
 
+/// Channel 2 x 1 (x 0.5, periodic in z), walls at y = 0 and 1, parabolic
+/// inflow of mean velocity 1 at x = 0, outflow at x = 2; mu = rho = 1.
+/// Steady state: the same parabola everywhere, p = 12 mu U (2 - x) / H^2.
+/// Returns the largest velocity and pressure errors at t = 1.5 (steady).
+std::pair<double, double> inflow_outflow_errors(int level) {
+  ForestSpec spec;
+  spec.trees = {4, 2, 1};
+  spec.tree_length = 0.5;
+  spec.level = level;
+  spec.periodic = {false, false, true};
+  const Forest forest(spec);
+  std::array<FlowBoundary, 6> bcs{};
+  bcs[face_index(0, 0)].kind = FlowBoundaryKind::Inflow;
+  bcs[face_index(0, 0)].inflow = [](const Vec3& x, double) {
+    return Vec3{6.0 * x.y * (1.0 - x.y), 0.0, 0.0};
+  };
+  bcs[face_index(0, 1)].kind = FlowBoundaryKind::Outflow;
+  bcs[face_index(2, 0)].kind = bcs[face_index(2, 1)].kind = FlowBoundaryKind::Periodic;
+  NavierStokesOptions options;
+  options.dt_max = 0.02;
+  options.pressure.tolerance = 1e-8;
+  options.viscous.tolerance = 1e-8;
+  NavierStokes ns(forest, bcs, Fluid{1.0, 1.0}, options);
+  ns.set_velocity([](const Vec3&) { return Vec3{}; });
+  while (ns.time() < 1.5) ns.step(ns.stable_dt());  // 1.5 diffusion times: steady to 4e-7
+  EXPECT_LT(ns.max_divergence(), 1e-6);
+  const int b = forest.block_cells();
+  double velocity_error = 0.0, pressure_error = 0.0;
+  for (int blk = 0; blk < forest.local_blocks(); ++blk)
+    for (int k = 0; k < b; ++k)
+      for (int j = 0; j < b; ++j)
+        for (int i = 0; i < b; ++i) {
+          const Vec3 x = cell_centre(forest, blk, i, j, k);
+          const double u = ns.velocity()[0](blk, i, j, k), v = ns.velocity()[1](blk, i, j, k);
+          velocity_error =
+              std::max({velocity_error, std::abs(u - 6.0 * x.y * (1.0 - x.y)), std::abs(v)});
+          pressure_error =
+              std::max(pressure_error, std::abs(ns.pressure()(blk, i, j, k) - 12.0 * (2.0 - x.x)));
+        }
+  return {forest.max(velocity_error), forest.max(pressure_error)};
+}
+
+TEST(FlowNavierStokes, ParabolicInflowAndOutflowKeepFullyDevelopedChannelFlow) {
+  const auto [u16, p16] = inflow_outflow_errors(0);
+  const auto [u32, p32] = inflow_outflow_errors(1);
+  std::printf(
+      "inflow/outflow channel, 16 / 32 cells across: max velocity error %.2e / %.2e (U = 1, "
+      "order %.2f), max pressure error %.2e / %.2e (p_in = 24)\n",
+      u16, u32, std::log2(u16 / u32), p16, p32);
+  EXPECT_LT(u16, 5e-3);                  // 0.5 % of the mean velocity, at the inlet
+  EXPECT_LT(p16, 0.24);                  // 1 % of the inlet pressure
+  EXPECT_GT(std::log2(u16 / u32), 0.9);  // the inlet error shrinks with h
+}
+
 }  // namespace
 }  // namespace sanguis::flow
