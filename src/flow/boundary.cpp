@@ -31,42 +31,39 @@ void fill_face(const Block& block, BlockField& field, int blk, int d, int side, 
   const int b = L.cells;
   double* data = field.block(blk);
   const double h = block.length / b;
+  const int e1 = (d + 1) % 3, e2 = (d + 2) % 3;
+  const std::ptrdiff_t s1 = L.stride(e1), s2 = L.stride(e2);
+  const bool given = value != nullptr && static_cast<bool>(*value);
   for (int m = 0; m < width; ++m) {
     const int ghost = side == 0 ? -1 - m : b + m;
     const int mirror = side == 0 ? m : b - 1 - m;
+    const int next = side == 0 ? 1 : b - 2;  // the second interior cell (quadratic closure)
+    const bool quadratic = m == 0 && b >= 2;
+    // Offsets of the slab's (t1, t2) = (0, 0) cells; the rest by the strides.
+    const auto g0 = along(d, ghost, 0, 0), m0 = along(d, mirror, 0, 0), n0 = along(d, next, 0, 0);
+    const std::ptrdiff_t og = L.index(g0[0], g0[1], g0[2]), om = L.index(m0[0], m0[1], m0[2]),
+                         on = L.index(n0[0], n0[1], n0[2]);
     for (int t2 = -width; t2 < b + width; ++t2) {
       for (int t1 = -width; t1 < b + width; ++t1) {
-        const auto g = along(d, ghost, t1, t2);
-        const auto s = along(d, mirror, t1, t2);
-        const double inner = data[L.index(s[0], s[1], s[2])];
-        double& out = data[L.index(g[0], g[1], g[2])];
+        const std::ptrdiff_t t = t1 * s1 + t2 * s2;
+        const double inner = data[om + t];
+        double& out = data[og + t];
         if (kind == BcKind::Neumann) {
           out = inner;
         } else if (value == nullptr) {
           out = -inner;  // homogeneous (multigrid corrections): linear closure
-        } else if (!*value) {
-          if (m == 0 && b >= 2) {
-            const auto s1 = along(d, side == 0 ? 1 : b - 2, t1, t2);
-            out = (-6.0 * inner + data[L.index(s1[0], s1[1], s1[2])]) / 3.0;
-          } else {
-            out = -inner;
-          }
         } else {
-          Vec3 x = block.lower;
-          for (int e = 0; e < 3; ++e) {
-            x[e] += (static_cast<double>(s[static_cast<std::size_t>(e)]) + 0.5) * h;
+          double g = 0.0;
+          if (given) {
+            Vec3 x = block.lower;
+            x[e1] += (t1 + 0.5) * h;
+            x[e2] += (t2 + 0.5) * h;
+            x[d] += side == 0 ? 0.0 : block.length;
+            g = (*value)(x);
           }
-          x[d] = block.lower[d] + (side == 0 ? 0.0 : block.length);
-          const double g = (*value)(x);
-          if (m == 0 && b >= 2) {
-            // Quadratic through the face value and the two first cells:
-            // exact for parabolic profiles (third-order boundary closure).
-            const auto s1 = along(d, side == 0 ? 1 : b - 2, t1, t2);
-            const double next = data[L.index(s1[0], s1[1], s1[2])];
-            out = (8.0 * g - 6.0 * inner + next) / 3.0;
-          } else {
-            out = 2.0 * g - inner;
-          }
+          // Quadratic through the face value and the two first cells: exact
+          // for parabolic profiles (third-order boundary closure).
+          out = quadratic ? (8.0 * g - 6.0 * inner + data[on + t]) / 3.0 : 2.0 * g - inner;
         }
       }
     }

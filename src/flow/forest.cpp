@@ -253,11 +253,11 @@ void Forest::exchange(std::span<BlockField* const> fields, int width) const {
             double* dst = fields[f]->block(blk);
             if (nb.link == Link::Local) {
               const double* src = fields[f]->block(nb.index);
+              const int row = rx.end - rx.begin;
               for (int k = rz.begin; k < rz.end; ++k)
                 for (int j = ry.begin; j < ry.end; ++j)
-                  for (int i = rx.begin; i < rx.end; ++i)
-                    dst[layout.index(i, j, k)] =
-                        src[layout.index(i + rx.shift, j + ry.shift, k + rz.shift)];
+                  std::copy_n(src + layout.index(rx.begin + rx.shift, j + ry.shift, k + rz.shift),
+                              row, dst + layout.index(rx.begin, j, k));
             } else {
               const double* src =
                   remote.data() + static_cast<std::size_t>(nb.index) * per_block + f * packed;

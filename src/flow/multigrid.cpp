@@ -79,6 +79,7 @@ Multigrid::Multigrid(const Forest& forest, const std::array<BcKind, 6>& kinds)
     level.active = BlockField(n, b);
     levels_.push_back(std::move(level));
   }
+  shifted_rhs_ = BlockField(n, forest.block_cells());
   set_coefficients(nullptr, nullptr);
 }
 
@@ -513,7 +514,7 @@ MultigridReport Multigrid::solve(BlockField& x, const BlockField& rhs, const Sca
   post_sweeps_ = options.post_sweeps;
   omega_ = options.relaxation;
   const BlockField* source = &rhs;
-  BlockField shifted;
+  BlockField& shifted = shifted_rhs_;
   const int b = rhs.cells();
   const BlockField& active = levels_.front().active;
   auto shift_interior = [&](BlockField& f, double by) {
@@ -525,7 +526,7 @@ MultigridReport Multigrid::solve(BlockField& x, const BlockField& rhs, const Sca
   };
   if (singular_) {
     // Compatibility: a singular problem only has a solution for a zero-mean rhs.
-    shifted = rhs;
+    shifted.raw().assign(rhs.raw().begin(), rhs.raw().end());  // reuses the buffer
     shift_interior(shifted, mean(rhs));
     source = &shifted;
   }

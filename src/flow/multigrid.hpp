@@ -105,6 +105,7 @@ class Multigrid {
   std::vector<double> coarse_active_;
   std::array<std::vector<double>, 3> coarse_beta_;  ///< (n_d + 1) faces along d
   double coarse_h_ = 1.0;
+  BlockField shifted_rhs_;  ///< zero-mean copy of the rhs of singular problems
   int pre_sweeps_ = 2;
   int post_sweeps_ = 2;
   double omega_ = 1.0;

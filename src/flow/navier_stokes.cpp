@@ -401,8 +401,9 @@ void NavierStokes::advect(double dt) {
     const Block& block = forest_.block(blk);
     const double h = block.length / b;
     const std::array<const double*, 3> uf{uf_[0].block(blk), uf_[1].block(blk), uf_[2].block(blk)};
-    std::array<std::vector<double>, 3> flux;
-    for (auto& fl : flux) fl.assign(static_cast<std::size_t>(L.size()), 0.0);
+    // Face fluxes of one block, per direction: scratch kept per thread.
+    thread_local std::array<std::vector<double>, 3> flux;
+    for (auto& fl : flux) fl.resize(static_cast<std::size_t>(L.size()));
     for (int comp = 0; comp < 3; ++comp) {
       const double* f = u_[D(comp)].block(blk);
       const double* src = g_[D(comp)].block(blk);
