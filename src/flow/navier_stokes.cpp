@@ -38,6 +38,13 @@ inline double bcg_face_value(const double* f, const double* src, double un, doub
   return value;
 }
 
+/// Viscosity on the face between two cells: the harmonic mean, so that a
+/// viscosity jump on a face passes the shear stress exactly (layered Couette).
+inline double face_viscosity(double left, double right) {
+  const double sum = left + right;
+  return sum > 0.0 ? 2.0 * left * right / sum : 0.0;
+}
+
 /// Whether the lower (side 0) or upper (side 1) d-face of a block is on the domain boundary.
 bool on_boundary(const Block& block, int d, int side) {
   std::array<int, 3> o{0, 0, 0};
@@ -449,6 +456,16 @@ void NavierStokes::advect(double dt) {
 
 void NavierStokes::update_viscous_coefficients(double dt) {
   if (dt == viscous_dt_ && !viscosity_changed_) return;
+  if (viscosity_changed_) {
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (int blk = 0; blk < forest_.local_blocks(); ++blk) {
+      for_each_cell(forest_.block_cells(), [&](int i, int j, int k) {
+        lo = std::min(lo, mu_(blk, i, j, k));
+        hi = std::max(hi, mu_(blk, i, j, k));
+      });
+    }
+    variable_viscosity_ = forest_.max(hi) > -forest_.max(-lo);
+  }
   const int n = forest_.local_blocks();
   const int b = forest_.block_cells();
   fill_scalar_neumann(mu_, 1);
@@ -465,7 +482,7 @@ void NavierStokes::update_viscous_coefficients(double dt) {
       double* out = beta[D(d)].block(blk);
       for_each_face(b, d, [&](int i, int j, int k) {
         const std::ptrdiff_t c = L.index(i, j, k);
-        out[c] = open[c] * scale * 0.5 * (mu[c] + mu[c - s]);
+        out[c] = open[c] * scale * face_viscosity(mu[c], mu[c - s]);
       });
     }
     if (!has_solids_) return;
@@ -486,6 +503,41 @@ void NavierStokes::update_viscous_coefficients(double dt) {
   viscous_mg_.set_coefficients(&alpha, &beta);
   viscous_dt_ = dt;
   viscosity_changed_ = false;
+}
+
+void NavierStokes::add_transpose_stress(double dt) {
+  // eq. 4.1: the part div(mu grad u^T) of the viscous stress, explicit with
+  // u^n (its ghosts are still filled), added to u*: for component i,
+  // (1/h) sum_j [mu (du_j/dx_i)] over the j-faces of the cell. It vanishes
+  // for uniform mu (then div(grad u^T) = grad div u = 0) and is skipped there.
+  const int b = forest_.block_cells();
+  const BlockLayout L = u_[0].layout();
+  const double factor = dt / fluid_.density;
+  forest_.for_each_block([&](int blk) {
+    const double h = forest_.block(blk).length / b;
+    const double* mu = mu_.block(blk);
+    for (int i = 0; i < 3; ++i) {
+      const std::ptrdiff_t si = L.stride(i);
+      double* out = scratch_[D(i)].block(blk);
+      for_each_cell(b, [&](int x, int y, int z) {
+        const std::ptrdiff_t c = L.index(x, y, z);
+        double sum = 0.0;
+        for (int j = 0; j < 3; ++j) {
+          const std::ptrdiff_t sj = L.stride(j);
+          const double* uj = u_[D(j)].block(blk);
+          const double* open = open_[D(j)].block(blk);
+          // du_j/dx_i on the lower (at c) and upper (at c + sj) j-faces.
+          auto gradient = [&](std::ptrdiff_t f) {
+            if (i == j) return (uj[f] - uj[f - sj]) / h;
+            return ((uj[f + si] - uj[f - si]) + (uj[f - sj + si] - uj[f - sj - si])) / (4.0 * h);
+          };
+          sum += open[c + sj] * face_viscosity(mu[c + sj], mu[c]) * gradient(c + sj) -
+                 open[c] * face_viscosity(mu[c], mu[c - sj]) * gradient(c);
+        }
+        out[c] += factor * sum / h;
+      });
+    }
+  });
 }
 
 void NavierStokes::viscous_step(double dt, StepReport& report) {
@@ -509,8 +561,8 @@ void NavierStokes::viscous_step(double dt, StepReport& report) {
             const std::ptrdiff_t s = L.stride(d);
             const double open_lo = open_[D(d)].block(blk)[c];
             const double open_hi = open_[D(d)].block(blk)[c + s];
-            lap += open_hi * 0.5 * (mu[c + s] + mu[c]) * (u[c + s] - u[c]) -
-                   open_lo * 0.5 * (mu[c] + mu[c - s]) * (u[c] - u[c - s]);
+            lap += open_hi * face_viscosity(mu[c + s], mu[c]) * (u[c + s] - u[c]) -
+                   open_lo * face_viscosity(mu[c], mu[c - s]) * (u[c] - u[c - s]);
             // No-slip faces of solid neighbours: 2 mu (0 - u)/h.
             if (solid_.block(blk)[c] == 0.0) lap -= (2.0 - open_lo - open_hi) * 2.0 * mu[c] * u[c];
           }
@@ -520,6 +572,7 @@ void NavierStokes::viscous_step(double dt, StepReport& report) {
     });
   }
   update_viscous_coefficients(dt);
+  if (variable_viscosity_) add_transpose_stress(dt);
   for (int comp = 0; comp < 3; ++comp) {
     BlockField& rhs = scratch_[D(comp)];
     BlockField& u = u_[D(comp)];

@@ -21,8 +21,9 @@
 //   5. projection (Chorin 1968): div((dt/rho) grad p) = div uf,
 //      uf -= (dt/rho) grad p, g = cell average of (a - grad p / rho),
 //      u = u** + dt g.
-// The term div(mu grad u^T) vanishes for uniform mu and is not yet included
-// for variable mu (see docs/theory/flow.md).
+// The term div(mu grad u^T) vanishes for uniform mu; for variable mu it is
+// added explicitly (with u^n) to the right-hand side of the viscous step.
+// Face viscosities are harmonic means of the two cells.
 
 #include <array>
 #include <cstdint>
@@ -134,6 +135,7 @@ class NavierStokes {
   void fill_scalar_neumann(BlockField& f, int width);
   void update_viscous_coefficients(double dt);
   void close_solid_faces(FaceField& uf) const;
+  void add_transpose_stress(double dt);
   void clear_solid_cells(VectorField& u) const;
 
   const Forest& forest_;
@@ -159,7 +161,8 @@ class NavierStokes {
   double viscous_dt_ = -1.0;  ///< dt the viscous coefficients were built for
   bool viscosity_changed_ = true;
   bool has_solids_ = false;
-  BlockField solid_;  ///< 1 in solid cells, 0 in fluid cells
+  bool variable_viscosity_ = false;  ///< mu not uniform: the grad u^T stress is added
+  BlockField solid_;                 ///< 1 in solid cells, 0 in fluid cells
   FaceField
       open_;  ///< 1 on faces between two fluid cells (or fluid and the domain boundary), else 0
   MultigridReport pressure_report_;

@@ -79,6 +79,51 @@ TEST(FlowNavierStokes, TaylorGreenVortexConvergesAtSecondOrder) {
   EXPECT_GT(std::log2(e32 / e64), 1.8);
 }
 
+/// The 3D Arnold-Beltrami-Childress flow on the periodic unit cube, an exact
+/// decaying Navier-Stokes solution (u x curl u = 0: the advection is a
+/// pressure gradient): max velocity error at t_end with dt = h/5.
+double abc_flow_error(int cells, double nu, double t_end) {
+  ForestSpec spec;
+  spec.level = cells == 16 ? 1 : 2;
+  spec.periodic = {true, true, true};
+  const Forest forest(spec);
+  NavierStokesOptions options;
+  options.viscous_theta = 0.5;
+  options.pressure.tolerance = 1e-10;
+  options.viscous.tolerance = 1e-10;
+  NavierStokes ns(forest, all_periodic(), Fluid{1.0, nu}, options);
+  auto exact = [nu](const Vec3& x, double t) {
+    const double k = 2 * kPi, decay = std::exp(-k * k * nu * t);
+    return Vec3{std::sin(k * x.z) + std::cos(k * x.y), std::sin(k * x.x) + std::cos(k * x.z),
+                std::sin(k * x.y) + std::cos(k * x.x)} *
+           decay;
+  };
+  ns.set_velocity([&](const Vec3& x) { return exact(x, 0.0); });
+  const int steps = static_cast<int>(std::lround(t_end * cells * 5.0));
+  for (int s = 0; s < steps; ++s) ns.step(t_end / steps);
+  double error = 0.0;
+  const int b = forest.block_cells();
+  for (int blk = 0; blk < forest.local_blocks(); ++blk)
+    for (int k = 0; k < b; ++k)
+      for (int j = 0; j < b; ++j)
+        for (int i = 0; i < b; ++i) {
+          const Vec3 e = exact(cell_centre(forest, blk, i, j, k), ns.time());
+          for (int c = 0; c < 3; ++c)
+            error = std::max(error, std::abs(ns.velocity()[c](blk, i, j, k) - e[c]));
+        }
+  return forest.max(error);
+}
+
+TEST(FlowNavierStokes, ThreeDimensionalBeltramiFlowConvergesAtSecondOrder) {
+  const double e16 = abc_flow_error(16, 0.05, 0.1);
+  const double e32 = abc_flow_error(32, 0.05, 0.1);
+  std::printf(
+      "ABC (Beltrami) flow 3D (nu 0.05, t 0.1, dt = h/5): max error 16^3 %.3e, 32^3 %.3e, order "
+      "%.2f\n",
+      e16, e32, std::log2(e16 / e32));
+  EXPECT_GT(std::log2(e16 / e32), 1.8);
+}
+
 /// Mean over x and z of u_x at cell row j of the channel (y cells = 16).
 std::vector<double> profile(const Forest& forest, const NavierStokes& ns, int rows) {
   std::vector<double> sum(static_cast<std::size_t>(rows), 0.0),
@@ -160,6 +205,30 @@ TEST(FlowNavierStokes, CouetteAtReynolds0p01IsExactlyLinearAndStable) {
       worst, vmax);
   EXPECT_LT(worst, 1e-9);
   EXPECT_LT(forest.max(vmax), 1e-10);
+}
+
+TEST(FlowNavierStokes, TwoLayerCouetteWithAViscosityJumpIsExact) {
+  // mu = 1 below y = 0.5, 4 above (the jump on a face); lid U = 1 at y = 1.
+  // Steady: uniform shear stress tau = U / (0.5/1 + 0.5/4) = 1.6, u piecewise linear.
+  const Forest forest = make_channel_forest();
+  NavierStokesOptions options;
+  options.dt_max = 0.01;
+  options.pressure.tolerance = 1e-10;
+  options.viscous.tolerance = 1e-10;
+  NavierStokes ns(forest, channel(1.0), Fluid{1.0, 1.0}, options);
+  ns.set_viscosity([](const Vec3& x) { return x.y < 0.5 ? 1.0 : 4.0; });
+  ns.set_velocity([](const Vec3&) { return Vec3{}; });
+  for (int s = 0; s < 400; ++s) ns.step(ns.stable_dt());
+  const auto u = profile(forest, ns, 16);
+  const double tau = 1.6;
+  double worst = 0.0;
+  for (int j = 0; j < 16; ++j) {
+    const double y = (j + 0.5) / 16.0;
+    const double exact = y < 0.5 ? tau * y : tau * 0.5 + tau * (y - 0.5) / 4.0;
+    worst = std::max(worst, std::abs(u[static_cast<std::size_t>(j)] - exact));
+  }
+  std::printf("two-layer Couette (viscosity ratio 4): max deviation %.2e\n", worst);
+  EXPECT_LT(worst, 1e-8);
 }
 
 /// Channel of height 1 between two solid slabs (cell masks) in a periodic box
