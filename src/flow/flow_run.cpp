@@ -82,7 +82,13 @@ FlowRunSummary run_flow_case(const FlowCase& c, const FlowRunOptions& options,
   const fs::path checkpoint = checkpoint_path(dir, forest);
   const fs::path csv_path = dir / "diagnostics.csv";
   if (options.restart && !fs::exists(checkpoint)) {
-    throw InputError(checkpoint.string(), "", "no checkpoint to restart from");
+    const bool other_ranks =
+        fs::exists(dir / "checkpoint_r0.bin") || fs::exists(dir / "checkpoint.bin");
+    throw InputError(checkpoint.string(), "",
+                     other_ranks
+                         ? "no checkpoint for this number of ranks (restart with the mpirun -np "
+                           "of the run that wrote the checkpoint)"
+                         : "no checkpoint to restart from");
   }
   NavierStokes ns(forest, c.boundaries, c.fluid, c.options);
   ns.set_body_force([&](const Vec3&) { return c.body_force; });
@@ -174,7 +180,7 @@ FlowRunSummary run_flow_case(const FlowCase& c, const FlowRunOptions& options,
         save_flow_checkpoint(checkpoint, ns, steps, frames);
         next_checkpoint += c.checkpoint_interval;
       }
-      if (!options.quiet && (steps & 15) == 0) {
+      if (root && !options.quiet && (steps & 15) == 0) {
         char status[128];
         std::snprintf(status, sizeof status, "t = %.4g / %.4g s, dt %.3g s", ns.time(), end, dt);
         progress.update(ns.time() / end, status, cells * static_cast<double>(steps - first_step));
@@ -200,7 +206,7 @@ FlowRunSummary run_flow_case(const FlowCase& c, const FlowRunOptions& options,
                ? cells * static_cast<double>(summary.steps) / summary.wall_seconds
                : 0.0)
        << " cell-updates/s)";
-  progress.finish(done.str());
+  if (root) progress.finish(done.str());
   if (root) {
     log << done.str() << "\n";
     console << "outputs:\n"

@@ -23,8 +23,9 @@ averaged over the cells next to each centre line (the line runs along cell
 faces for even cell counts: the average of the 2 x 2 neighbouring columns is
 the bilinear interpolation there).
 
-Writes validation/flow/results/cavity.json and .csv and
-docs/validation/figures/flow_cavity_re100.png. Exits 1 if a check fails.
+Writes validation/flow/results/cavity.json and .csv,
+docs/validation/figures/flow_cavity_re100.png (profiles) and
+flow_cavity_re100_slice.png (the 3D mid-plane). Exits 1 if a check fails.
 
 Usage: /usr/bin/python3 validation/flow/cavity.py [--build build] [--fine] [--replot]
 """
@@ -43,6 +44,7 @@ ROOT = Path(__file__).resolve().parents[2]
 RESULTS = ROOT / "validation" / "flow" / "results"
 RUNS = RESULTS / "runs"
 FIGURE = ROOT / "docs" / "validation" / "figures" / "flow_cavity_re100.png"
+SLICE = ROOT / "docs" / "validation" / "figures" / "flow_cavity_re100_slice.png"
 
 # Ghia, Ghia & Shin (1982), Re = 100: Table I (u on x = 0.5), Table II (v on y = 0.5).
 GHIA_U = np.array([
@@ -127,6 +129,37 @@ def last_frame(name):
     return frames[-1]
 
 
+def draw_slice(name):
+    """The mid-plane z = 0.5 of a 3D run: speed and in-plane streamlines (PNG)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    centres, arrays = read_vtu(last_frame(name))
+    h = np.min(np.diff(np.unique(np.round(centres[:, 0], 12))))
+    n = int(round(1.0 / h))
+    mask = np.abs(centres[:, 2] - 0.5) < 0.6 * h  # the two cell layers beside z = 0.5
+    ix = np.floor(centres[mask, 0] / h).astype(int)
+    iy = np.floor(centres[mask, 1] / h).astype(int)
+    u = np.zeros((n, n)); v = np.zeros((n, n)); vort = np.zeros((n, n)); count = np.zeros((n, n))
+    np.add.at(u, (iy, ix), arrays["velocity"][mask, 0])
+    np.add.at(v, (iy, ix), arrays["velocity"][mask, 1])
+    np.add.at(vort, (iy, ix), arrays["vorticity_magnitude"][mask])
+    np.add.at(count, (iy, ix), 1.0)
+    u /= count; v /= count; vort /= count
+    x = (np.arange(n) + 0.5) * h
+    fig, ax = plt.subplots(figsize=(5.5, 5))
+    speed = np.hypot(u, v)
+    im = ax.pcolormesh(np.linspace(0, 1, n + 1), np.linspace(0, 1, n + 1), speed, cmap="viridis", shading="flat")
+    ax.streamplot(x, x, u, v, color="w", density=1.2, linewidth=0.6, arrowsize=0.6)
+    fig.colorbar(im, ax=ax, label="|(u, v)| / U")
+    ax.set_aspect("equal")
+    ax.set_xlabel("x / L")
+    ax.set_ylabel("y / L")
+    ax.set_title(f"Cavity Re = 100, {n}$^3$: mid-plane z = 0.5, t = 15 L/U")
+    fig.tight_layout()
+    fig.savefig(SLICE, dpi=120)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--build", default="build")
@@ -205,6 +238,8 @@ def main():
     fig.tight_layout()
     FIGURE.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(FIGURE, dpi=120)
+
+    draw_slice(f"cavity-3d-{sizes_3d[-1]}")
 
     ok = True
     for c, p in checks:
