@@ -207,6 +207,46 @@ TEST(FlowNavierStokes, CouetteAtReynolds0p01IsExactlyLinearAndStable) {
   EXPECT_LT(forest.max(vmax), 1e-10);
 }
 
+TEST(FlowNavierStokes, SquareDuctFlowRateMatchesTheSeriesSolutionAt16CellsAcross) {
+  // Square duct of side a = 1 (walls at y, z = 0 and 1), periodic along x,
+  // driven by a body force G: Q = 4 b c^3 G/(3 mu) [1 - 192 c/(pi^5 b)
+  // sum_{i odd} tanh(i pi b / 2c) / i^5] with b = c = a/2 (White, Viscous
+  // Fluid Flow, eq. 3-48).
+  ForestSpec spec;
+  spec.trees = {1, 2, 2};
+  spec.tree_length = 0.5;
+  spec.periodic = {true, false, false};
+  const Forest forest(spec);
+  std::array<FlowBoundary, 6> bcs{};
+  bcs[face_index(0, 0)].kind = bcs[face_index(0, 1)].kind = FlowBoundaryKind::Periodic;
+  const double G = 2.0, mu = 1.0;
+  NavierStokesOptions options;
+  options.dt_max = 0.01;
+  options.viscous.tolerance = 1e-10;
+  options.pressure.tolerance = 1e-10;
+  NavierStokes ns(forest, bcs, Fluid{1.0, mu}, options);
+  ns.set_velocity([](const Vec3&) { return Vec3{}; });
+  ns.set_body_force([G](const Vec3&) { return Vec3{G, 0.0, 0.0}; });
+  for (int s = 0; s < 200; ++s) ns.step(ns.stable_dt());  // 2 diffusion times a^2 rho / mu
+  const int b = forest.block_cells();
+  double volume_flux = 0.0;
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    const double h = forest.block(blk).length / b;
+    for (int k = 0; k < b; ++k)
+      for (int j = 0; j < b; ++j)
+        for (int i = 0; i < b; ++i) volume_flux += ns.velocity()[0](blk, i, j, k) * h * h * h;
+  }
+  const double rate = forest.sum(volume_flux) / 0.5;  // over the duct length 0.5
+  double series = 0.0;
+  for (int i = 1; i < 200; i += 2) series += std::tanh(i * kPi / 2.0) / std::pow(i, 5);
+  const double half = 0.5;
+  const double exact =
+      4.0 * half * half * half * half * G / (3.0 * mu) * (1.0 - 192.0 / std::pow(kPi, 5) * series);
+  std::printf("square duct, 16 x 16 cells: flow rate %.6f, series %.6f, relative error %.2e\n",
+              rate, exact, rate / exact - 1.0);
+  EXPECT_LT(std::abs(rate / exact - 1.0), 5e-3);
+}
+
 TEST(FlowNavierStokes, TwoLayerCouetteWithAViscosityJumpIsExact) {
   // mu = 1 below y = 0.5, 4 above (the jump on a face); lid U = 1 at y = 1.
   // Steady: uniform shear stress tau = U / (0.5/1 + 0.5/4) = 1.6, u piecewise linear.
