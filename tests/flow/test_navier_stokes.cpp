@@ -247,6 +247,24 @@ TEST(FlowNavierStokes, SquareDuctFlowRateMatchesTheSeriesSolutionAt16CellsAcross
   EXPECT_LT(std::abs(rate / exact - 1.0), 5e-3);
 }
 
+TEST(FlowNavierStokes, OpenMpThreadsOverBlocksGiveTheSameResultBitForBit) {
+  auto run = [](int threads) {
+    ForestSpec spec;
+    spec.level = 1;  // 16^3 cells in 8 blocks
+    spec.threads = threads;
+    const Forest forest(spec);
+    std::array<FlowBoundary, 6> bcs{};
+    bcs[face_index(1, 1)].wall_velocity = {1.0, 0.0, 0.0};
+    NavierStokes ns(forest, bcs, Fluid{1.0, 0.01});
+    ns.set_velocity([](const Vec3&) { return Vec3{}; });
+    for (int s = 0; s < 5; ++s) ns.step(0.02);
+    return std::array<std::vector<double>, 2>{ns.velocity()[0].raw(), ns.pressure().raw()};
+  };
+  const auto one = run(1), two = run(2);
+  EXPECT_EQ(one[0], two[0]);
+  EXPECT_EQ(one[1], two[1]);
+}
+
 TEST(FlowNavierStokes, TwoLayerCouetteWithAViscosityJumpIsExact) {
   // mu = 1 below y = 0.5, 4 above (the jump on a face); lid U = 1 at y = 1.
   // Steady: uniform shear stress tau = U / (0.5/1 + 0.5/4) = 1.6, u piecewise linear.
