@@ -6,7 +6,7 @@ Runs cases/flow/cavity-re100.toml (unit cube, lid y = 1 moving along x at
 validation/flow/results/runs/:
 
 * 2D: the cavity in the x-y plane, periodic in z (one block of 8 cells thick),
-  at 32^2 and 64^2 cells (128^2 with --fine). Compared with Ghia, Ghia & Shin
+  at 32^2 and 64^2 cells (96^2 with --fine). Compared with Ghia, Ghia & Shin
   (1982), J. Comput. Phys. 48:387, Tables I and II (Re = 100, 129^2 multigrid
   vorticity-stream function solution): u on the vertical centre line x = 0.5,
   v on the horizontal one y = 0.5. Check: the largest difference at the Ghia
@@ -155,7 +155,7 @@ def draw_slice(name):
     ax.set_aspect("equal")
     ax.set_xlabel("x / L")
     ax.set_ylabel("y / L")
-    ax.set_title(f"Cavity Re = 100, {n}$^3$: mid-plane z = 0.5, t = 15 L/U")
+    ax.set_title(f"Re = 100, {n}$^3$, plane z = 0.5, t = 15 L/U")
     fig.tight_layout()
     fig.savefig(SLICE, dpi=120)
 
@@ -163,12 +163,12 @@ def draw_slice(name):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--build", default="build")
-    parser.add_argument("--fine", action="store_true", help="also 128^2 and 48^3")
+    parser.add_argument("--fine", action="store_true", help="also 96^2 and 48^3")
     parser.add_argument("--replot", action="store_true", help="use the runs on disk")
     args = parser.parse_args()
     sanguis = (ROOT / args.build / "app" / "sanguis").resolve()
     case_text = (ROOT / "cases" / "flow" / "cavity-re100.toml").read_text()
-    sizes_2d = [32, 64] + ([128] if args.fine else [])
+    sizes_2d = [32, 64] + ([96] if args.fine else [])
     sizes_3d = [16, 32] + ([48] if args.fine else [])
 
     results = {"2d": {}, "3d": {}}
