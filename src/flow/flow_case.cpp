@@ -167,6 +167,13 @@ FlowCase load_flow_case(const ConfigTable& cfg, const std::filesystem::path& sou
 
   c.initial_velocity = flow.get_vec3("initial_velocity_m_s", {});
   c.body_force = flow.get_vec3("body_force_N_m3", {});
+  for (const ConfigTable& box : flow.table_array("solid")) {
+    const Vec3 lo = box.get_vec3("min_m"), hi = box.get_vec3("max_m");
+    for (int d = 0; d < 3; ++d) {
+      if (!(hi[d] > lo[d])) box.fail("max_m", "must be above min_m in x, y and z");
+    }
+    c.solid_boxes.push_back({lo, hi});
+  }
 
   const auto time = flow.find_table("time");
   if (time) {
@@ -218,8 +225,12 @@ std::string describe(const FlowCase& c) {
       << "\n";
   s << "initial velocity (" << c.initial_velocity.x << ", " << c.initial_velocity.y << ", "
     << c.initial_velocity.z << ") m/s; body force (" << c.body_force.x << ", " << c.body_force.y
-    << ", " << c.body_force.z << ") N/m3\n"
-    << "time: end " << c.end_time << " s, cfl " << c.options.cfl << ", max step "
+    << ", " << c.body_force.z << ") N/m3\n";
+  for (const auto& box : c.solid_boxes) {
+    s << "solid box (" << box[0].x << ", " << box[0].y << ", " << box[0].z << ") - (" << box[1].x
+      << ", " << box[1].y << ", " << box[1].z << ") m\n";
+  }
+  s << "time: end " << c.end_time << " s, cfl " << c.options.cfl << ", max step "
     << c.options.dt_max << " s, viscous theta " << c.options.viscous_theta << "\n"
     << "multigrid: tolerance " << c.options.pressure.tolerance << " (relative to the rhs), at most "
     << c.options.pressure.max_cycles << " V(" << c.options.pressure.pre_sweeps << ","

@@ -7,6 +7,7 @@
 #include <array>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "core/config.hpp"
 #include "flow/navier_stokes.hpp"
@@ -23,8 +24,10 @@ struct FlowCase {
   std::array<std::string, 6> boundary_text;  ///< as read, for the log
   Fluid fluid;
   NavierStokesOptions options;
-  Vec3 initial_velocity{};           ///< uniform initial velocity (m/s)
-  Vec3 body_force{};                 ///< uniform body force density (N/m^3)
+  Vec3 initial_velocity{};  ///< uniform initial velocity (m/s)
+  Vec3 body_force{};        ///< uniform body force density (N/m^3)
+  /// Solid boxes [min, max] (m): cells whose centre lies inside are solid.
+  std::vector<std::array<Vec3, 2>> solid_boxes;
   double output_interval = 0.0;      ///< (s)
   bool vtk = true;                   ///< write ParaView files
   double checkpoint_interval = 0.0;  ///< (s), 0: only at the end

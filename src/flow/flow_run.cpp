@@ -91,6 +91,17 @@ FlowRunSummary run_flow_case(const FlowCase& c, const FlowRunOptions& options,
                          : "no checkpoint to restart from");
   }
   NavierStokes ns(forest, c.boundaries, c.fluid, c.options);
+  if (!c.solid_boxes.empty()) {
+    ns.set_solid([&](const Vec3& x) {
+      for (const auto& box : c.solid_boxes) {
+        if (x.x > box[0].x && x.x < box[1].x && x.y > box[0].y && x.y < box[1].y &&
+            x.z > box[0].z && x.z < box[1].z) {
+          return true;
+        }
+      }
+      return false;
+    });
+  }
   ns.set_body_force([&](const Vec3&) { return c.body_force; });
   std::int64_t steps = 0, frames = 0;
   if (options.restart) {

@@ -66,6 +66,11 @@ void expect_input_error(const std::string& text, const std::string& fragment) {
   }
 }
 
+std::string read_bytes(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
 TEST(FlowCase, ValidCaseResolvesGridBoundariesAndFluid) {
   const FlowCase c = parse(kChannel);
   EXPECT_EQ(c.name, "channel");
@@ -79,6 +84,30 @@ TEST(FlowCase, ValidCaseResolvesGridBoundariesAndFluid) {
   EXPECT_DOUBLE_EQ(c.boundaries[face_index(1, 1)].wall_velocity.x, 0.5);
   EXPECT_DOUBLE_EQ(c.body_force.x, 2.0);
   EXPECT_DOUBLE_EQ(c.options.dt_max, 0.005);
+}
+
+TEST(FlowCase, SolidBoxesAreReadAndRun) {
+  const std::string text = kChannel + R"(
+[[flow.solid]]
+min_m = [0.0, 0.4, 0.0]
+max_m = [0.25, 0.6, 0.5]
+)";
+  const FlowCase c = parse(text);
+  ASSERT_EQ(c.solid_boxes.size(), 1u);
+  EXPECT_DOUBLE_EQ(c.solid_boxes[0][1].y, 0.6);
+  expect_input_error(replaced(text, "max_m = [0.25, 0.6, 0.5]", "max_m = [0.25, 0.3, 0.5]"),
+                     "flow.solid[0].max_m");
+  const auto dir = std::filesystem::temp_directory_path() / "sanguis_flow_solid_test";
+  std::filesystem::remove_all(dir);
+  FlowRunOptions options;
+  options.output_dir = dir;
+  options.quiet = true;
+  std::ostringstream console;
+  const auto summary = run_flow_case(c, options, console);
+  EXPECT_NEAR(summary.simulated_time, 0.04, 1e-12);
+  const std::string log = read_bytes(dir / "run.log");
+  EXPECT_NE(log.find("solid box"), std::string::npos);
+  std::filesystem::remove_all(dir);
 }
 
 TEST(FlowCaseErrors, UnknownKeysNonCubicCellsAndOneSidedPeriodicityAreErrors) {
@@ -95,11 +124,6 @@ TEST(FlowCaseErrors, UnknownKeysNonCubicCellsAndOneSidedPeriodicityAreErrors) {
   expect_input_error(replaced(kChannel, "type = \"wall\" }", "type = \"wal\" }"), "y_min.type");
   expect_input_error(replaced(kChannel, "interval_s = 0.01", "interval_s = 0.01\nsnapshots = 3"),
                      "snapshots");
-}
-
-std::string read_bytes(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 TEST(FlowRun, WritesFramesDiagnosticsAndRestartsBitForBit) {
