@@ -208,7 +208,7 @@ Range ghost_range(int o, int b, int width) {
 
 }  // namespace
 
-void Forest::exchange(std::span<BlockField* const> fields, int width) const {
+void Forest::exchange(std::span<BlockField* const> fields, int width, bool faces_only) const {
   if (fields.empty()) return;
   const BlockLayout layout = fields[0]->layout();
   const int b = layout.cells;
@@ -243,7 +243,8 @@ void Forest::exchange(std::span<BlockField* const> fields, int width) const {
     for (int oz = -1; oz <= 1; ++oz) {
       for (int oy = -1; oy <= 1; ++oy) {
         for (int ox = -1; ox <= 1; ++ox) {
-          if (ox == 0 && oy == 0 && oz == 0) continue;
+          const int nonzero = (ox != 0) + (oy != 0) + (oz != 0);
+          if (nonzero == 0 || (faces_only && nonzero > 1)) continue;
           const Neighbour nb =
               block.neighbours[static_cast<std::size_t>(neighbour_slot(ox, oy, oz))];
           if (nb.link == Link::Boundary) continue;

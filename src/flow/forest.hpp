@@ -90,10 +90,12 @@ class Forest {
   /// `width` <= min(kGhost, b) of the block) with copies of that block's
   /// interior, for all the given fields (same b). Boundary ghosts are left
   /// for boundary.hpp.
-  void exchange(std::span<BlockField* const> fields, int width) const;
-  void exchange(BlockField& field, int width) const {
+  /// With `faces_only` the edge and corner ghosts are left as they are
+  /// (7-point stencils read face ghosts only).
+  void exchange(std::span<BlockField* const> fields, int width, bool faces_only = false) const;
+  void exchange(BlockField& field, int width, bool faces_only = false) const {
     BlockField* one[] = {&field};
-    exchange(one, width);
+    exchange(one, width, faces_only);
   }
 
   /// Runs body(b) for every local block, on the forest's OpenMP threads.

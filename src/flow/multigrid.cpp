@@ -335,9 +335,10 @@ void Multigrid::coarse_solve() {
   }
 }
 
-void Multigrid::fill_ghosts(int level, BlockField& x, const ScalarBoundary* bc) const {
+void Multigrid::fill_ghosts(int level, BlockField& x, const ScalarBoundary* bc,
+                            bool faces_only) const {
   (void)level;
-  forest_.exchange(x, 1);
+  forest_.exchange(x, 1, faces_only);
   if (bc) {
     fill_boundary_ghosts(forest_, x, *bc, 1, false);
   } else {
@@ -353,7 +354,7 @@ void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const Sc
   const std::array<std::ptrdiff_t, 3> s{L.stride(0), L.stride(1), L.stride(2)};
   for (int sweep = 0; sweep < sweeps; ++sweep) {
     for (int colour = 0; colour < 2; ++colour) {
-      fill_ghosts(level, x, bc);
+      fill_ghosts(level, x, bc, true);  // the 7-point stencil reads face ghosts only
       forest_.for_each_block([&](int blk) {
         const Block& block = forest_.block(blk);
         const double h = block.length / b;
@@ -409,7 +410,7 @@ void Multigrid::compute_residual(int level, BlockField& x, const BlockField& rhs
   const BlockLayout L = x.layout();
   const int b = L.cells;
   const std::array<std::ptrdiff_t, 3> s{L.stride(0), L.stride(1), L.stride(2)};
-  fill_ghosts(level, x, bc);
+  fill_ghosts(level, x, bc, true);
   forest_.for_each_block([&](int blk) {
     const double h = forest_.block(blk).length / b;
     const double inv_h2 = 1.0 / (h * h);

@@ -81,7 +81,8 @@ class Multigrid {
     FaceField beta;
     BlockField active;  ///< 1 where the cell takes part (some open face or alpha > 0), else 0
   };
-  void fill_ghosts(int level, BlockField& x, const ScalarBoundary* bc) const;
+  void fill_ghosts(int level, BlockField& x, const ScalarBoundary* bc,
+                   bool faces_only = false) const;
   void smooth(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc,
               int sweeps);
   void compute_residual(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc,
