@@ -254,11 +254,14 @@ void Forest::exchange(std::span<BlockField* const> fields, int width, bool faces
             double* dst = fields[f]->block(blk);
             if (nb.link == Link::Local) {
               const double* src = fields[f]->block(nb.index);
-              const int row = rx.end - rx.begin;
+              const int row = rx.end - rx.begin;  // short rows: a plain loop, no memmove call
               for (int k = rz.begin; k < rz.end; ++k)
-                for (int j = ry.begin; j < ry.end; ++j)
-                  std::copy_n(src + layout.index(rx.begin + rx.shift, j + ry.shift, k + rz.shift),
-                              row, dst + layout.index(rx.begin, j, k));
+                for (int j = ry.begin; j < ry.end; ++j) {
+                  const double* from =
+                      src + layout.index(rx.begin + rx.shift, j + ry.shift, k + rz.shift);
+                  double* to = dst + layout.index(rx.begin, j, k);
+                  for (int i = 0; i < row; ++i) to[i] = from[i];
+                }
             } else {
               const double* src =
                   remote.data() + static_cast<std::size_t>(nb.index) * per_block + f * packed;
