@@ -16,17 +16,20 @@ namespace sanguis::flow {
 /// Width of the ghost layer around every block (BCG advection needs two).
 inline constexpr int kGhost = 2;
 
-/// Index arithmetic of one block of b^3 cells with ghost layers of width kGhost.
+/// Index arithmetic of one block of b^3 cells with ghost layers of width
+/// `ghost` (kGhost for the flow fields; 1 on coarse multigrid levels, whose
+/// 7-point smoother and trilinear prolongation read one layer).
 struct BlockLayout {
-  int cells = 8;  ///< cells per block edge, b
+  int cells = 8;       ///< cells per block edge, b
+  int ghost = kGhost;  ///< ghost layers on each side
 
-  [[nodiscard]] constexpr int side() const { return cells + 2 * kGhost; }
+  [[nodiscard]] constexpr int side() const { return cells + 2 * ghost; }
   [[nodiscard]] constexpr std::ptrdiff_t size() const {
     return std::ptrdiff_t{side()} * side() * side();
   }
-  /// Offset of cell (i,j,k), each in [-kGhost, b + kGhost).
+  /// Offset of cell (i,j,k), each in [-ghost, b + ghost).
   [[nodiscard]] constexpr std::ptrdiff_t index(int i, int j, int k) const {
-    return (std::ptrdiff_t{k + kGhost} * side() + (j + kGhost)) * side() + (i + kGhost);
+    return (std::ptrdiff_t{k + ghost} * side() + (j + ghost)) * side() + (i + ghost);
   }
   /// Offset between neighbouring cells along direction d.
   [[nodiscard]] constexpr std::ptrdiff_t stride(int d) const {
@@ -38,8 +41,8 @@ struct BlockLayout {
 class BlockField {
  public:
   BlockField() = default;
-  BlockField(int blocks, int cells_per_block)
-      : layout_{cells_per_block},
+  BlockField(int blocks, int cells_per_block, int ghost = kGhost)
+      : layout_{cells_per_block, ghost},
         blocks_(blocks),
         data_(static_cast<std::size_t>(blocks * layout_.size()), 0.0) {}
 
@@ -68,8 +71,9 @@ using VectorField = std::array<BlockField, 3>;
 /// Three face-centred components: component d lives on the lower d-faces.
 using FaceField = std::array<BlockField, 3>;
 
-inline VectorField make_vector_field(int blocks, int cells) {
-  return {BlockField(blocks, cells), BlockField(blocks, cells), BlockField(blocks, cells)};
+inline VectorField make_vector_field(int blocks, int cells, int ghost = kGhost) {
+  return {BlockField(blocks, cells, ghost), BlockField(blocks, cells, ghost),
+          BlockField(blocks, cells, ghost)};
 }
 
 }  // namespace sanguis::flow

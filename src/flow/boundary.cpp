@@ -72,7 +72,7 @@ void fill_face(const Block& block, BlockField& field, int blk, int d, int side, 
 
 void fill_all(const Forest& forest, BlockField& field, const std::array<BcKind, 6>& kinds,
               const std::array<FaceValue, 6>* values, int width) {
-  width = std::min({width, field.cells(), kGhost});
+  width = std::min({width, field.cells(), field.layout().ghost});
   forest.for_each_block([&](int blk) {
     const Block& block = forest.block(blk);
     for (int d = 0; d < 3; ++d) {
@@ -93,7 +93,7 @@ void fill_all(const Forest& forest, BlockField& field, const std::array<BcKind, 
 
 void fill_face_field_ghosts(const Forest& forest, FaceField& uf, int width) {
   const int b = uf[0].cells();
-  width = std::min({width, b, kGhost});
+  width = std::min({width, b, uf[0].layout().ghost});
   const BlockLayout& L = uf[0].layout();
   forest.for_each_block([&](int blk) {
     const Block& block = forest.block(blk);
@@ -119,7 +119,7 @@ void fill_face_field_ghosts(const Forest& forest, FaceField& uf, int width) {
               for (int t1 = -width; t1 < b + width; ++t1) {
                 const auto g = along(d, ghost, t1, t2);
                 const auto src = along(d, mirror, t1, t2);
-                if (g[static_cast<std::size_t>(d)] >= b + kGhost) continue;
+                if (g[static_cast<std::size_t>(d)] >= b + L.ghost) continue;
                 data[L.index(g[0], g[1], g[2])] = data[L.index(src[0], src[1], src[2])];
               }
           }

@@ -212,7 +212,7 @@ void Forest::exchange(std::span<BlockField* const> fields, int width, bool faces
   if (fields.empty()) return;
   const BlockLayout layout = fields[0]->layout();
   const int b = layout.cells;
-  width = std::min({width, b, kGhost});
+  width = std::min({width, b, layout.ghost});
   const std::size_t nf = fields.size();
   const std::size_t packed = static_cast<std::size_t>(b) * b * b;  // one field of one block
   const std::size_t per_block = nf * packed;

@@ -69,14 +69,17 @@ Multigrid::Multigrid(const Forest& forest, const std::array<BcKind, 6>& kinds)
   }
   const int n = forest.local_blocks();
   for (int b = forest.block_cells(); b >= 1; b /= 2) {
+    // The finest level shares the layout of the caller's fields; coarser
+    // ones keep the one ghost layer their smoother and prolongation read.
+    const int ghost = b == forest.block_cells() ? kGhost : 1;
     Level level;
     level.cells = b;
-    level.x = BlockField(n, b);
-    level.rhs = BlockField(n, b);
-    level.res = BlockField(n, b);
-    level.alpha = BlockField(n, b);
-    level.beta = make_vector_field(n, b);
-    level.active = BlockField(n, b);
+    level.x = BlockField(n, b, ghost);
+    level.rhs = BlockField(n, b, ghost);
+    level.res = BlockField(n, b, ghost);
+    level.alpha = BlockField(n, b, ghost);
+    level.beta = make_vector_field(n, b, ghost);
+    level.active = BlockField(n, b, ghost);
     levels_.push_back(std::move(level));
   }
   shifted_rhs_ = BlockField(n, forest.block_cells());
