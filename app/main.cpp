@@ -16,6 +16,8 @@
 #include "dem/dem_case.hpp"
 #include "dem/dem_run.hpp"
 #include "dem/parameter_procedure.hpp"
+#include "flow/flow_case.hpp"
+#include "flow/flow_run.hpp"
 
 namespace {
 
@@ -119,13 +121,30 @@ struct RunArgs {
 };
 
 int run_command(const RunArgs& args) {
-  ConfigTable config = ConfigTable::parse_file(args.case_file);
-  for (const std::string& o : args.overrides) config.set_override(o);
-  if (args.seed >= 0) config.set_override("simulation.seed=" + std::to_string(args.seed));
-  dem::DemCase c = dem::load_dem_case(config, args.case_file);
+  ConfigTable cfg = ConfigTable::parse_file(args.case_file);
+  for (const std::string& o : args.overrides) cfg.set_override(o);
   const std::string& output = args.output;
   const int threads = args.threads;
   const bool restart = args.restart, quiet = args.quiet;
+  if (flow::is_flow_case(cfg)) {
+    if (args.seed >= 0)
+      throw InputError(args.case_file, "--seed", "a flow case has no random seed");
+    flow::FlowCase fc = flow::load_flow_case(cfg, args.case_file);
+    if (threads > 0) fc.forest.threads = threads;
+    flow::FlowRunOptions options;
+    options.output_dir =
+        output.empty() ? std::filesystem::path("output") / fc.name : std::filesystem::path(output);
+    options.restart = restart;
+    options.quiet = quiet;
+    if (std::filesystem::exists(options.output_dir) &&
+        !std::filesystem::is_directory(options.output_dir)) {
+      throw InputError(options.output_dir.string(), "--output", "exists and is not a directory");
+    }
+    flow::run_flow_case(fc, options, std::cout);
+    return 0;
+  }
+  if (args.seed >= 0) cfg.set_override("simulation.seed=" + std::to_string(args.seed));
+  dem::DemCase c = dem::load_dem_case(cfg, args.case_file);
   if (threads > 0) c.setup.threads = threads;
   dem::RunOptions options;
   options.output_dir =
@@ -183,7 +202,9 @@ int main(int argc, char** argv) {
   bench::BenchOptions bo;
   std::string bench_name;
   auto* bench_cmd = app.add_subcommand("bench", "throughput benchmarks (one JSON line)");
-  bench_cmd->add_option("name", bench_name, "benchmark: dem-spheres | dem-crosses | membrane")
+  bench_cmd
+      ->add_option("name", bench_name,
+                   "benchmark: dem-spheres | dem-crosses | membrane | flow-cavity")
       ->required();
   auto* particles_opt = bench_cmd->add_option(
       "--particles", bo.particles, "number of particles (dem-spheres 32000, dem-crosses 3000)");
@@ -194,6 +215,8 @@ int main(int argc, char** argv) {
   bench_cmd->add_option("--triangles", bo.triangles, "membrane: triangles per capsule (20*4^k)")
       ->capture_default_str();
   bench_cmd->add_option("--capsules", bo.capsules, "membrane: number of capsules")
+      ->capture_default_str();
+  bench_cmd->add_option("--cells-per-side", bo.cells_per_side, "flow-cavity: cells per edge")
       ->capture_default_str();
 
   const auto run_analysis = app::add_analysis_commands(app);
@@ -223,10 +246,13 @@ int main(int argc, char** argv) {
       } else if (bench_name == "membrane") {
         if (!steps_given) bo.steps = 20;
         std::cout << bench::run_membrane(bo) << std::endl;
+      } else if (bench_name == "flow-cavity") {
+        if (!steps_given) bo.steps = 20;
+        std::cout << bench::run_flow_cavity(bo) << std::endl;
       } else {
-        throw InputError(
-            "", "bench",
-            "unknown benchmark '" + bench_name + "' (dem-spheres, dem-crosses, membrane)");
+        throw InputError("", "bench",
+                         "unknown benchmark '" + bench_name +
+                             "' (dem-spheres, dem-crosses, membrane, flow-cavity)");
       }
       return 0;
     }

@@ -2,8 +2,11 @@
 // Throughput benchmarks behind `sanguis bench NAME`. Each builds its case in code
 // (documented in bench/README.md), times the time loop only (set-up excluded, as
 // LAMMPS reports its loop time) and returns one JSON line.
+#include <array>
 #include <cstdint>
 #include <string>
+
+#include "flow/navier_stokes.hpp"
 
 namespace sanguis::bench {
 
@@ -12,8 +15,9 @@ struct BenchOptions {
   std::int64_t steps = 2000;
   int threads = 1;
   std::uint64_t seed = 4928459;
-  std::int64_t triangles = 5120;  // membrane: triangles per capsule (20 * 4^k)
-  std::int64_t capsules = 100;    // membrane: number of capsules
+  std::int64_t triangles = 5120;     // membrane: triangles per capsule (20 * 4^k)
+  std::int64_t capsules = 100;       // membrane: number of capsules
+  std::int64_t cells_per_side = 64;  // flow-cavity: cells along each edge (multiple of 8)
 };
 
 // dem-spheres: 32,000 spheres on a tilted chute, Table 2.1 contact parameters,
@@ -29,5 +33,12 @@ std::string run_dem_crosses(const BenchOptions& options);
 // deformed; one step = one force evaluation of every capsule. Reports
 // seconds_per_step (default 20 steps, after one untimed warm-up evaluation).
 std::string run_membrane(const BenchOptions& options);
+
+// flow-cavity: lid-driven cubic cavity at Re = 100, cells_per_side^3 cells,
+// dt = 0.01, multigrid tolerance 1e-3; also times V-cycles of the multigrid alone.
+std::string run_flow_cavity(const BenchOptions& options);
+
+/// Walls all round, the one at y = max moving along x (the cavity's lid).
+std::array<flow::FlowBoundary, 6> cavity_boundaries(double lid_velocity);
 
 }  // namespace sanguis::bench

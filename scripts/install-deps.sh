@@ -8,6 +8,7 @@ set -euo pipefail
 packages=(
   g++ cmake ninja-build make pkg-config
   libeigen3-dev libtomlplusplus-dev libcli11-dev libgtest-dev
+  libp4est-dev libopenmpi-dev openmpi-bin
   python3 python3-numpy python3-matplotlib
 )
 if [[ "${1:-}" == "--bench" ]]; then

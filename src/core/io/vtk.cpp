@@ -381,6 +381,43 @@ void write_point_cloud_vtu(const std::filesystem::path& path, const PointCloud& 
   });
 }
 
+void write_hex_mesh_vtu(const std::filesystem::path& path, const HexMesh& mesh) {
+  const std::size_t cell_count = mesh.cells.size();
+  std::set<std::string> names_seen;
+  check_attribute_arrays(path, "cell data", cell_count, mesh.cell_data, names_seen);
+  check_attribute_arrays(path, "cell data", cell_count, mesh.int_cell_data, names_seen);
+  const auto point_count = static_cast<std::int64_t>(mesh.points.size());
+  std::vector<std::int64_t> connectivity;
+  connectivity.reserve(8 * cell_count);
+  std::vector<std::int64_t> offsets(cell_count);
+  for (std::size_t c = 0; c < cell_count; ++c) {
+    for (const std::int64_t p : mesh.cells[c]) {
+      if (p < 0 || p >= point_count) {
+        throw std::invalid_argument(path.string() + ": hexahedron " + std::to_string(c) +
+                                    " has point index " + std::to_string(p) + " out of range");
+      }
+      connectivity.push_back(p);
+    }
+    offsets[c] = static_cast<std::int64_t>(8 * (c + 1));
+  }
+  constexpr std::uint8_t kVtkHexahedron = 12;
+  const std::vector<std::uint8_t> types(cell_count, kVtkHexahedron);
+  write_file_atomically(path, [&](std::ostream& out) {
+    write_file_header(out, "UnstructuredGrid");
+    out << "    <Piece NumberOfPoints=\"" << mesh.points.size() << "\" NumberOfCells=\""
+        << cell_count << "\">\n";
+    write_attribute_section(out, "      ", "CellData", mesh.cell_data, mesh.int_cell_data);
+    write_points(out, "      ", mesh.points);
+    out << "      <Cells>\n";
+    write_int64_array(out, "        ", "connectivity", 1, connectivity);
+    write_int64_array(out, "        ", "offsets", 1, offsets);
+    write_uint8_array(out, "        ", "types", types);
+    out << "      </Cells>\n"
+        << "    </Piece>\n";
+    write_file_footer(out, "UnstructuredGrid");
+  });
+}
+
 void write_polymesh_vtp(const std::filesystem::path& path, const PolyMesh& mesh) {
   const std::size_t point_count = mesh.points.size();
   check_cells(path, "line", mesh.lines, 2, point_count);

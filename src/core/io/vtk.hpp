@@ -17,6 +17,7 @@
 // empty or duplicate array names, out-of-range point indices) throws
 // std::invalid_argument naming the array, before anything is written.
 // I/O failures throw std::runtime_error naming the file.
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -76,6 +77,20 @@ struct PolyMesh {
 
 // Writes a PolyData (.vtp) with the mesh's lines and polygons.
 void write_polymesh_vtp(const std::filesystem::path& path, const PolyMesh& mesh);
+
+// Hexahedral cells (block-structured grids): each cell lists its 8 corner
+// point indices in VTK_HEXAHEDRON order (the lower z face counter-clockwise
+// seen from above, then the upper z face likewise). Cell data has one tuple
+// per cell.
+struct HexMesh {
+  std::vector<Vec3> points;
+  std::vector<std::array<std::int64_t, 8>> cells;
+  std::vector<DataArray> cell_data;
+  std::vector<IntDataArray> int_cell_data;
+};
+
+// Writes an UnstructuredGrid (.vtu) of VTK_HEXAHEDRON cells.
+void write_hex_mesh_vtu(const std::filesystem::path& path, const HexMesh& mesh);
 
 // A ParaView time-series index (.pvd "Collection"): opening it in ParaView
 // loads every frame listed as one data set with a time slider.

@@ -1,0 +1,79 @@
+#pragma once
+// Storage for fields on a forest of blocks: each local block holds a cube of
+// b^3 cells surrounded by ghost layers of width 2, contiguous per block (one
+// array per scalar: structure of arrays). A vector field is three scalars; a
+// face-centred field (fluxes, face velocities, face coefficients) is three
+// scalars of the same shape where component d at cell (i,j,k) is the value on
+// the *lower* d-face of that cell, so the faces 0..b of a block are the slots
+// 0..b (slot b lies in the ghost layer and equals the neighbour's face 0).
+
+#include <array>
+#include <cstddef>
+#include <vector>
+
+namespace sanguis::flow {
+
+/// Width of the ghost layer around every block (BCG advection needs two).
+inline constexpr int kGhost = 2;
+
+/// Index arithmetic of one block of b^3 cells with ghost layers of width
+/// `ghost` (kGhost for the flow fields; 1 on coarse multigrid levels, whose
+/// 7-point smoother and trilinear prolongation read one layer).
+struct BlockLayout {
+  int cells = 8;       ///< cells per block edge, b
+  int ghost = kGhost;  ///< ghost layers on each side
+
+  [[nodiscard]] constexpr int side() const { return cells + 2 * ghost; }
+  [[nodiscard]] constexpr std::ptrdiff_t size() const {
+    return std::ptrdiff_t{side()} * side() * side();
+  }
+  /// Offset of cell (i,j,k), each in [-ghost, b + ghost).
+  [[nodiscard]] constexpr std::ptrdiff_t index(int i, int j, int k) const {
+    return (std::ptrdiff_t{k + ghost} * side() + (j + ghost)) * side() + (i + ghost);
+  }
+  /// Offset between neighbouring cells along direction d.
+  [[nodiscard]] constexpr std::ptrdiff_t stride(int d) const {
+    return d == 0 ? 1 : (d == 1 ? side() : std::ptrdiff_t{side()} * side());
+  }
+};
+
+/// One scalar per cell (interior and ghosts) of every local block.
+class BlockField {
+ public:
+  BlockField() = default;
+  BlockField(int blocks, int cells_per_block, int ghost = kGhost)
+      : layout_{cells_per_block, ghost},
+        blocks_(blocks),
+        data_(static_cast<std::size_t>(blocks * layout_.size()), 0.0) {}
+
+  [[nodiscard]] const BlockLayout& layout() const { return layout_; }
+  [[nodiscard]] int cells() const { return layout_.cells; }
+  [[nodiscard]] int blocks() const { return blocks_; }
+
+  [[nodiscard]] double* block(int b) { return data_.data() + b * layout_.size(); }
+  [[nodiscard]] const double* block(int b) const { return data_.data() + b * layout_.size(); }
+
+  double& operator()(int b, int i, int j, int k) { return block(b)[layout_.index(i, j, k)]; }
+  double operator()(int b, int i, int j, int k) const { return block(b)[layout_.index(i, j, k)]; }
+
+  void fill(double value) { data_.assign(data_.size(), value); }
+  [[nodiscard]] std::vector<double>& raw() { return data_; }
+  [[nodiscard]] const std::vector<double>& raw() const { return data_; }
+
+ private:
+  BlockLayout layout_{};
+  int blocks_ = 0;
+  std::vector<double> data_;
+};
+
+/// Three cell-centred components (velocity, pressure gradient, ...).
+using VectorField = std::array<BlockField, 3>;
+/// Three face-centred components: component d lives on the lower d-faces.
+using FaceField = std::array<BlockField, 3>;
+
+inline VectorField make_vector_field(int blocks, int cells, int ghost = kGhost) {
+  return {BlockField(blocks, cells, ghost), BlockField(blocks, cells, ghost),
+          BlockField(blocks, cells, ghost)};
+}
+
+}  // namespace sanguis::flow

@@ -1,0 +1,142 @@
+#include "flow/boundary.hpp"
+
+#include <algorithm>
+
+namespace sanguis::flow {
+
+std::array<BcKind, 6> uniform_kinds(const Forest& forest, BcKind kind) {
+  std::array<BcKind, 6> kinds{};
+  for (int d = 0; d < 3; ++d) {
+    const BcKind k = forest.spec().periodic[static_cast<std::size_t>(d)] ? BcKind::Periodic : kind;
+    kinds[static_cast<std::size_t>(face_index(d, 0))] = k;
+    kinds[static_cast<std::size_t>(face_index(d, 1))] = k;
+  }
+  return kinds;
+}
+
+namespace {
+
+/// Cell (i,j,k) with the coordinate along d replaced by `n`.
+std::array<int, 3> along(int d, int n, int t1, int t2) {
+  std::array<int, 3> c{};
+  c[static_cast<std::size_t>(d)] = n;
+  c[static_cast<std::size_t>((d + 1) % 3)] = t1;
+  c[static_cast<std::size_t>((d + 2) % 3)] = t2;
+  return c;
+}
+
+void fill_face(const Block& block, BlockField& field, int blk, int d, int side, BcKind kind,
+               const FaceValue* value, int width) {
+  const BlockLayout& L = field.layout();
+  const int b = L.cells;
+  double* data = field.block(blk);
+  const double h = block.length / b;
+  const int e1 = (d + 1) % 3, e2 = (d + 2) % 3;
+  const std::ptrdiff_t s1 = L.stride(e1), s2 = L.stride(e2);
+  const bool given = value != nullptr && static_cast<bool>(*value);
+  for (int m = 0; m < width; ++m) {
+    const int ghost = side == 0 ? -1 - m : b + m;
+    const int mirror = side == 0 ? m : b - 1 - m;
+    const int next = side == 0 ? 1 : b - 2;  // the second interior cell (quadratic closure)
+    const bool quadratic = m == 0 && b >= 2;
+    // Offsets of the slab's (t1, t2) = (0, 0) cells; the rest by the strides.
+    const auto g0 = along(d, ghost, 0, 0), m0 = along(d, mirror, 0, 0), n0 = along(d, next, 0, 0);
+    const std::ptrdiff_t og = L.index(g0[0], g0[1], g0[2]), om = L.index(m0[0], m0[1], m0[2]),
+                         on = L.index(n0[0], n0[1], n0[2]);
+    for (int t2 = -width; t2 < b + width; ++t2) {
+      for (int t1 = -width; t1 < b + width; ++t1) {
+        const std::ptrdiff_t t = t1 * s1 + t2 * s2;
+        const double inner = data[om + t];
+        double& out = data[og + t];
+        if (kind == BcKind::Neumann) {
+          out = inner;
+        } else if (value == nullptr) {
+          out = -inner;  // homogeneous (multigrid corrections): linear closure
+        } else {
+          double g = 0.0;
+          if (given) {
+            Vec3 x = block.lower;
+            x[e1] += (t1 + 0.5) * h;
+            x[e2] += (t2 + 0.5) * h;
+            x[d] += side == 0 ? 0.0 : block.length;
+            g = (*value)(x);
+          }
+          // Quadratic through the face value and the two first cells: exact
+          // for parabolic profiles (third-order boundary closure).
+          out = quadratic ? (8.0 * g - 6.0 * inner + data[on + t]) / 3.0 : 2.0 * g - inner;
+        }
+      }
+    }
+  }
+}
+
+void fill_all(const Forest& forest, BlockField& field, const std::array<BcKind, 6>& kinds,
+              const std::array<FaceValue, 6>* values, int width) {
+  width = std::min({width, field.cells(), field.layout().ghost});
+  forest.for_each_block([&](int blk) {
+    const Block& block = forest.block(blk);
+    for (int d = 0; d < 3; ++d) {
+      for (int side = 0; side < 2; ++side) {
+        std::array<int, 3> o{0, 0, 0};
+        o[static_cast<std::size_t>(d)] = side == 0 ? -1 : 1;
+        const Neighbour nb =
+            block.neighbours[static_cast<std::size_t>(neighbour_slot(o[0], o[1], o[2]))];
+        if (nb.link != Link::Boundary) continue;
+        const auto f = static_cast<std::size_t>(face_index(d, side));
+        fill_face(block, field, blk, d, side, kinds[f], values ? &(*values)[f] : nullptr, width);
+      }
+    }
+  });
+}
+
+}  // namespace
+
+void fill_face_field_ghosts(const Forest& forest, FaceField& uf, int width) {
+  const int b = uf[0].cells();
+  width = std::min({width, b, uf[0].layout().ghost});
+  const BlockLayout& L = uf[0].layout();
+  forest.for_each_block([&](int blk) {
+    const Block& block = forest.block(blk);
+    for (int d = 0; d < 3; ++d) {
+      for (int side = 0; side < 2; ++side) {
+        std::array<int, 3> o{0, 0, 0};
+        o[static_cast<std::size_t>(d)] = side == 0 ? -1 : 1;
+        if (block.neighbours[static_cast<std::size_t>(neighbour_slot(o[0], o[1], o[2]))].link !=
+            Link::Boundary) {
+          continue;
+        }
+        for (int e = 0; e < 3; ++e) {
+          double* data = uf[static_cast<std::size_t>(e)].block(blk);
+          for (int m = 0; m < width; ++m) {
+            int ghost = side == 0 ? -1 - m : b + m;
+            int mirror = side == 0 ? m : b - 1 - m;
+            if (e == d) {
+              // Normal component: faces beyond the boundary face copy it.
+              if (side == 1) ++ghost;
+              mirror = side == 0 ? 0 : b;
+            }
+            for (int t2 = -width; t2 < b + width; ++t2)
+              for (int t1 = -width; t1 < b + width; ++t1) {
+                const auto g = along(d, ghost, t1, t2);
+                const auto src = along(d, mirror, t1, t2);
+                if (g[static_cast<std::size_t>(d)] >= b + L.ghost) continue;
+                data[L.index(g[0], g[1], g[2])] = data[L.index(src[0], src[1], src[2])];
+              }
+          }
+        }
+      }
+    }
+  });
+}
+
+void fill_boundary_ghosts(const Forest& forest, BlockField& field, const ScalarBoundary& bc,
+                          int width, bool homogeneous) {
+  fill_all(forest, field, bc.kind, homogeneous ? nullptr : &bc.value, width);
+}
+
+void fill_boundary_ghosts(const Forest& forest, BlockField& field,
+                          const std::array<BcKind, 6>& kinds, int width) {
+  fill_all(forest, field, kinds, nullptr, width);
+}
+
+}  // namespace sanguis::flow

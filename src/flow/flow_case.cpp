@@ -1,0 +1,242 @@
+#include "flow/flow_case.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace sanguis::flow {
+
+namespace {
+
+constexpr const char* kFaceNames[6] = {"x_min", "x_max", "y_min", "y_max", "z_min", "z_max"};
+
+std::array<int, 3> read_cells(const ConfigTable& grid) {
+  const Vec3 raw = grid.get_vec3("cells");
+  std::array<int, 3> cells{};
+  for (int d = 0; d < 3; ++d) {
+    const double v = raw[d];
+    if (v != std::floor(v) || v < 1 || v > 1 << 20) {
+      grid.fail("cells", "must be three positive integers");
+    }
+    cells[static_cast<std::size_t>(d)] = static_cast<int>(v);
+  }
+  return cells;
+}
+
+/// Brick and level: as few trees as possible (the largest common level).
+void choose_forest(const ConfigTable& grid, FlowCase& c, const Vec3& size) {
+  const int b = c.forest.block_cells;
+  for (int d = 0; d < 3; ++d) {
+    if (c.cells[static_cast<std::size_t>(d)] % b != 0) {
+      grid.fail("cells", "every count must be a multiple of block_cells = " + std::to_string(b));
+    }
+  }
+  const double h = size.x / c.cells[0];
+  for (int d = 1; d < 3; ++d) {
+    const double hd = size[d] / c.cells[static_cast<std::size_t>(d)];
+    if (std::abs(hd - h) > 1e-9 * h) {
+      grid.fail("cells", "cells must be cubes: size_m / cells must be the same in x, y and z");
+    }
+  }
+  int level = 0;
+  auto divisible = [&](int l) {
+    for (const int n : c.cells)
+      if ((n / b) % (1 << l) != 0) return false;
+    return true;
+  };
+  while (level < 10 && divisible(level + 1)) ++level;
+  c.forest.level = level;
+  for (std::size_t d = 0; d < 3; ++d) c.forest.trees[d] = c.cells[d] / b / (1 << level);
+  c.forest.tree_length = h * b * (1 << level);
+}
+
+FlowBoundary read_boundary(const ConfigTable& t, std::string& text) {
+  FlowBoundary bc;
+  const std::string type = t.get_choice("type", {"periodic", "wall", "inflow", "outflow"});
+  text = type;
+  if (type == "periodic") {
+    bc.kind = FlowBoundaryKind::Periodic;
+  } else if (type == "wall") {
+    bc.kind = FlowBoundaryKind::Wall;
+    bc.wall_velocity = t.get_vec3("velocity_m_s", {});
+    std::ostringstream s;
+    s << "wall, velocity (" << bc.wall_velocity.x << ", " << bc.wall_velocity.y << ", "
+      << bc.wall_velocity.z << ") m/s";
+    text = s.str();
+  } else if (type == "inflow") {
+    bc.kind = FlowBoundaryKind::Inflow;
+    const Vec3 u = t.get_vec3("velocity_m_s");
+    const std::string profile = t.get_choice("profile", {"uniform", "parabolic"}, "uniform");
+    std::ostringstream s;
+    s << "inflow, " << profile << ", mean velocity (" << u.x << ", " << u.y << ", " << u.z
+      << ") m/s";
+    text = s.str();
+    bc.inflow = [u](const Vec3&, double) { return u; };
+    if (profile == "parabolic") bc.inflow = nullptr;  // set once the domain is known
+    bc.wall_velocity = u;                             // the mean, for the parabolic profile
+  } else {
+    bc.kind = FlowBoundaryKind::Outflow;
+  }
+  return bc;
+}
+
+/// Parabolic inflow: 6 s (1 - s) along each non-periodic tangential direction
+/// (mean 1 per direction), times the mean velocity.
+VelocityProfile parabolic_profile(const FlowCase& c, int face) {
+  const int d = face / 2;
+  const Vec3 mean = c.boundaries[static_cast<std::size_t>(face)].wall_velocity;
+  const Vec3 lower = c.forest.origin;
+  const Vec3 extent{c.forest.trees[0] * c.forest.tree_length,
+                    c.forest.trees[1] * c.forest.tree_length,
+                    c.forest.trees[2] * c.forest.tree_length};
+  const std::array<bool, 3> periodic = c.forest.periodic;
+  return [=](const Vec3& x, double) {
+    double shape = 1.0;
+    for (int e = 0; e < 3; ++e) {
+      if (e == d || periodic[static_cast<std::size_t>(e)]) continue;
+      const double s = (x[e] - lower[e]) / extent[e];
+      shape *= 6.0 * s * (1.0 - s);
+    }
+    return shape * mean;
+  };
+}
+
+}  // namespace
+
+bool is_flow_case(const ConfigTable& cfg) {
+  return cfg.has("flow");
+}
+
+FlowCase load_flow_case(const ConfigTable& cfg, const std::filesystem::path& source) {
+  FlowCase c;
+  c.source = source;
+  const ConfigTable sim = cfg.table("simulation");
+  c.name = sim.get_string("name", source.stem().string());
+  c.end_time = sim.get_positive("end_time_s");
+  const std::int64_t threads = sim.get_int("threads", 0);
+  if (threads < 0 || threads > 1024) sim.fail("threads", "must be 0 (all cores) or 1..1024");
+  c.forest.threads = threads == 0 ? std::max(1, omp_get_num_procs()) : static_cast<int>(threads);
+
+  const ConfigTable flow = cfg.table("flow");
+  const ConfigTable grid = flow.table("grid");
+  c.forest.origin = grid.get_vec3("origin_m", {});
+  const Vec3 size = grid.get_vec3("size_m");
+  for (int d = 0; d < 3; ++d) {
+    if (!(size[d] > 0.0)) grid.fail("size_m", "every extent must be > 0");
+  }
+  c.cells = read_cells(grid);
+  const std::int64_t b = grid.get_int("block_cells", 8);
+  if (b < 2 || b > 64 || (b & (b - 1)) != 0)
+    grid.fail("block_cells", "must be a power of two in 2..64");
+  c.forest.block_cells = static_cast<int>(b);
+  choose_forest(grid, c, size);
+
+  const ConfigTable fluid = flow.table("fluid");
+  c.fluid.density = fluid.get_positive("density_kg_m3");
+  c.fluid.viscosity = fluid.get_double("viscosity_Pa_s");
+  if (!(c.fluid.viscosity >= 0.0)) fluid.fail("viscosity_Pa_s", "must be >= 0");
+
+  const ConfigTable bounds = flow.table("boundary");
+  for (int f = 0; f < 6; ++f) {
+    const auto fi = static_cast<std::size_t>(f);
+    c.boundaries[fi] = read_boundary(bounds.table(kFaceNames[f]), c.boundary_text[fi]);
+  }
+  for (int d = 0; d < 3; ++d) {
+    const auto lo = static_cast<std::size_t>(2 * d), hi = lo + 1;
+    const bool plo = c.boundaries[lo].kind == FlowBoundaryKind::Periodic;
+    const bool phi = c.boundaries[hi].kind == FlowBoundaryKind::Periodic;
+    if (plo != phi) {
+      bounds.fail(
+          kFaceNames[hi],
+          std::string("periodic on one side needs periodic on the other (") + kFaceNames[lo] + ")");
+    }
+    c.forest.periodic[static_cast<std::size_t>(d)] = plo;
+    for (const std::size_t f : {lo, hi}) {
+      if (c.boundaries[f].kind == FlowBoundaryKind::Wall &&
+          c.boundaries[f].wall_velocity[d] != 0.0) {
+        bounds.fail(std::string(kFaceNames[f]) + ".velocity_m_s",
+                    "a wall can only move tangentially");
+      }
+      if (c.boundaries[f].kind == FlowBoundaryKind::Inflow && !c.boundaries[f].inflow) {
+        c.boundaries[f].inflow = parabolic_profile(c, static_cast<int>(f));
+      }
+    }
+  }
+
+  c.initial_velocity = flow.get_vec3("initial_velocity_m_s", {});
+  c.body_force = flow.get_vec3("body_force_N_m3", {});
+  for (const ConfigTable& box : flow.table_array("solid")) {
+    const Vec3 lo = box.get_vec3("min_m"), hi = box.get_vec3("max_m");
+    for (int d = 0; d < 3; ++d) {
+      if (!(hi[d] > lo[d])) box.fail("max_m", "must be above min_m in x, y and z");
+    }
+    c.solid_boxes.push_back({lo, hi});
+  }
+
+  const auto time = flow.find_table("time");
+  if (time) {
+    c.options.cfl = time->get_positive("cfl", 0.8);
+    if (c.options.cfl > 1.0) time->fail("cfl", "must be <= 1 (BCG stability)");
+    c.options.dt_max = time->get_positive("max_time_step_s", c.end_time);
+    const std::string scheme =
+        time->get_choice("viscous_scheme", {"backward_euler", "crank_nicolson"}, "backward_euler");
+    c.options.viscous_theta = scheme == "crank_nicolson" ? 0.5 : 1.0;
+  } else {
+    c.options.dt_max = c.end_time;
+  }
+  const auto solver = flow.find_table("solver");
+  if (solver) {
+    const double tol = solver->get_positive("tolerance", 1e-6);
+    if (tol >= 1.0) solver->fail("tolerance", "must be < 1");
+    c.options.pressure.tolerance = tol;
+    c.options.viscous.tolerance = tol;
+    const std::int64_t cycles = solver->get_int("max_cycles", 50);
+    if (cycles < 1 || cycles > 10000) solver->fail("max_cycles", "must be in 1..10000");
+    c.options.pressure.max_cycles = c.options.viscous.max_cycles = static_cast<int>(cycles);
+  }
+
+  const auto output = cfg.find_table("output");
+  c.output_interval = c.end_time / 100.0;
+  if (output) {
+    c.output_interval = output->get_positive("interval_s", c.end_time / 100.0);
+    c.vtk = output->get_bool("vtk", true);
+    c.checkpoint_interval = output->get_non_negative("checkpoint_interval_s", 0.0);
+  }
+  cfg.check_no_unknown_keys();
+  return c;
+}
+
+std::string describe(const FlowCase& c) {
+  std::ostringstream s;
+  s.precision(10);
+  const double h = c.forest.tree_length / (c.forest.block_cells << c.forest.level);
+  s << "case " << c.name << " (" << c.source.string() << "): flow\n"
+    << "grid: " << c.cells[0] << " x " << c.cells[1] << " x " << c.cells[2] << " cells of " << h
+    << " m; blocks of " << c.forest.block_cells << "^3 cells; p4est brick " << c.forest.trees[0]
+    << " x " << c.forest.trees[1] << " x " << c.forest.trees[2] << " trees at level "
+    << c.forest.level << "; origin (" << c.forest.origin.x << ", " << c.forest.origin.y << ", "
+    << c.forest.origin.z << ") m\n"
+    << "fluid: density " << c.fluid.density << " kg/m3, viscosity " << c.fluid.viscosity
+    << " Pa s\n";
+  for (int f = 0; f < 6; ++f)
+    s << "boundary " << kFaceNames[f] << ": " << c.boundary_text[static_cast<std::size_t>(f)]
+      << "\n";
+  s << "initial velocity (" << c.initial_velocity.x << ", " << c.initial_velocity.y << ", "
+    << c.initial_velocity.z << ") m/s; body force (" << c.body_force.x << ", " << c.body_force.y
+    << ", " << c.body_force.z << ") N/m3\n";
+  for (const auto& box : c.solid_boxes) {
+    s << "solid box (" << box[0].x << ", " << box[0].y << ", " << box[0].z << ") - (" << box[1].x
+      << ", " << box[1].y << ", " << box[1].z << ") m\n";
+  }
+  s << "time: end " << c.end_time << " s, cfl " << c.options.cfl << ", max step "
+    << c.options.dt_max << " s, viscous theta " << c.options.viscous_theta << "\n"
+    << "multigrid: tolerance " << c.options.pressure.tolerance << " (relative to the rhs), at most "
+    << c.options.pressure.max_cycles << " V(" << c.options.pressure.pre_sweeps << ","
+    << c.options.pressure.post_sweeps << ") cycles\n"
+    << "threads " << c.forest.threads << "\n";
+  return s.str();
+}
+
+}  // namespace sanguis::flow

@@ -1,0 +1,45 @@
+#pragma once
+// A flow case file: the [flow] section (grid, fluid, boundaries, initial
+// state, body force, solver), [simulation] (name, end time, threads) and
+// [output], read strictly (unknown keys are errors). See docs/case-file.md,
+// section "Flow cases".
+
+#include <array>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "core/config.hpp"
+#include "flow/navier_stokes.hpp"
+
+namespace sanguis::flow {
+
+struct FlowCase {
+  std::string name;                          ///< [simulation].name, default the file's stem
+  std::filesystem::path source;              ///< the case file
+  double end_time = 0.0;                     ///< (s)
+  ForestSpec forest;                         ///< brick, block size, periodicity
+  std::array<int, 3> cells{};                ///< cells per direction
+  std::array<FlowBoundary, 6> boundaries{};  ///< by face_index
+  std::array<std::string, 6> boundary_text;  ///< as read, for the log
+  Fluid fluid;
+  NavierStokesOptions options;
+  Vec3 initial_velocity{};  ///< uniform initial velocity (m/s)
+  Vec3 body_force{};        ///< uniform body force density (N/m^3)
+  /// Solid boxes [min, max] (m): cells whose centre lies inside are solid.
+  std::vector<std::array<Vec3, 2>> solid_boxes;
+  double output_interval = 0.0;      ///< (s)
+  bool vtk = true;                   ///< write ParaView files
+  double checkpoint_interval = 0.0;  ///< (s), 0: only at the end
+};
+
+/// True when the case file has a [flow] section (the run is a flow run).
+bool is_flow_case(const ConfigTable& cfg);
+
+/// Reads and checks a flow case; throws InputError naming file and key.
+FlowCase load_flow_case(const ConfigTable& cfg, const std::filesystem::path& source);
+
+/// The resolved parameters, one per line (for run.log).
+std::string describe(const FlowCase& c);
+
+}  // namespace sanguis::flow

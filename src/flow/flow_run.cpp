@@ -1,0 +1,232 @@
+#include "flow/flow_run.hpp"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <optional>
+#include <ostream>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "core/io/csv.hpp"
+#include "core/io/vtk.hpp"
+#include "core/progress.hpp"
+#include "core/version.hpp"
+#include "flow/flow_output.hpp"
+
+namespace sanguis::flow {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::vector<std::string> kColumns = {"time_s",
+                                           "step",
+                                           "dt_s",
+                                           "kinetic_energy_J",
+                                           "max_velocity_m_s",
+                                           "max_divergence_1_s",
+                                           "pressure_vcycles",
+                                           "pressure_reduction_per_cycle"};
+
+struct Diagnostics {
+  double kinetic_energy = 0.0;
+  double max_velocity = 0.0;
+};
+
+Diagnostics diagnostics(const NavierStokes& ns) {
+  const Forest& forest = ns.forest();
+  const int b = forest.block_cells();
+  double energy = 0.0, vmax = 0.0;
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    const double h = forest.block(blk).length / b;
+    for (int k = 0; k < b; ++k)
+      for (int j = 0; j < b; ++j)
+        for (int i = 0; i < b; ++i) {
+          double v2 = 0.0;
+          for (const auto& u : ns.velocity()) v2 += u(blk, i, j, k) * u(blk, i, j, k);
+          energy += 0.5 * ns.fluid().density * v2 * h * h * h;
+          vmax = std::max(vmax, std::sqrt(v2));
+        }
+  }
+  if (!std::isfinite(energy)) vmax = std::numeric_limits<double>::infinity();
+  return {forest.sum(energy), forest.max(vmax)};
+}
+
+std::string frame_file(std::int64_t frame, const Forest& forest) {
+  char name[96];
+  if (forest.ranks() == 1) {
+    std::snprintf(name, sizeof name, "flow/flow_%08lld.vtu", static_cast<long long>(frame));
+  } else {
+    std::snprintf(name, sizeof name, "flow/flow_%08lld_r%d.vtu", static_cast<long long>(frame),
+                  forest.rank());
+  }
+  return name;
+}
+
+fs::path checkpoint_path(const fs::path& dir, const Forest& forest) {
+  return forest.ranks() == 1 ? dir / "checkpoint.bin"
+                             : dir / ("checkpoint_r" + std::to_string(forest.rank()) + ".bin");
+}
+
+}  // namespace
+
+FlowRunSummary run_flow_case(const FlowCase& c, const FlowRunOptions& options,
+                             std::ostream& console) {
+  const fs::path dir = options.output_dir;
+  const Forest forest(c.forest);
+  const bool root = forest.rank() == 0;
+  const fs::path checkpoint = checkpoint_path(dir, forest);
+  const fs::path csv_path = dir / "diagnostics.csv";
+  if (options.restart && !fs::exists(checkpoint)) {
+    const bool other_ranks =
+        fs::exists(dir / "checkpoint_r0.bin") || fs::exists(dir / "checkpoint.bin");
+    throw InputError(checkpoint.string(), "",
+                     other_ranks
+                         ? "no checkpoint for this number of ranks (restart with the mpirun -np "
+                           "of the run that wrote the checkpoint)"
+                         : "no checkpoint to restart from");
+  }
+  NavierStokes ns(forest, c.boundaries, c.fluid, c.options);
+  if (!c.solid_boxes.empty()) {
+    ns.set_solid([&](const Vec3& x) {
+      for (const auto& box : c.solid_boxes) {
+        if (x.x > box[0].x && x.x < box[1].x && x.y > box[0].y && x.y < box[1].y &&
+            x.z > box[0].z && x.z < box[1].z) {
+          return true;
+        }
+      }
+      return false;
+    });
+  }
+  ns.set_body_force([&](const Vec3&) { return c.body_force; });
+  std::int64_t steps = 0, frames = 0;
+  if (options.restart) {
+    const auto counters = load_flow_checkpoint(checkpoint, ns);
+    steps = counters.steps;
+    frames = counters.frames;
+    if (root && fs::exists(csv_path)) io::CsvWriter::truncate_after(csv_path, ns.time());
+  } else {
+    ns.set_velocity([&](const Vec3&) { return c.initial_velocity; });
+  }
+  fs::create_directories(dir / "flow");
+
+  std::ofstream log;
+  if (root) {
+    log.open(dir / "run.log", options.restart ? std::ios::app : std::ios::trunc);
+    if (!log) throw InputError((dir / "run.log").string(), "", "cannot write the run log");
+    log << (options.restart
+                ? "\n--- restart from checkpoint at t = " + std::to_string(ns.time()) + " s"
+                : std::string("sanguis ") + kVersion)
+        << "\n"
+        << describe(c) << "ranks " << forest.ranks() << "\n"
+        << std::flush;
+  }
+  io::PvdIndex pvd(dir / "flow.pvd");
+  if (options.restart && root) pvd.load_existing(ns.time());
+  std::optional<io::CsvWriter> csv;
+  if (root) csv.emplace(csv_path, kColumns, options.restart && fs::exists(csv_path));
+
+  StepReport last;
+  const auto record = [&]() {
+    if (c.vtk) {
+      io::write_hex_mesh_vtu(dir / frame_file(frames, forest), flow_mesh(ns));
+      if (root) {
+        for (int r = 0; r < forest.ranks(); ++r) {
+          char name[96];
+          if (forest.ranks() == 1) {
+            std::snprintf(name, sizeof name, "flow/flow_%08lld.vtu",
+                          static_cast<long long>(frames));
+          } else {
+            std::snprintf(name, sizeof name, "flow/flow_%08lld_r%d.vtu",
+                          static_cast<long long>(frames), r);
+          }
+          pvd.add(ns.time(), name, r);
+        }
+        pvd.write();
+      }
+      ++frames;
+    }
+    const Diagnostics d = diagnostics(ns);
+    const double divergence = ns.max_divergence();
+    if (csv) {
+      csv->row({ns.time(), static_cast<double>(steps), last.dt, d.kinetic_energy, d.max_velocity,
+                divergence, static_cast<double>(last.pressure_cycles), last.pressure_reduction});
+    }
+    if (!std::isfinite(d.max_velocity))
+      throw SimulationError("non-finite velocity at t = " + std::to_string(ns.time()));
+  };
+  if (!options.restart) record();
+
+  const double end = options.stop_at >= 0.0 ? std::min(options.stop_at, c.end_time) : c.end_time;
+  const double eps = 1e-12 * c.end_time;
+  double next_output = c.output_interval * (std::floor(ns.time() / c.output_interval + 1e-9) + 1.0);
+  double next_checkpoint =
+      c.checkpoint_interval > 0.0
+          ? c.checkpoint_interval * (std::floor(ns.time() / c.checkpoint_interval + 1e-9) + 1.0)
+          : std::numeric_limits<double>::infinity();
+  if (root) {
+    console << "sanguis run: " << c.name << ": flow, "
+            << static_cast<long long>(c.cells[0]) * c.cells[1] * c.cells[2] << " cells in "
+            << forest.global_blocks() << " blocks on " << forest.ranks()
+            << " rank(s), to t = " << end << " s, output to " << dir.string() << "\n";
+  }
+  ProgressReporter progress(std::cerr, root && !options.quiet && isatty(STDERR_FILENO) != 0);
+  const std::int64_t first_step = steps;
+  const double cells = static_cast<double>(c.cells[0]) * c.cells[1] * c.cells[2];
+  try {
+    while (ns.time() < end - eps) {
+      double dt = ns.stable_dt();
+      dt = std::min({dt, next_output - ns.time(), end - ns.time()});
+      last = ns.step(dt);
+      ++steps;
+      if (ns.time() >= next_output - eps) {
+        record();
+        next_output += c.output_interval;
+      }
+      if (ns.time() >= next_checkpoint - eps) {
+        save_flow_checkpoint(checkpoint, ns, steps, frames);
+        next_checkpoint += c.checkpoint_interval;
+      }
+      if (root && !options.quiet && (steps & 15) == 0) {
+        char status[128];
+        std::snprintf(status, sizeof status, "t = %.4g / %.4g s, dt %.3g s", ns.time(), end, dt);
+        progress.update(ns.time() / end, status, cells * static_cast<double>(steps - first_step));
+      }
+    }
+  } catch (const SimulationError& e) {
+    if (root) log << "ERROR: " << e.what() << "\n";
+    throw;
+  }
+  const double since_output = ns.time() - (next_output - c.output_interval);
+  if (since_output > eps && ns.time() >= c.end_time - eps) record();
+  save_flow_checkpoint(checkpoint, ns, steps, frames);
+
+  FlowRunSummary summary;
+  summary.steps = steps - first_step;
+  summary.simulated_time = ns.time();
+  summary.wall_seconds = progress.elapsed_seconds();
+  std::ostringstream done;
+  done.precision(4);
+  done << "done: t = " << ns.time() << " s, " << summary.steps << " steps in "
+       << ProgressReporter::format_duration(summary.wall_seconds) << " ("
+       << (summary.wall_seconds > 0
+               ? cells * static_cast<double>(summary.steps) / summary.wall_seconds
+               : 0.0)
+       << " cell-updates/s)";
+  if (root) progress.finish(done.str());
+  if (root) {
+    log << done.str() << "\n";
+    console << "outputs:\n"
+            << "  ParaView    " << (dir / "flow.pvd").string() << "\n"
+            << "  diagnostics " << csv_path.string() << "\n"
+            << "  log         " << (dir / "run.log").string() << "\n"
+            << "  checkpoint  " << checkpoint.string() << "\n";
+  }
+  return summary;
+}
+
+}  // namespace sanguis::flow

@@ -1,0 +1,30 @@
+#pragma once
+// Runs a flow case to its end with outputs: the block grid with the flow
+// fields as ParaView files with a .pvd time index, diagnostics.csv, run.log,
+// checkpoints and a progress line with ETA. Restart continues bit for bit
+// from the checkpoint (one file per MPI rank).
+
+#include <filesystem>
+#include <iosfwd>
+
+#include "flow/flow_case.hpp"
+
+namespace sanguis::flow {
+
+struct FlowRunOptions {
+  std::filesystem::path output_dir;
+  bool restart = false;   ///< continue from the checkpoint in output_dir
+  bool quiet = false;     ///< no progress line
+  double stop_at = -1.0;  ///< stop (with a checkpoint) at this time instead of the end; < 0: off
+};
+
+struct FlowRunSummary {
+  std::int64_t steps = 0;       ///< steps done by this call
+  double simulated_time = 0.0;  ///< time reached (s)
+  double wall_seconds = 0.0;
+};
+
+FlowRunSummary run_flow_case(const FlowCase& c, const FlowRunOptions& options,
+                             std::ostream& console);
+
+}  // namespace sanguis::flow

@@ -1,0 +1,141 @@
+#pragma once
+// A forest of blocks: a p8est forest of octrees over a brick of trees (a
+// rectangular domain of any aspect ratio, periodic per direction) whose leaves
+// each carry a block of b^3 cells with ghost layers (see block_field.hpp).
+//
+// The forest owns the p4est objects (connectivity, forest, ghost layer) and
+// answers for every local block: its level, its integer coordinates among the
+// blocks of that level, its position, and its 26 neighbours (a local block, a
+// remote block from the ghost layer, or the domain boundary). Ghost exchange
+// copies neighbour interiors into the ghost layers, within one rank and
+// across ranks (p8est_ghost_exchange_custom over the mirror blocks).
+//
+// Adaptivity (issue #7) will add neighbours one level coarser or finer: the
+// neighbour table and the exchange are written per block pair so that
+// coarse-fine interpolation slots in at `Link`, not in the callers.
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include <mpi.h>
+
+#include "core/vec3.hpp"
+#include "flow/block_field.hpp"
+
+namespace sanguis::flow {
+
+/// The shape of a forest of uniform resolution.
+struct ForestSpec {
+  std::array<int, 3> trees{1, 1, 1};                  ///< trees per direction (brick)
+  std::array<bool, 3> periodic{false, false, false};  ///< periodicity per direction
+  int level = 0;                                      ///< refinement level of every leaf
+  int block_cells = 8;             ///< cells per block edge b (a power of two, >= 2)
+  double tree_length = 1.0;        ///< edge length of one tree (m)
+  Vec3 origin{};                   ///< lower corner of the domain (m)
+  int threads = 1;                 ///< OpenMP threads over blocks
+  MPI_Comm comm = MPI_COMM_WORLD;  ///< ranks sharing the forest (MPI_COMM_SELF: this rank alone)
+};
+
+/// How a block reaches one of its 26 neighbours.
+enum class Link : std::uint8_t {
+  Local,     ///< a block of this rank; index is the local block number
+  Remote,    ///< a block of another rank; index is its number in the ghost layer
+  Boundary,  ///< outside a non-periodic domain face
+};
+
+struct Neighbour {
+  Link link = Link::Boundary;  ///< where the neighbour lives
+  std::int32_t index = -1;     ///< local or ghost-layer number, -1 for Boundary
+};
+
+/// Offset number of neighbour (ox,oy,oz), each in {-1,0,1}.
+constexpr int neighbour_slot(int ox, int oy, int oz) {
+  return (ox + 1) + 3 * (oy + 1) + 9 * (oz + 1);
+}
+
+/// One local leaf of the forest.
+struct Block {
+  int level = 0;                           ///< p8est refinement level
+  std::array<std::int64_t, 3> coord{};     ///< integer position among blocks of this level
+  Vec3 lower{};                            ///< physical lower corner (m)
+  double length = 0.0;                     ///< edge length (m)
+  std::array<Neighbour, 27> neighbours{};  ///< by neighbour_slot; the centre slot is unused
+};
+
+class Forest {
+ public:
+  explicit Forest(const ForestSpec& spec);
+  ~Forest();
+  Forest(const Forest&) = delete;
+  Forest& operator=(const Forest&) = delete;
+
+  [[nodiscard]] const ForestSpec& spec() const { return spec_; }
+  [[nodiscard]] int block_cells() const { return spec_.block_cells; }
+  [[nodiscard]] int local_blocks() const { return static_cast<int>(blocks_.size()); }
+  [[nodiscard]] const Block& block(int b) const { return blocks_[static_cast<std::size_t>(b)]; }
+  [[nodiscard]] std::int64_t global_blocks() const { return global_blocks_; }
+  /// Blocks per direction at `level` over the whole domain.
+  [[nodiscard]] std::array<std::int64_t, 3> blocks_per_direction(int level) const;
+  /// Domain extent per direction (m).
+  [[nodiscard]] Vec3 extent() const;
+
+  [[nodiscard]] MPI_Comm comm() const { return comm_; }
+  [[nodiscard]] int rank() const { return rank_; }
+  [[nodiscard]] int ranks() const { return ranks_; }
+
+  /// Fills the ghost cells of every block that face another block (within
+  /// `width` <= min(kGhost, b) of the block) with copies of that block's
+  /// interior, for all the given fields (same b). Boundary ghosts are left
+  /// for boundary.hpp.
+  /// With `faces_only` the edge and corner ghosts are left as they are
+  /// (7-point stencils read face ghosts only).
+  void exchange(std::span<BlockField* const> fields, int width, bool faces_only = false) const;
+  void exchange(BlockField& field, int width, bool faces_only = false) const {
+    BlockField* one[] = {&field};
+    exchange(one, width, faces_only);
+  }
+
+  /// Runs body(b) for every local block, on the forest's OpenMP threads.
+  template <typename Body>
+  void for_each_block(Body&& body) const;
+
+  /// Sum and maximum over all ranks.
+  [[nodiscard]] double sum(double local) const;
+  [[nodiscard]] double max(double local) const;
+
+  /// Repartitions the blocks evenly over the ranks (a no-op on uniform
+  /// forests built here; fields are not migrated yet - issue #7).
+  void partition();
+
+ private:
+  void build_blocks();
+  void build_neighbours();
+
+  struct P4estObjects;  ///< connectivity, forest and ghost layer (forest.cpp)
+
+  ForestSpec spec_;
+  MPI_Comm comm_;
+  int rank_ = 0;
+  int ranks_ = 1;
+  std::unique_ptr<P4estObjects> p4est_;
+  std::vector<Block> blocks_;
+  std::vector<std::int32_t> mirror_blocks_;  ///< local block number of each mirror
+  std::int64_t global_blocks_ = 0;
+  std::int64_t remote_blocks_ = 0;  ///< blocks in the ghost layer
+};
+
+template <typename Body>
+void Forest::for_each_block(Body&& body) const {
+  const int n = local_blocks();
+  if (spec_.threads > 1) {
+#pragma omp parallel for schedule(static) num_threads(spec_.threads)
+    for (int b = 0; b < n; ++b) body(b);
+  } else {
+    for (int b = 0; b < n; ++b) body(b);
+  }
+}
+
+}  // namespace sanguis::flow

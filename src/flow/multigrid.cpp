@@ -1,0 +1,557 @@
+#include "flow/multigrid.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace sanguis::flow {
+
+namespace {
+
+constexpr std::size_t D(int d) {
+  return static_cast<std::size_t>(d);
+}
+
+/// Pointers to the coefficient arrays of one block.
+struct BlockCoefficients {
+  const double* alpha;
+  std::array<const double*, 3> beta;
+};
+
+/// The new value of cell c under Gauss-Seidel for eq. (1). `implicit`
+/// (times inv_h2) is added to the diagonal and, times the old value, to the
+/// numerator: the part of the ghost values that depends on the cell itself
+/// (quadratic Dirichlet closure), treated implicitly.
+inline double relaxed_value(const double* x, double rhs, const BlockCoefficients& k,
+                            std::ptrdiff_t c, const std::array<std::ptrdiff_t, 3>& s, double inv_h2,
+                            double implicit = 0.0) {
+  double num = rhs + implicit * inv_h2 * x[c];
+  double den = k.alpha[c] + implicit * inv_h2;
+  for (int d = 0; d < 3; ++d) {
+    const double lo = k.beta[D(d)][c];
+    const double hi = k.beta[D(d)][c + s[D(d)]];
+    num += inv_h2 * (lo * x[c - s[D(d)]] + hi * x[c + s[D(d)]]);
+    den += inv_h2 * (lo + hi);
+  }
+  return den > 0.0 ? num / den : x[c];  // a cell cut off on all sides (solid) keeps its value
+}
+
+/// (A x)_c = alpha x_c - div(beta grad x)_c, eq. (1).
+inline double applied(const double* x, const BlockCoefficients& k, std::ptrdiff_t c,
+                      const std::array<std::ptrdiff_t, 3>& s, double inv_h2) {
+  double ax = k.alpha[c] * x[c];
+  for (int d = 0; d < 3; ++d) {
+    const double lo = k.beta[D(d)][c];
+    const double hi = k.beta[D(d)][c + s[D(d)]];
+    ax -= inv_h2 * (hi * (x[c + s[D(d)]] - x[c]) - lo * (x[c] - x[c - s[D(d)]]));
+  }
+  return ax;
+}
+
+}  // namespace
+
+double MultigridReport::mean_reduction() const {
+  if (residuals.size() < 2 || residuals.back() <= 0.0) return 0.0;
+  const double cycles_done = static_cast<double>(residuals.size() - 1);
+  return std::pow(residuals.front() / residuals.back(), 1.0 / cycles_done);
+}
+
+Multigrid::Multigrid(const Forest& forest, const std::array<BcKind, 6>& kinds)
+    : forest_(forest), kinds_(kinds) {
+  for (int d = 0; d < 3; ++d) {
+    const bool periodic = forest.spec().periodic[D(d)];
+    for (int side = 0; side < 2; ++side) {
+      if ((kinds_[D(face_index(d, side))] == BcKind::Periodic) != periodic) {
+        throw std::invalid_argument(
+            "multigrid: boundary kinds disagree with the forest's periodicity");
+      }
+    }
+  }
+  const int n = forest.local_blocks();
+  for (int b = forest.block_cells(); b >= 1; b /= 2) {
+    // The finest level shares the layout of the caller's fields; coarser
+    // ones keep the one ghost layer their smoother and prolongation read.
+    const int ghost = b == forest.block_cells() ? kGhost : 1;
+    Level level;
+    level.cells = b;
+    level.x = BlockField(n, b, ghost);
+    level.rhs = BlockField(n, b, ghost);
+    level.res = BlockField(n, b, ghost);
+    level.alpha = BlockField(n, b, ghost);
+    level.beta = make_vector_field(n, b, ghost);
+    level.active = BlockField(n, b, ghost);
+    levels_.push_back(std::move(level));
+  }
+  shifted_rhs_ = BlockField(n, forest.block_cells());
+  set_coefficients(nullptr, nullptr);
+}
+
+void Multigrid::set_coefficients(const BlockField* alpha, const FaceField* beta) {
+  has_alpha_ = alpha != nullptr;
+  Level& fine = levels_.front();
+  if (alpha) {
+    fine.alpha = *alpha;
+  } else {
+    fine.alpha.fill(0.0);
+  }
+  for (int d = 0; d < 3; ++d) {
+    if (beta) {
+      fine.beta[D(d)] = (*beta)[D(d)];
+    } else {
+      fine.beta[D(d)].fill(1.0);
+    }
+  }
+  // Coarser levels: alpha averaged over the 8 children, beta over the 4 fine
+  // faces that make up a coarse face.
+  for (std::size_t m = 1; m < levels_.size(); ++m) {
+    const Level& f = levels_[m - 1];
+    Level& c = levels_[m];
+    const int bc = c.cells;
+    forest_.for_each_block([&](int blk) {
+      for (int k = 0; k < bc; ++k)
+        for (int j = 0; j < bc; ++j)
+          for (int i = 0; i < bc; ++i) {
+            double sum = 0.0;
+            for (int dk = 0; dk < 2; ++dk)
+              for (int dj = 0; dj < 2; ++dj)
+                for (int di = 0; di < 2; ++di)
+                  sum += f.alpha(blk, 2 * i + di, 2 * j + dj, 2 * k + dk);
+            c.alpha(blk, i, j, k) = sum / 8.0;
+          }
+      for (int d = 0; d < 3; ++d) {
+        std::array<int, 3> hi{bc, bc, bc};
+        hi[D(d)] = bc + 1;  // faces 0..bc along d
+        for (int k = 0; k < hi[2]; ++k)
+          for (int j = 0; j < hi[1]; ++j)
+            for (int i = 0; i < hi[0]; ++i) {
+              double sum = 0.0;
+              for (int t2 = 0; t2 < 2; ++t2)
+                for (int t1 = 0; t1 < 2; ++t1) {
+                  std::array<int, 3> fc{2 * i, 2 * j, 2 * k};
+                  fc[D((d + 1) % 3)] += t1;
+                  fc[D((d + 2) % 3)] += t2;
+                  sum += f.beta[D(d)](blk, fc[0], fc[1], fc[2]);
+                }
+              c.beta[D(d)](blk, i, j, k) = sum / 4.0;
+            }
+      }
+    });
+  }
+  bool dirichlet = false;
+  for (const BcKind k : kinds_) dirichlet = dirichlet || k == BcKind::Dirichlet;
+  singular_ = !has_alpha_ && !dirichlet;
+  compute_activity();
+  build_coarse_operator();
+}
+
+void Multigrid::compute_activity() {
+  Level& fine = levels_.front();
+  const int b = fine.cells;
+  const BlockLayout L = fine.alpha.layout();
+  forest_.for_each_block([&](int blk) {
+    for (int k = 0; k < b; ++k)
+      for (int j = 0; j < b; ++j)
+        for (int i = 0; i < b; ++i) {
+          const std::ptrdiff_t c = L.index(i, j, k);
+          double open = fine.alpha.block(blk)[c];
+          for (int d = 0; d < 3; ++d) {
+            open += fine.beta[D(d)].block(blk)[c] + fine.beta[D(d)].block(blk)[c + L.stride(d)];
+          }
+          fine.active.block(blk)[c] = open > 0.0 ? 1.0 : 0.0;
+        }
+  });
+  for (std::size_t m = 1; m < levels_.size(); ++m) {
+    const Level& f = levels_[m - 1];
+    Level& c = levels_[m];
+    const int bc = c.cells;
+    forest_.for_each_block([&](int blk) {
+      for (int k = 0; k < bc; ++k)
+        for (int j = 0; j < bc; ++j)
+          for (int i = 0; i < bc; ++i) {
+            double any = 0.0;
+            for (int dk = 0; dk < 2; ++dk)
+              for (int dj = 0; dj < 2; ++dj)
+                for (int di = 0; di < 2; ++di)
+                  any = std::max(any, f.active(blk, 2 * i + di, 2 * j + dj, 2 * k + dk));
+            c.active(blk, i, j, k) = any;
+          }
+    });
+  }
+  for (Level& level : levels_) {
+    forest_.exchange(level.active, 1);
+    fill_boundary_ghosts(forest_, level.active, uniform_kinds(forest_, BcKind::Neumann), 1);
+  }
+}
+
+void Multigrid::build_coarse_operator() {
+  const int level = forest_.spec().level;
+  coarse_n_ = forest_.blocks_per_direction(level);
+  coarse_h_ = forest_.spec().tree_length / static_cast<double>(std::int64_t{1} << level);
+  const auto [nx, ny, nz] = coarse_n_;
+  coarse_alpha_.assign(static_cast<std::size_t>(nx * ny * nz), 0.0);
+  coarse_active_.assign(static_cast<std::size_t>(nx * ny * nz), 0.0);
+  for (int d = 0; d < 3; ++d) {
+    auto n = coarse_n_;
+    n[D(d)] += 1;
+    coarse_beta_[D(d)].assign(static_cast<std::size_t>(n[0] * n[1] * n[2]), 0.0);
+  }
+  const Level& c = levels_.back();
+  for (int blk = 0; blk < forest_.local_blocks(); ++blk) {
+    const Block& block = forest_.block(blk);
+    const auto& p = block.coord;
+    coarse_alpha_[static_cast<std::size_t>((p[2] * ny + p[1]) * nx + p[0])] = c.alpha(blk, 0, 0, 0);
+    coarse_active_[static_cast<std::size_t>((p[2] * ny + p[1]) * nx + p[0])] =
+        c.active(blk, 0, 0, 0);
+    for (int d = 0; d < 3; ++d) {
+      auto n = coarse_n_;
+      n[D(d)] += 1;
+      auto face = [&](std::array<std::int64_t, 3> q) {
+        return static_cast<std::size_t>((q[2] * n[1] + q[1]) * n[0] + q[0]);
+      };
+      coarse_beta_[D(d)][face(p)] = c.beta[D(d)](blk, 0, 0, 0);
+      std::array<int, 3> o{0, 0, 0};
+      o[D(d)] = 1;
+      if (block.neighbours[D(neighbour_slot(o[0], o[1], o[2]))].link == Link::Boundary) {
+        auto q = p;
+        q[D(d)] += 1;
+        std::array<int, 3> up{0, 0, 0};
+        up[D(d)] = 1;
+        coarse_beta_[D(d)][face(q)] = c.beta[D(d)](blk, up[0], up[1], up[2]);
+      }
+    }
+  }
+  MPI_Allreduce(MPI_IN_PLACE, coarse_alpha_.data(), static_cast<int>(coarse_alpha_.size()),
+                MPI_DOUBLE, MPI_SUM, forest_.comm());
+  MPI_Allreduce(MPI_IN_PLACE, coarse_active_.data(), static_cast<int>(coarse_active_.size()),
+                MPI_DOUBLE, MPI_SUM, forest_.comm());
+  for (auto& beta : coarse_beta_) {
+    MPI_Allreduce(MPI_IN_PLACE, beta.data(), static_cast<int>(beta.size()), MPI_DOUBLE, MPI_SUM,
+                  forest_.comm());
+  }
+}
+
+void Multigrid::coarse_solve() {
+  Level& c = levels_.back();
+  const auto [nx, ny, nz] = coarse_n_;
+  const auto cells = static_cast<std::size_t>(nx * ny * nz);
+  std::vector<double> rhs(cells, 0.0);
+  auto cell = [&](const std::array<std::int64_t, 3>& p) {
+    return static_cast<std::size_t>((p[2] * ny + p[1]) * nx + p[0]);
+  };
+  for (int blk = 0; blk < forest_.local_blocks(); ++blk) {
+    rhs[cell(forest_.block(blk).coord)] = c.rhs(blk, 0, 0, 0);
+  }
+  MPI_Allreduce(MPI_IN_PLACE, rhs.data(), static_cast<int>(cells), MPI_DOUBLE, MPI_SUM,
+                forest_.comm());
+  // Inactive cells (closed on all sides) are left out: zero rows, zero values.
+  double active_cells = 0.0;
+  for (std::size_t i = 0; i < cells; ++i) {
+    rhs[i] *= coarse_active_[i];
+    active_cells += coarse_active_[i];
+  }
+  auto remove_mean = [&](std::vector<double>& v) {
+    if (active_cells == 0.0) return;
+    double sum = 0.0;
+    for (std::size_t i = 0; i < cells; ++i) sum += coarse_active_[i] * v[i];
+    const double m = sum / active_cells;
+    for (std::size_t i = 0; i < cells; ++i) v[i] -= coarse_active_[i] * m;
+  };
+  if (singular_) remove_mean(rhs);
+
+  const double inv_h2 = 1.0 / (coarse_h_ * coarse_h_);
+  const std::array<std::int64_t, 3> n = coarse_n_;
+  auto apply = [&](const std::vector<double>& x, std::vector<double>& ax) {
+    for (std::int64_t k = 0; k < nz; ++k)
+      for (std::int64_t j = 0; j < ny; ++j)
+        for (std::int64_t i = 0; i < nx; ++i) {
+          const std::array<std::int64_t, 3> p{i, j, k};
+          const std::size_t c0 = cell(p);
+          double sum = coarse_alpha_[c0] * x[c0];
+          for (int d = 0; d < 3; ++d) {
+            auto nf = n;
+            nf[D(d)] += 1;
+            auto face = [&](const std::array<std::int64_t, 3>& q) {
+              return static_cast<std::size_t>((q[2] * nf[1] + q[1]) * nf[0] + q[0]);
+            };
+            const double beta_lo = coarse_beta_[D(d)][face(p)];
+            auto up = p;
+            up[D(d)] += 1;
+            double beta_hi = 0.0;
+            double x_lo = 0.0, x_hi = 0.0;
+            const BcKind kind_lo = kinds_[D(face_index(d, 0))];
+            const BcKind kind_hi = kinds_[D(face_index(d, 1))];
+            auto wrapped = p;
+            if (p[D(d)] > 0) {
+              wrapped[D(d)] = p[D(d)] - 1;
+              x_lo = x[cell(wrapped)];
+            } else if (kind_lo == BcKind::Periodic) {
+              wrapped[D(d)] = n[D(d)] - 1;
+              x_lo = x[cell(wrapped)];
+            } else {
+              x_lo = kind_lo == BcKind::Dirichlet ? -x[c0] : x[c0];
+            }
+            wrapped = p;
+            if (p[D(d)] < n[D(d)] - 1) {
+              wrapped[D(d)] = p[D(d)] + 1;
+              x_hi = x[cell(wrapped)];
+              beta_hi = coarse_beta_[D(d)][face(up)];
+            } else if (kind_hi == BcKind::Periodic) {
+              wrapped[D(d)] = 0;
+              x_hi = x[cell(wrapped)];
+              beta_hi = coarse_beta_[D(d)][face(wrapped)];
+            } else {
+              x_hi = kind_hi == BcKind::Dirichlet ? -x[c0] : x[c0];
+              beta_hi = coarse_beta_[D(d)][face(up)];
+            }
+            sum -= inv_h2 * (beta_hi * (x_hi - x[c0]) - beta_lo * (x[c0] - x_lo));
+          }
+          ax[c0] = sum;
+        }
+  };
+  auto dot = [](const std::vector<double>& a, const std::vector<double>& b) {
+    double s = 0.0;
+    for (std::size_t i = 0; i < a.size(); ++i) s += a[i] * b[i];
+    return s;
+  };
+  // Conjugate gradients: the operator is symmetric positive (semi-)definite.
+  std::vector<double> x(cells, 0.0), r = rhs, p = rhs, ap(cells, 0.0);
+  const double bb = dot(rhs, rhs);
+  double rr = bb;
+  for (int it = 0; it < 4 * static_cast<int>(cells) + 50 && rr > 1e-26 * bb && bb > 0.0; ++it) {
+    apply(p, ap);
+    const double pap = dot(p, ap);
+    if (!(pap > 0.0)) break;
+    const double a = rr / pap;
+    for (std::size_t i = 0; i < cells; ++i) {
+      x[i] += a * p[i];
+      r[i] -= a * ap[i];
+    }
+    if (singular_) remove_mean(r);
+    const double rr_new = dot(r, r);
+    if (rr_new == 0.0) break;
+    for (std::size_t i = 0; i < cells; ++i) p[i] = r[i] + (rr_new / rr) * p[i];
+    rr = rr_new;
+  }
+  if (singular_) remove_mean(x);
+  for (int blk = 0; blk < forest_.local_blocks(); ++blk) {
+    c.x(blk, 0, 0, 0) = x[cell(forest_.block(blk).coord)];
+  }
+}
+
+void Multigrid::fill_ghosts(int level, BlockField& x, const ScalarBoundary* bc,
+                            bool faces_only) const {
+  (void)level;
+  forest_.exchange(x, 1, faces_only);
+  if (bc) {
+    fill_boundary_ghosts(forest_, x, *bc, 1, false);
+  } else {
+    fill_boundary_ghosts(forest_, x, kinds_, 1);
+  }
+}
+
+void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc,
+                       int sweeps) {
+  const Level& lv = levels_[D(level)];
+  const BlockLayout L = x.layout();
+  const int b = L.cells;
+  const std::array<std::ptrdiff_t, 3> s{L.stride(0), L.stride(1), L.stride(2)};
+  for (int sweep = 0; sweep < sweeps; ++sweep) {
+    for (int colour = 0; colour < 2; ++colour) {
+      fill_ghosts(level, x, bc, true);  // the 7-point stencil reads face ghosts only
+      forest_.for_each_block([&](int blk) {
+        const Block& block = forest_.block(blk);
+        const double h = block.length / b;
+        const double inv_h2 = 1.0 / (h * h);
+        const auto parity =
+            static_cast<int>((block.coord[0] + block.coord[1] + block.coord[2]) * b) & 1;
+        const BlockCoefficients k{
+            lv.alpha.block(blk),
+            {lv.beta[0].block(blk), lv.beta[1].block(blk), lv.beta[2].block(blk)}};
+        double* xb = x.block(blk);
+        const double* rb = rhs.block(blk);
+        // Dirichlet faces of this block with the quadratic closure (finest level):
+        // ghost = (8 g - 6 x0 + x1)/3 depends on x0 with weight -2.
+        std::array<bool, 6> dirichlet{};
+        bool any = false;
+        if (bc != nullptr) {
+          for (int d = 0; d < 3; ++d)
+            for (int side = 0; side < 2; ++side) {
+              std::array<int, 3> o{0, 0, 0};
+              o[D(d)] = side == 0 ? -1 : 1;
+              const bool on =
+                  block.neighbours[D(neighbour_slot(o[0], o[1], o[2]))].link == Link::Boundary &&
+                  kinds_[D(face_index(d, side))] == BcKind::Dirichlet;
+              dirichlet[D(face_index(d, side))] = on;
+              any = any || on;
+            }
+        }
+        for (int kk = 0; kk < b; ++kk)
+          for (int j = 0; j < b; ++j)
+            for (int i = ((kk + j + parity + colour) & 1); i < b; i += 2) {
+              const std::ptrdiff_t c = L.index(i, j, kk);
+              double implicit = 0.0;
+              if (any) {
+                const std::array<int, 3> n{i, j, kk};
+                for (int d = 0; d < 3; ++d) {
+                  if (dirichlet[D(face_index(d, 0))] && n[D(d)] == 0)
+                    implicit += 2.0 * k.beta[D(d)][c];
+                  if (dirichlet[D(face_index(d, 1))] && n[D(d)] == b - 1) {
+                    implicit += 2.0 * k.beta[D(d)][c + s[D(d)]];
+                  }
+                }
+              }
+              xb[c] += omega_ * (relaxed_value(xb, rb[c], k, c, s, inv_h2, implicit) - xb[c]);
+            }
+      });
+    }
+  }
+}
+
+void Multigrid::compute_residual(int level, BlockField& x, const BlockField& rhs,
+                                 const ScalarBoundary* bc, BlockField& r) {
+  const Level& lv = levels_[D(level)];
+  const BlockLayout L = x.layout();
+  const int b = L.cells;
+  const std::array<std::ptrdiff_t, 3> s{L.stride(0), L.stride(1), L.stride(2)};
+  fill_ghosts(level, x, bc, true);
+  forest_.for_each_block([&](int blk) {
+    const double h = forest_.block(blk).length / b;
+    const double inv_h2 = 1.0 / (h * h);
+    const BlockCoefficients k{
+        lv.alpha.block(blk), {lv.beta[0].block(blk), lv.beta[1].block(blk), lv.beta[2].block(blk)}};
+    const double* xb = x.block(blk);
+    const double* fb = rhs.block(blk);
+    const double* ab = lv.active.block(blk);
+    double* rb = r.block(blk);
+    for (int kk = 0; kk < b; ++kk)
+      for (int j = 0; j < b; ++j)
+        for (int i = 0; i < b; ++i) {
+          const std::ptrdiff_t c = L.index(i, j, kk);
+          rb[c] = (fb[c] - applied(xb, k, c, s, inv_h2)) * ab[c];
+        }
+  });
+}
+
+void Multigrid::vcycle(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc) {
+  if (static_cast<std::size_t>(level) + 1 == levels_.size()) {
+    coarse_solve();
+    return;
+  }
+  smooth(level, x, rhs, bc, pre_sweeps_);
+  Level& fine = levels_[D(level)];
+  Level& coarse = levels_[D(level + 1)];
+  compute_residual(level, x, rhs, bc, fine.res);
+  const int bc_cells = coarse.cells;
+  forest_.for_each_block([&](int blk) {
+    for (int k = 0; k < bc_cells; ++k)
+      for (int j = 0; j < bc_cells; ++j)
+        for (int i = 0; i < bc_cells; ++i) {
+          double sum = 0.0;
+          for (int dk = 0; dk < 2; ++dk)
+            for (int dj = 0; dj < 2; ++dj)
+              for (int di = 0; di < 2; ++di)
+                sum += fine.res(blk, 2 * i + di, 2 * j + dj, 2 * k + dk);
+          coarse.rhs(blk, i, j, k) = sum / 8.0;
+        }
+  });
+  coarse.x.fill(0.0);
+  vcycle(level + 1, coarse.x, coarse.rhs, nullptr);
+  fill_ghosts(level + 1, coarse.x, nullptr);
+  // Trilinear prolongation of the correction (weights 3/4, 1/4 per direction).
+  const int b = fine.cells;
+  forest_.for_each_block([&](int blk) {
+    for (int k = 0; k < b; ++k)
+      for (int j = 0; j < b; ++j)
+        for (int i = 0; i < b; ++i) {
+          const int ci = i >> 1, cj = j >> 1, ck = k >> 1;
+          const int si = (i & 1) ? 1 : -1, sj = (j & 1) ? 1 : -1, sk = (k & 1) ? 1 : -1;
+          double value = 0.0, weight = 0.0;
+          for (int dk = 0; dk < 2; ++dk)
+            for (int dj = 0; dj < 2; ++dj)
+              for (int di = 0; di < 2; ++di) {
+                const int ii = ci + di * si, jj = cj + dj * sj, kk = ck + dk * sk;
+                const double w = (di ? 0.25 : 0.75) * (dj ? 0.25 : 0.75) * (dk ? 0.25 : 0.75) *
+                                 coarse.active(blk, ii, jj, kk);
+                value += w * coarse.x(blk, ii, jj, kk);
+                weight += w;
+              }
+          if (weight > 0.0) x(blk, i, j, k) += value / weight;
+        }
+  });
+  smooth(level, x, rhs, bc, post_sweeps_);
+}
+
+double Multigrid::rms(const BlockField& f) const {
+  const int b = f.cells();
+  double local = 0.0;
+  for (int blk = 0; blk < forest_.local_blocks(); ++blk)
+    for (int k = 0; k < b; ++k)
+      for (int j = 0; j < b; ++j)
+        for (int i = 0; i < b; ++i) local += f(blk, i, j, k) * f(blk, i, j, k);
+  const double cells = static_cast<double>(forest_.global_blocks()) * b * b * b;
+  return std::sqrt(forest_.sum(local) / cells);
+}
+
+double Multigrid::mean(const BlockField& f) const {
+  const int b = f.cells();
+  const BlockField& active = levels_.front().active;
+  double local = 0.0, count = 0.0;
+  for (int blk = 0; blk < forest_.local_blocks(); ++blk)
+    for (int k = 0; k < b; ++k)
+      for (int j = 0; j < b; ++j)
+        for (int i = 0; i < b; ++i) {
+          local += active(blk, i, j, k) * f(blk, i, j, k);
+          count += active(blk, i, j, k);
+        }
+  const double cells = forest_.sum(count);
+  return cells > 0.0 ? forest_.sum(local) / cells : 0.0;
+}
+
+void Multigrid::residual(BlockField& x, const BlockField& rhs, const ScalarBoundary& bc,
+                         BlockField& r) {
+  compute_residual(0, x, rhs, &bc, r);
+}
+
+MultigridReport Multigrid::solve(BlockField& x, const BlockField& rhs, const ScalarBoundary& bc,
+                                 const MultigridOptions& options) {
+  pre_sweeps_ = options.pre_sweeps;
+  post_sweeps_ = options.post_sweeps;
+  omega_ = options.relaxation;
+  const BlockField* source = &rhs;
+  BlockField& shifted = shifted_rhs_;
+  const int b = rhs.cells();
+  const BlockField& active = levels_.front().active;
+  auto shift_interior = [&](BlockField& f, double by) {
+    forest_.for_each_block([&](int blk) {
+      for (int k = 0; k < b; ++k)
+        for (int j = 0; j < b; ++j)
+          for (int i = 0; i < b; ++i) f(blk, i, j, k) -= by * active(blk, i, j, k);
+    });
+  };
+  if (singular_) {
+    // Compatibility: a singular problem only has a solution for a zero-mean rhs.
+    shifted.raw().assign(rhs.raw().begin(), rhs.raw().end());  // reuses the buffer
+    shift_interior(shifted, mean(rhs));
+    source = &shifted;
+  }
+  MultigridReport report;
+  report.rhs_norm = rms(*source);
+  Level& fine = levels_.front();
+  compute_residual(0, x, *source, &bc, fine.res);
+  report.residuals.push_back(rms(fine.res));
+  const double scale = report.rhs_norm > 0.0 ? report.rhs_norm : report.residuals.front();
+  const double target = std::max(options.tolerance * scale, options.absolute_tolerance);
+  report.converged = report.residuals.back() <= target;
+  while (!report.converged && report.cycles < options.max_cycles) {
+    vcycle(0, x, *source, &bc);
+    if (singular_) shift_interior(x, mean(x));
+    compute_residual(0, x, *source, &bc, fine.res);
+    report.residuals.push_back(rms(fine.res));
+    ++report.cycles;
+    report.converged = report.residuals.back() <= target;
+  }
+  fill_ghosts(0, x, &bc);
+  return report;
+}
+
+}  // namespace sanguis::flow

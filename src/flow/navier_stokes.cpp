@@ -1,0 +1,800 @@
+#include "flow/navier_stokes.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+#include <vector>
+
+namespace sanguis::flow {
+
+namespace {
+
+constexpr std::size_t D(int d) {
+  return static_cast<std::size_t>(d);
+}
+using Strides = std::array<std::ptrdiff_t, 3>;
+
+/// Bell-Colella-Glaz upwind value at the lower d-face of cell c (between
+/// c - s_d and c) at t + dt/2 (Bell, Colella & Glaz 1989, as in Basilisk's
+/// bcg.h): the upwind cell value extrapolated by its central slope, a source
+/// term, and transverse upwind corrections with the transverse velocities
+/// `vt` of the upwind cell.
+inline double bcg_face_value(const double* f, const double* src, double un, double dt, double h,
+                             int d, std::ptrdiff_t c, const Strides& s,
+                             const std::array<double, 3>& vt) {
+  const double sign = un > 0.0 ? 1.0 : -1.0;
+  const double courant = dt * un / h;
+  const std::ptrdiff_t up = un > 0.0 ? c - s[D(d)] : c;
+  const double slope = 0.5 * (f[up + s[D(d)]] - f[up - s[D(d)]]);  // h df/dx
+  double value =
+      f[up] + 0.25 * dt * (src[c] + src[c - s[D(d)]]) + 0.5 * sign * (1.0 - sign * courant) * slope;
+  for (int e = 0; e < 3; ++e) {
+    if (e == d) continue;
+    const double vn = vt[D(e)];
+    const double df = vn < 0.0 ? f[up + s[D(e)]] - f[up] : f[up] - f[up - s[D(e)]];
+    value -= dt * vn * df / (2.0 * h);
+  }
+  return value;
+}
+
+/// Viscosity on the face between two cells: the harmonic mean, so that a
+/// viscosity jump on a face passes the shear stress exactly (layered Couette).
+inline double face_viscosity(double left, double right) {
+  const double sum = left + right;
+  return sum > 0.0 ? 2.0 * left * right / sum : 0.0;
+}
+
+/// Whether the lower (side 0) or upper (side 1) d-face of a block is on the domain boundary.
+bool on_boundary(const Block& block, int d, int side) {
+  std::array<int, 3> o{0, 0, 0};
+  o[D(d)] = side == 0 ? -1 : 1;
+  return block.neighbours[D(neighbour_slot(o[0], o[1], o[2]))].link == Link::Boundary;
+}
+
+/// Calls body(i, j, k) over the faces 0..b along d and the cells 0..b-1 across.
+template <typename Body>
+inline void for_each_face(int b, int d, Body&& body) {
+  const int ni = d == 0 ? b + 1 : b, nj = d == 1 ? b + 1 : b, nk = d == 2 ? b + 1 : b;
+  for (int k = 0; k < nk; ++k)
+    for (int j = 0; j < nj; ++j)
+      for (int i = 0; i < ni; ++i) body(i, j, k);
+}
+
+template <typename Body>
+inline void for_each_cell(int b, Body&& body) {
+  for (int k = 0; k < b; ++k)
+    for (int j = 0; j < b; ++j)
+      for (int i = 0; i < b; ++i) body(i, j, k);
+}
+
+std::array<BcKind, 6> velocity_kinds(const std::array<FlowBoundary, 6>& bcs) {
+  std::array<BcKind, 6> kinds{};
+  for (std::size_t f = 0; f < 6; ++f) {
+    switch (bcs[f].kind) {
+      case FlowBoundaryKind::Periodic:
+        kinds[f] = BcKind::Periodic;
+        break;
+      case FlowBoundaryKind::Wall:
+      case FlowBoundaryKind::Inflow:
+        kinds[f] = BcKind::Dirichlet;
+        break;
+      case FlowBoundaryKind::Outflow:
+        kinds[f] = BcKind::Neumann;
+        break;
+    }
+  }
+  return kinds;
+}
+
+std::array<BcKind, 6> pressure_kinds(const std::array<FlowBoundary, 6>& bcs) {
+  std::array<BcKind, 6> kinds{};
+  for (std::size_t f = 0; f < 6; ++f) {
+    switch (bcs[f].kind) {
+      case FlowBoundaryKind::Periodic:
+        kinds[f] = BcKind::Periodic;
+        break;
+      case FlowBoundaryKind::Wall:
+      case FlowBoundaryKind::Inflow:
+        kinds[f] = BcKind::Neumann;
+        break;
+      case FlowBoundaryKind::Outflow:
+        kinds[f] = BcKind::Dirichlet;
+        break;
+    }
+  }
+  return kinds;
+}
+
+const std::array<FlowBoundary, 6>& checked(const Forest& forest,
+                                           const std::array<FlowBoundary, 6>& bcs) {
+  for (int d = 0; d < 3; ++d) {
+    for (int side = 0; side < 2; ++side) {
+      const FlowBoundary& bc = bcs[D(face_index(d, side))];
+      const bool periodic = forest.spec().periodic[D(d)];
+      if ((bc.kind == FlowBoundaryKind::Periodic) != periodic) {
+        throw std::invalid_argument("navier-stokes: boundary " +
+                                    std::to_string(face_index(d, side)) +
+                                    " must be periodic exactly when the forest is periodic there");
+      }
+      if (bc.kind == FlowBoundaryKind::Wall && bc.wall_velocity[d] != 0.0) {
+        throw std::invalid_argument("navier-stokes: a wall can only move tangentially");
+      }
+      if (bc.kind == FlowBoundaryKind::Inflow && !bc.inflow) {
+        throw std::invalid_argument("navier-stokes: an inflow boundary needs a velocity profile");
+      }
+    }
+  }
+  return bcs;
+}
+
+}  // namespace
+
+NavierStokes::NavierStokes(const Forest& forest, const std::array<FlowBoundary, 6>& boundaries,
+                           const Fluid& fluid, const NavierStokesOptions& options)
+    : forest_(forest),
+      boundaries_(checked(forest, boundaries)),
+      fluid_(fluid),
+      options_(options),
+      pressure_mg_(forest, pressure_kinds(boundaries)),
+      viscous_mg_(forest, velocity_kinds(boundaries)) {
+  if (!(fluid.density > 0.0) || !(fluid.viscosity >= 0.0)) {
+    throw std::invalid_argument("navier-stokes: density must be > 0 and viscosity >= 0");
+  }
+  const int n = forest.local_blocks();
+  const int b = forest.block_cells();
+  u_ = make_vector_field(n, b);
+  g_ = make_vector_field(n, b);
+  uf_ = make_vector_field(n, b);
+  accel_ = make_vector_field(n, b);
+  scratch_ = make_vector_field(n, b);
+  p_ = BlockField(n, b);
+  phi_ = BlockField(n, b);
+  mu_ = BlockField(n, b);
+  mu_.fill(fluid.viscosity);
+  solid_ = BlockField(n, b);
+  open_ = make_vector_field(n, b);
+  for (auto& f : open_) f.fill(1.0);
+  const auto vk = velocity_kinds(boundaries_);
+  for (int c = 0; c < 3; ++c) {
+    ScalarBoundary& bc = velocity_bc_[D(c)];
+    bc.kind = vk;
+    for (std::size_t f = 0; f < 6; ++f) {
+      const FlowBoundary& fb = boundaries_[f];
+      if (fb.kind == FlowBoundaryKind::Wall) {
+        const double value = fb.wall_velocity[c];
+        if (value != 0.0) bc.value[f] = [value](const Vec3&) { return value; };
+      } else if (fb.kind == FlowBoundaryKind::Inflow) {
+        bc.value[f] = [this, f, c](const Vec3& x) { return boundaries_[f].inflow(x, bc_time_)[c]; };
+      }
+    }
+  }
+  pressure_bc_.kind = pressure_kinds(boundaries_);
+}
+
+void NavierStokes::set_velocity(const std::function<Vec3(const Vec3&)>& u0, double time) {
+  const int b = forest_.block_cells();
+  time_ = time;
+  bc_time_ = time;
+  forest_.for_each_block([&](int blk) {
+    const Block& block = forest_.block(blk);
+    const double h = block.length / b;
+    for_each_cell(b, [&](int i, int j, int k) {
+      const Vec3 x{block.lower.x + (i + 0.5) * h, block.lower.y + (j + 0.5) * h,
+                   block.lower.z + (k + 0.5) * h};
+      const Vec3 v = u0(x);
+      for (int c = 0; c < 3; ++c) u_[D(c)](blk, i, j, k) = v[c];
+    });
+  });
+  // Project the initial field: uf exactly divergence-free, u corrected.
+  face_average_plus_acceleration(0.0);
+  phi_.fill(0.0);
+  pressure_report_ = project(phi_);
+  forest_.for_each_block([&](int blk) {
+    const double h = forest_.block(blk).length / b;
+    for (int d = 0; d < 3; ++d) {
+      const std::ptrdiff_t s = phi_.layout().stride(d);
+      double* ub = u_[D(d)].block(blk);
+      const double* pb = phi_.block(blk);
+      for_each_cell(b, [&](int i, int j, int k) {
+        const std::ptrdiff_t c = phi_.layout().index(i, j, k);
+        ub[c] -= 0.5 * ((pb[c + s] - pb[c]) + (pb[c] - pb[c - s])) / h;
+      });
+    }
+  });
+  p_.fill(0.0);
+  phi_.fill(0.0);
+  // g = a until the first projection gives a pressure.
+  forest_.for_each_block([&](int blk) {
+    for (int d = 0; d < 3; ++d) {
+      const std::ptrdiff_t s = phi_.layout().stride(d);
+      const double* ab = accel_[D(d)].block(blk);
+      double* gb = g_[D(d)].block(blk);
+      for_each_cell(b, [&](int i, int j, int k) {
+        const std::ptrdiff_t c = phi_.layout().index(i, j, k);
+        gb[c] = 0.5 * (ab[c] + ab[c + s]);
+      });
+    }
+  });
+  clear_solid_cells(u_);
+  fill_velocity_ghosts(u_);
+}
+
+void NavierStokes::set_body_force(const std::function<Vec3(const Vec3&)>& f) {
+  const int b = forest_.block_cells();
+  forest_.for_each_block([&](int blk) {
+    const Block& block = forest_.block(blk);
+    const double h = block.length / b;
+    for (int d = 0; d < 3; ++d) {
+      for_each_face(b, d, [&](int i, int j, int k) {
+        Vec3 x{block.lower.x + (i + 0.5) * h, block.lower.y + (j + 0.5) * h,
+               block.lower.z + (k + 0.5) * h};
+        x[d] -= 0.5 * h;
+        accel_[D(d)](blk, i, j, k) = f(x)[d] / fluid_.density;
+      });
+    }
+  });
+}
+
+void NavierStokes::set_viscosity(const std::function<double(const Vec3&)>& mu) {
+  const int b = forest_.block_cells();
+  forest_.for_each_block([&](int blk) {
+    const Block& block = forest_.block(blk);
+    const double h = block.length / b;
+    for_each_cell(b, [&](int i, int j, int k) {
+      mu_(blk, i, j, k) = mu({block.lower.x + (i + 0.5) * h, block.lower.y + (j + 0.5) * h,
+                              block.lower.z + (k + 0.5) * h});
+    });
+  });
+  viscosity_changed_ = true;
+}
+
+void NavierStokes::set_solid(const std::function<bool(const Vec3&)>& solid) {
+  const int b = forest_.block_cells();
+  bool any = false;
+  for (int blk = 0; blk < forest_.local_blocks(); ++blk) {
+    const Block& block = forest_.block(blk);
+    const double h = block.length / b;
+    for_each_cell(b, [&](int i, int j, int k) {
+      const bool inside = solid({block.lower.x + (i + 0.5) * h, block.lower.y + (j + 0.5) * h,
+                                 block.lower.z + (k + 0.5) * h});
+      solid_(blk, i, j, k) = inside ? 1.0 : 0.0;
+      any = any || inside;
+    });
+  }
+  has_solids_ = forest_.max(any ? 1.0 : 0.0) > 0.0;
+  fill_scalar_neumann(solid_, 1);
+  forest_.for_each_block([&](int blk) {
+    const BlockLayout L = solid_.layout();
+    const double* sb = solid_.block(blk);
+    for (int d = 0; d < 3; ++d) {
+      double* ob = open_[D(d)].block(blk);
+      for_each_face(b, d, [&](int i, int j, int k) {
+        const std::ptrdiff_t c = L.index(i, j, k);
+        ob[c] = (sb[c] == 0.0 && sb[c - L.stride(d)] == 0.0) ? 1.0 : 0.0;
+      });
+    }
+  });
+  // Solid cells leave the pressure problem: all their faces are closed
+  // (beta = 0), so the multigrid treats them as inactive.
+  pressure_mg_.set_coefficients(nullptr, has_solids_ ? &open_ : nullptr);
+  viscosity_changed_ = true;
+  clear_solid_cells(u_);
+  close_solid_faces(uf_);
+}
+
+void NavierStokes::close_solid_faces(FaceField& uf) const {
+  if (!has_solids_) return;
+  const int b = forest_.block_cells();
+  forest_.for_each_block([&](int blk) {
+    for (int d = 0; d < 3; ++d) {
+      const double* ob = open_[D(d)].block(blk);
+      double* out = uf[D(d)].block(blk);
+      for_each_face(b, d, [&](int i, int j, int k) {
+        const std::ptrdiff_t c = solid_.layout().index(i, j, k);
+        out[c] *= ob[c];
+      });
+    }
+  });
+}
+
+void NavierStokes::clear_solid_cells(VectorField& u) const {
+  if (!has_solids_) return;
+  const int b = forest_.block_cells();
+  forest_.for_each_block([&](int blk) {
+    for_each_cell(b, [&](int i, int j, int k) {
+      if (solid_(blk, i, j, k) != 0.0) {
+        for (auto& comp : u) comp(blk, i, j, k) = 0.0;
+      }
+    });
+  });
+}
+
+void NavierStokes::fill_velocity_ghosts(VectorField& u, int width) {
+  BlockField* fields[] = {&u[0], &u[1], &u[2]};
+  forest_.exchange(fields, width);
+  for (int c = 0; c < 3; ++c) fill_boundary_ghosts(forest_, u[D(c)], velocity_bc_[D(c)], width);
+}
+
+void NavierStokes::fill_scalar_neumann(BlockField& f, int width) {
+  forest_.exchange(f, width);
+  fill_boundary_ghosts(forest_, f, uniform_kinds(forest_, BcKind::Neumann), width);
+}
+
+void NavierStokes::set_boundary_faces(FaceField& uf) const {
+  const int b = forest_.block_cells();
+  forest_.for_each_block([&](int blk) {
+    const Block& block = forest_.block(blk);
+    const double h = block.length / b;
+    for (int d = 0; d < 3; ++d) {
+      for (int side = 0; side < 2; ++side) {
+        const FlowBoundary& fb = boundaries_[D(face_index(d, side))];
+        if (!on_boundary(block, d, side)) continue;
+        if (fb.kind != FlowBoundaryKind::Wall && fb.kind != FlowBoundaryKind::Inflow) continue;
+        for (int t2 = 0; t2 < b; ++t2)
+          for (int t1 = 0; t1 < b; ++t1) {
+            std::array<int, 3> idx{};
+            idx[D(d)] = side == 0 ? 0 : b;
+            idx[D((d + 1) % 3)] = t1;
+            idx[D((d + 2) % 3)] = t2;
+            double value = fb.wall_velocity[d];
+            if (fb.kind == FlowBoundaryKind::Inflow) {
+              Vec3 x{};
+              for (int e = 0; e < 3; ++e) x[e] = block.lower[e] + (idx[D(e)] + 0.5) * h;
+              x[d] = block.lower[d] + idx[D(d)] * h;
+              value = fb.inflow(x, bc_time_)[d];
+            }
+            uf[D(d)](blk, idx[0], idx[1], idx[2]) = value;
+          }
+      }
+    }
+  });
+}
+
+void NavierStokes::fill_face_ghosts(FaceField& uf) {
+  BlockField* fields[] = {&uf[0], &uf[1], &uf[2]};
+  forest_.exchange(fields, kGhost);
+  fill_face_field_ghosts(forest_, uf, kGhost);
+}
+
+double NavierStokes::stable_dt() const {
+  const int b = forest_.block_cells();
+  double rate = 0.0;  // max |uf| / h
+  for (int blk = 0; blk < forest_.local_blocks(); ++blk) {
+    const double h = forest_.block(blk).length / b;
+    for (int d = 0; d < 3; ++d) {
+      for_each_face(b, d, [&](int i, int j, int k) {
+        rate = std::max(rate, std::abs(uf_[D(d)](blk, i, j, k)) / h);
+      });
+    }
+  }
+  rate = forest_.max(rate);
+  const double dt = rate > 0.0 ? std::min(options_.dt_max, options_.cfl / rate) : options_.dt_max;
+  if (!std::isfinite(dt)) {
+    throw std::invalid_argument("navier-stokes: fluid at rest and no maximum time step given");
+  }
+  return dt;
+}
+
+void NavierStokes::predict_face_velocity(double dt) {
+  const int b = forest_.block_cells();
+  const BlockLayout L = u_[0].layout();
+  const Strides s{L.stride(0), L.stride(1), L.stride(2)};
+  forest_.for_each_block([&](int blk) {
+    const double h = forest_.block(blk).length / b;
+    const std::array<const double*, 3> u{u_[0].block(blk), u_[1].block(blk), u_[2].block(blk)};
+    for (int d = 0; d < 3; ++d) {
+      const double* f = u[D(d)];
+      const double* src = g_[D(d)].block(blk);
+      double* out = uf_[D(d)].block(blk);
+      for_each_face(b, d, [&](int i, int j, int k) {
+        const std::ptrdiff_t c = L.index(i, j, k);
+        const double un = 0.5 * (f[c] + f[c - s[D(d)]]);
+        const std::ptrdiff_t up = un > 0.0 ? c - s[D(d)] : c;
+        const std::array<double, 3> vt{u[0][up], u[1][up], u[2][up]};
+        out[c] = bcg_face_value(f, src, un, dt, h, d, c, s, vt);
+      });
+    }
+  });
+  set_boundary_faces(uf_);
+  close_solid_faces(uf_);
+}
+
+void NavierStokes::advect(double dt) {
+  const int b = forest_.block_cells();
+  const BlockLayout L = u_[0].layout();
+  const Strides s{L.stride(0), L.stride(1), L.stride(2)};
+  forest_.for_each_block([&](int blk) {
+    const Block& block = forest_.block(blk);
+    const double h = block.length / b;
+    const std::array<const double*, 3> uf{uf_[0].block(blk), uf_[1].block(blk), uf_[2].block(blk)};
+    // Face fluxes of one block, per direction: scratch kept per thread.
+    thread_local std::array<std::vector<double>, 3> flux;
+    for (auto& fl : flux) fl.resize(static_cast<std::size_t>(L.size()));
+    for (int comp = 0; comp < 3; ++comp) {
+      const double* f = u_[D(comp)].block(blk);
+      const double* src = g_[D(comp)].block(blk);
+      for (int d = 0; d < 3; ++d) {
+        const bool dirichlet_lo =
+            on_boundary(block, d, 0) &&
+            velocity_bc_[D(comp)].kind[D(face_index(d, 0))] == BcKind::Dirichlet;
+        const bool dirichlet_hi =
+            on_boundary(block, d, 1) &&
+            velocity_bc_[D(comp)].kind[D(face_index(d, 1))] == BcKind::Dirichlet;
+        double* fl = flux[D(d)].data();
+        for_each_face(b, d, [&](int i, int j, int k) {
+          const std::ptrdiff_t c = L.index(i, j, k);
+          const double un = uf[D(d)][c];
+          const int n = d == 0 ? i : (d == 1 ? j : k);
+          double value;
+          if (n == 0 && dirichlet_lo) {
+            // The boundary value itself, from the quadratic ghost closure.
+            value = (3.0 * f[c - s[D(d)]] + 6.0 * f[c] - f[c + s[D(d)]]) / 8.0;
+          } else if (n == b && dirichlet_hi) {
+            value = (3.0 * f[c] + 6.0 * f[c - s[D(d)]] - f[c - 2 * s[D(d)]]) / 8.0;
+          } else {
+            const std::ptrdiff_t up = un > 0.0 ? c - s[D(d)] : c;
+            std::array<double, 3> vt{};
+            for (int e = 0; e < 3; ++e) vt[D(e)] = 0.5 * (uf[D(e)][up] + uf[D(e)][up + s[D(e)]]);
+            value = bcg_face_value(f, src, un, dt, h, d, c, s, vt);
+          }
+          fl[c] = value * un;
+        });
+      }
+      double* out = scratch_[D(comp)].block(blk);
+      for_each_cell(b, [&](int i, int j, int k) {
+        const std::ptrdiff_t c = L.index(i, j, k);
+        double div = 0.0;
+        for (int d = 0; d < 3; ++d)
+          div += flux[D(d)][static_cast<std::size_t>(c + s[D(d)])] -
+                 flux[D(d)][static_cast<std::size_t>(c)];
+        out[c] = f[c] - dt * div / h;
+      });
+    }
+  });
+}
+
+void NavierStokes::update_viscous_coefficients(double dt) {
+  if (dt == viscous_dt_ && !viscosity_changed_) return;
+  if (viscosity_changed_) {
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (int blk = 0; blk < forest_.local_blocks(); ++blk) {
+      for_each_cell(forest_.block_cells(), [&](int i, int j, int k) {
+        lo = std::min(lo, mu_(blk, i, j, k));
+        hi = std::max(hi, mu_(blk, i, j, k));
+      });
+    }
+    variable_viscosity_ = forest_.max(hi) > -forest_.max(-lo);
+  }
+  const int n = forest_.local_blocks();
+  const int b = forest_.block_cells();
+  fill_scalar_neumann(mu_, 1);
+  BlockField alpha(n, b);
+  alpha.fill(1.0);
+  FaceField beta = make_vector_field(n, b);
+  const double scale = options_.viscous_theta * dt / fluid_.density;
+  forest_.for_each_block([&](int blk) {
+    const BlockLayout L = mu_.layout();
+    const double* mu = mu_.block(blk);
+    for (int d = 0; d < 3; ++d) {
+      const std::ptrdiff_t s = L.stride(d);
+      const double* open = open_[D(d)].block(blk);
+      double* out = beta[D(d)].block(blk);
+      for_each_face(b, d, [&](int i, int j, int k) {
+        const std::ptrdiff_t c = L.index(i, j, k);
+        out[c] = open[c] * scale * face_viscosity(mu[c], mu[c - s]);
+      });
+    }
+    if (!has_solids_) return;
+    // No-slip on the faces of solid cells: a fluid cell there gets the wall
+    // flux 2 mu (0 - u)/h implicitly (alpha), the solid cell keeps u = 0.
+    const double h = forest_.block(blk).length / b;
+    for_each_cell(b, [&](int i, int j, int k) {
+      const std::ptrdiff_t c = L.index(i, j, k);
+      if (solid_.block(blk)[c] != 0.0) return;
+      double walls = 0.0;
+      for (int d = 0; d < 3; ++d) {
+        const double* open = open_[D(d)].block(blk);
+        walls += (1.0 - open[c]) + (1.0 - open[c + L.stride(d)]);
+      }
+      alpha.block(blk)[c] += walls * 2.0 * scale * mu[c] / (h * h);
+    });
+  });
+  viscous_mg_.set_coefficients(&alpha, &beta);
+  viscous_dt_ = dt;
+  viscosity_changed_ = false;
+}
+
+void NavierStokes::add_transpose_stress(double dt) {
+  // eq. 4.1: the part div(mu grad u^T) of the viscous stress, explicit with
+  // u^n (its ghosts are still filled), added to u*: for component i,
+  // (1/h) sum_j [mu (du_j/dx_i)] over the j-faces of the cell. It vanishes
+  // for uniform mu (then div(grad u^T) = grad div u = 0) and is skipped there.
+  const int b = forest_.block_cells();
+  const BlockLayout L = u_[0].layout();
+  const double factor = dt / fluid_.density;
+  forest_.for_each_block([&](int blk) {
+    const double h = forest_.block(blk).length / b;
+    const double* mu = mu_.block(blk);
+    for (int i = 0; i < 3; ++i) {
+      const std::ptrdiff_t si = L.stride(i);
+      double* out = scratch_[D(i)].block(blk);
+      for_each_cell(b, [&](int x, int y, int z) {
+        const std::ptrdiff_t c = L.index(x, y, z);
+        double sum = 0.0;
+        for (int j = 0; j < 3; ++j) {
+          const std::ptrdiff_t sj = L.stride(j);
+          const double* uj = u_[D(j)].block(blk);
+          const double* open = open_[D(j)].block(blk);
+          // du_j/dx_i on the lower (at c) and upper (at c + sj) j-faces.
+          auto gradient = [&](std::ptrdiff_t f) {
+            if (i == j) return (uj[f] - uj[f - sj]) / h;
+            return ((uj[f + si] - uj[f - si]) + (uj[f - sj + si] - uj[f - sj - si])) / (4.0 * h);
+          };
+          sum += open[c + sj] * face_viscosity(mu[c + sj], mu[c]) * gradient(c + sj) -
+                 open[c] * face_viscosity(mu[c], mu[c - sj]) * gradient(c);
+        }
+        out[c] += factor * sum / h;
+      });
+    }
+  });
+}
+
+void NavierStokes::viscous_step(double dt, StepReport& report) {
+  const int b = forest_.block_cells();
+  const BlockLayout L = u_[0].layout();
+  const double theta = options_.viscous_theta;
+  // The explicit part (1 - theta) dt/rho div(mu grad u^n) uses u^n, whose
+  // ghosts are still filled: add it to u* first.
+  if (theta < 1.0) {
+    fill_scalar_neumann(mu_, 1);
+    forest_.for_each_block([&](int blk) {
+      const double h = forest_.block(blk).length / b;
+      const double* mu = mu_.block(blk);
+      for (int comp = 0; comp < 3; ++comp) {
+        const double* u = u_[D(comp)].block(blk);
+        double* out = scratch_[D(comp)].block(blk);
+        for_each_cell(b, [&](int i, int j, int k) {
+          const std::ptrdiff_t c = L.index(i, j, k);
+          double lap = 0.0;
+          for (int d = 0; d < 3; ++d) {
+            const std::ptrdiff_t s = L.stride(d);
+            const double open_lo = open_[D(d)].block(blk)[c];
+            const double open_hi = open_[D(d)].block(blk)[c + s];
+            lap += open_hi * face_viscosity(mu[c + s], mu[c]) * (u[c + s] - u[c]) -
+                   open_lo * face_viscosity(mu[c], mu[c - s]) * (u[c] - u[c - s]);
+            // No-slip faces of solid neighbours: 2 mu (0 - u)/h.
+            if (solid_.block(blk)[c] == 0.0) lap -= (2.0 - open_lo - open_hi) * 2.0 * mu[c] * u[c];
+          }
+          out[c] += (1.0 - theta) * dt / fluid_.density * lap / (h * h);
+        });
+      }
+    });
+  }
+  update_viscous_coefficients(dt);
+  if (variable_viscosity_) add_transpose_stress(dt);
+  for (int comp = 0; comp < 3; ++comp) {
+    BlockField& rhs = scratch_[D(comp)];
+    BlockField& u = u_[D(comp)];
+    const BlockField& g = g_[D(comp)];
+    forest_.for_each_block([&](int blk) {
+      for_each_cell(b, [&](int i, int j, int k) {
+        rhs(blk, i, j, k) += dt * g(blk, i, j, k);
+        u(blk, i, j, k) = rhs(blk, i, j, k);
+      });
+    });
+    const auto r = viscous_mg_.solve(u, rhs, velocity_bc_[D(comp)], options_.viscous);
+    report.viscous_cycles += r.cycles;
+    if (!r.converged) {
+      std::ostringstream what;
+      what << "navier-stokes: viscous solve did not converge: RMS residual " << r.residuals.front()
+           << " -> " << r.residuals.back() << " in " << r.cycles << " V-cycles, RMS rhs "
+           << r.rhs_norm;
+      throw SimulationError(what.str());
+    }
+    forest_.for_each_block([&](int blk) {
+      for_each_cell(b, [&](int i, int j, int k) { u(blk, i, j, k) -= dt * g(blk, i, j, k); });
+    });
+  }
+}
+
+void NavierStokes::face_average_plus_acceleration(double dt) {
+  const int b = forest_.block_cells();
+  fill_velocity_ghosts(u_, 1);
+  forest_.for_each_block([&](int blk) {
+    for (int d = 0; d < 3; ++d) {
+      const std::ptrdiff_t s = u_[0].layout().stride(d);
+      const double* u = u_[D(d)].block(blk);
+      const double* a = accel_[D(d)].block(blk);
+      double* out = uf_[D(d)].block(blk);
+      for_each_face(b, d, [&](int i, int j, int k) {
+        const std::ptrdiff_t c = u_[0].layout().index(i, j, k);
+        out[c] = 0.5 * (u[c] + u[c - s]) + dt * a[c];
+      });
+    }
+  });
+  set_boundary_faces(uf_);
+  close_solid_faces(uf_);
+}
+
+MultigridReport NavierStokes::project(BlockField& phi) {
+  // eq. 4.2 discretely: div(grad phi) = div uf, then uf -= grad phi.
+  const int b = forest_.block_cells();
+  const BlockLayout L = phi.layout();
+  BlockField& rhs = scratch_[0];
+  forest_.for_each_block([&](int blk) {
+    const double h = forest_.block(blk).length / b;
+    for_each_cell(b, [&](int i, int j, int k) {
+      const std::ptrdiff_t c = L.index(i, j, k);
+      double div = 0.0;
+      for (int d = 0; d < 3; ++d)
+        div += uf_[D(d)].block(blk)[c + L.stride(d)] - uf_[D(d)].block(blk)[c];
+      rhs.block(blk)[c] = -div / h;
+    });
+  });
+  // A floor above round-off: |div uf| ~ 1e-12 max|uf|/h is exact enough.
+  double rate = 0.0;
+  for (int blk = 0; blk < forest_.local_blocks(); ++blk) {
+    const double h = forest_.block(blk).length / b;
+    for (int d = 0; d < 3; ++d) {
+      for_each_face(b, d, [&](int i, int j, int k) {
+        rate = std::max(rate, std::abs(uf_[D(d)](blk, i, j, k)) / h);
+      });
+    }
+  }
+  MultigridOptions options = options_.pressure;
+  options.absolute_tolerance = std::max(options.absolute_tolerance, 1e-12 * forest_.max(rate));
+  MultigridReport report = pressure_mg_.solve(phi, rhs, pressure_bc_, options);
+  if (!report.converged) {
+    std::ostringstream what;
+    what << "navier-stokes: projection did not converge: RMS residual " << report.residuals.front()
+         << " -> " << report.residuals.back() << " in " << report.cycles << " V-cycles, RMS rhs "
+         << report.rhs_norm << ", tolerance " << options_.pressure.tolerance;
+    throw SimulationError(what.str());
+  }
+  forest_.for_each_block([&](int blk) {
+    const double h = forest_.block(blk).length / b;
+    const double* pb = phi.block(blk);
+    for (int d = 0; d < 3; ++d) {
+      const std::ptrdiff_t s = L.stride(d);
+      double* out = uf_[D(d)].block(blk);
+      const double* open = open_[D(d)].block(blk);
+      for_each_face(b, d, [&](int i, int j, int k) {
+        const std::ptrdiff_t c = L.index(i, j, k);
+        out[c] -= open[c] * (pb[c] - pb[c - s]) / h;
+      });
+    }
+  });
+  return report;
+}
+
+StepReport NavierStokes::step(double dt) {
+  if (!(dt > 0.0)) throw std::invalid_argument("navier-stokes: dt must be > 0");
+  StepReport report;
+  report.dt = dt;
+  const int b = forest_.block_cells();
+  const double rho = fluid_.density;
+  bc_time_ = time_ + dt;
+
+  // 1. prediction of the face velocity at t + dt/2, MAC projection with dt/2.
+  fill_velocity_ghosts(u_);
+  fill_scalar_neumann(g_[0], 1);
+  fill_scalar_neumann(g_[1], 1);
+  fill_scalar_neumann(g_[2], 1);
+  predict_face_velocity(dt);
+  forest_.for_each_block([&](int blk) {
+    for_each_cell(
+        b, [&](int i, int j, int k) { phi_(blk, i, j, k) = p_(blk, i, j, k) * 0.5 * dt / rho; });
+  });
+  report.predictor_cycles = project(phi_).cycles;
+  fill_face_ghosts(uf_);
+  set_boundary_faces(uf_);
+
+  // 2. advection u* = u - dt div(uf u_{n+1/2}).
+  advect(dt);
+
+  // 3. implicit viscosity.
+  bool viscous = false;
+  for (int blk = 0; blk < forest_.local_blocks() && !viscous; ++blk)
+    for_each_cell(b, [&](int i, int j, int k) { viscous = viscous || mu_(blk, i, j, k) != 0.0; });
+  viscous = forest_.max(viscous ? 1.0 : 0.0) > 0.0;
+  if (viscous) {
+    viscous_step(dt, report);
+  } else {
+    for (int c = 0; c < 3; ++c) u_[D(c)] = scratch_[D(c)];
+  }
+
+  // 4. face velocity with the body force, 5. projection.
+  face_average_plus_acceleration(dt);
+  BlockField& phi = scratch_[1];
+  forest_.for_each_block([&](int blk) {
+    for_each_cell(b, [&](int i, int j, int k) { phi(blk, i, j, k) = p_(blk, i, j, k) * dt / rho; });
+  });
+  pressure_report_ = project(phi);
+  report.pressure_cycles = pressure_report_.cycles;
+  report.pressure_reduction = pressure_report_.mean_reduction();
+  const BlockLayout L = p_.layout();
+  forest_.for_each_block([&](int blk) {
+    const Block& block = forest_.block(blk);
+    const double h = block.length / b;
+    const double* pb = phi.block(blk);
+    // Faces where the velocity is prescribed (walls, inflow): the pressure
+    // condition there (Neumann) only keeps uf fixed; their gradient is not
+    // the fluid's, so g comes from the interior face beside them.
+    std::array<bool, 6> prescribed{};
+    for (int d = 0; d < 3; ++d)
+      for (int side = 0; side < 2; ++side) {
+        const FlowBoundaryKind kind = boundaries_[D(face_index(d, side))].kind;
+        prescribed[D(face_index(d, side))] =
+            on_boundary(block, d, side) &&
+            (kind == FlowBoundaryKind::Wall || kind == FlowBoundaryKind::Inflow);
+      }
+    for_each_cell(b, [&](int i, int j, int k) {
+      const std::ptrdiff_t c = L.index(i, j, k);
+      const std::array<int, 3> n{i, j, k};
+      p_.block(blk)[c] = pb[c] * rho / dt;
+      for (int d = 0; d < 3; ++d) {
+        const std::ptrdiff_t s = L.stride(d);
+        const double* a = accel_[D(d)].block(blk);
+        const double* open = open_[D(d)].block(blk);
+        const double grad_lo = (pb[c] - pb[c - s]) / (h * dt);
+        const double grad_hi = (pb[c + s] - pb[c]) / (h * dt);
+        // Average over the faces open to the flow (both, away from solids
+        // and prescribed boundaries).
+        const double open_lo = (n[D(d)] == 0 && prescribed[D(face_index(d, 0))]) ? 0.0 : open[c];
+        const double open_hi =
+            (n[D(d)] == b - 1 && prescribed[D(face_index(d, 1))]) ? 0.0 : open[c + s];
+        const double weight = open_lo + open_hi;
+        const double gd =
+            weight > 0.0 ? (open_lo * (a[c] - grad_lo) + open_hi * (a[c + s] - grad_hi)) / weight
+                         : 0.0;
+        g_[D(d)].block(blk)[c] = gd;
+        u_[D(d)].block(blk)[c] += dt * gd;
+      }
+    });
+  });
+  clear_solid_cells(u_);
+  time_ += dt;
+  return report;
+}
+
+double NavierStokes::max_divergence() const {
+  const int b = forest_.block_cells();
+  const BlockLayout L = p_.layout();
+  double worst = 0.0;
+  for (int blk = 0; blk < forest_.local_blocks(); ++blk) {
+    const double h = forest_.block(blk).length / b;
+    for_each_cell(b, [&](int i, int j, int k) {
+      const std::ptrdiff_t c = L.index(i, j, k);
+      double div = 0.0;
+      for (int d = 0; d < 3; ++d)
+        div += uf_[D(d)].block(blk)[c + L.stride(d)] - uf_[D(d)].block(blk)[c];
+      worst = std::max(worst, std::abs(div) / h);
+    });
+  }
+  return forest_.max(worst);
+}
+
+BlockField NavierStokes::vorticity_magnitude() {
+  const int b = forest_.block_cells();
+  fill_velocity_ghosts(u_, 1);
+  BlockField out(forest_.local_blocks(), b);
+  const BlockLayout L = out.layout();
+  forest_.for_each_block([&](int blk) {
+    const double h = forest_.block(blk).length / b;
+    auto dd = [&](int comp, int d, std::ptrdiff_t c) {
+      const double* u = u_[D(comp)].block(blk);
+      return (u[c + L.stride(d)] - u[c - L.stride(d)]) / (2.0 * h);
+    };
+    for_each_cell(b, [&](int i, int j, int k) {
+      const std::ptrdiff_t c = L.index(i, j, k);
+      const double wx = dd(2, 1, c) - dd(1, 2, c);
+      const double wy = dd(0, 2, c) - dd(2, 0, c);
+      const double wz = dd(1, 0, c) - dd(0, 1, c);
+      out.block(blk)[c] = std::sqrt(wx * wx + wy * wy + wz * wz);
+    });
+  });
+  return out;
+}
+
+}  // namespace sanguis::flow

@@ -1,0 +1,171 @@
+#pragma once
+// Incompressible Navier-Stokes equations, constant density, variable
+// viscosity, body force (thesis eq. 4.1-4.2):
+//
+//     rho (du/dt + u.grad u) = -grad p + div(mu (grad u + grad u^T)) + f_b
+//     div u = 0
+//
+// on a forest of blocks, following the solver the thesis used (Basilisk
+// navier-stokes/centered.h, §4.3.1; Popinet 2003, 2009): a velocity u and the
+// pressure p at cell centres, a face velocity uf that is exactly
+// divergence-free (to the multigrid tolerance), body forces on faces.
+// One step, dt:
+//   1. prediction: uf at t + dt/2 from u by the Bell-Colella-Glaz upwind
+//      scheme (Bell, Colella & Glaz 1989), MAC-projected with dt/2;
+//   2. advection: u* = u - dt div(uf u_{n+1/2}) with the face values of u by
+//      BCG (second order in space and time);
+//   3. viscosity: (rho/dt - theta div(mu grad)) u** = rho/dt (u* + dt g) +
+//      (1 - theta) div(mu grad u), then u** -= dt g (theta = 1 backward
+//      Euler, 1/2 Crank-Nicolson), solved by multigrid;
+//   4. acceleration: uf = face average of u** + dt a (a = f_b / rho on faces);
+//   5. projection (Chorin 1968): div((dt/rho) grad p) = div uf,
+//      uf -= (dt/rho) grad p, g = cell average of (a - grad p / rho),
+//      u = u** + dt g.
+// The term div(mu grad u^T) vanishes for uniform mu; for variable mu it is
+// added explicitly (with u^n) to the right-hand side of the viscous step.
+// Face viscosities are harmonic means of the two cells.
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <limits>
+
+#include "core/error.hpp"
+#include "flow/block_field.hpp"
+#include "flow/boundary.hpp"
+#include "flow/forest.hpp"
+#include "flow/multigrid.hpp"
+
+namespace sanguis::flow {
+
+enum class FlowBoundaryKind : std::uint8_t {
+  Periodic,  ///< the forest is periodic in this direction
+  Wall,      ///< no-slip wall moving with `wall_velocity` (tangential)
+  Inflow,    ///< prescribed velocity `inflow(x, t)`
+  Outflow,   ///< zero normal gradient of velocity, pressure 0
+};
+
+using VelocityProfile = std::function<Vec3(const Vec3& x, double t)>;
+
+struct FlowBoundary {
+  FlowBoundaryKind kind = FlowBoundaryKind::Wall;  ///< condition type
+  Vec3 wall_velocity{};                            ///< Wall: velocity of the wall (m/s)
+  VelocityProfile inflow;                          ///< Inflow: velocity on the face (m/s)
+};
+
+struct Fluid {
+  double density = 1.0;    ///< rho (kg/m^3)
+  double viscosity = 1.0;  ///< mu (Pa s), the uniform value the viscosity field starts from
+};
+
+struct NavierStokesOptions {
+  double cfl = 0.8;  ///< dt <= cfl h / max |uf| (BCG is stable up to 1)
+  double dt_max = std::numeric_limits<double>::infinity();  ///< user maximum (s)
+  double viscous_theta = 1.0;  ///< implicitness of the viscous step (1: Euler, 0.5: CN)
+  MultigridOptions pressure{1e-6, 50, 2, 2, 1.15};  ///< projection solves
+  MultigridOptions viscous{1e-6, 50, 2, 2, 1.15};   ///< viscous solves
+};
+
+/// What one step did.
+struct StepReport {
+  double dt = 0.0;
+  int pressure_cycles = 0;          ///< V-cycles of the final projection
+  int predictor_cycles = 0;         ///< V-cycles of the predictor projection
+  int viscous_cycles = 0;           ///< V-cycles of the three viscous solves
+  double pressure_reduction = 0.0;  ///< mean residual reduction per cycle (final projection)
+};
+
+class NavierStokes {
+ public:
+  NavierStokes(const Forest& forest, const std::array<FlowBoundary, 6>& boundaries,
+               const Fluid& fluid, const NavierStokesOptions& options = {});
+
+  /// Sets u(x) at cell centres, projects it (uf exactly divergence-free),
+  /// resets the pressure and the time.
+  void set_velocity(const std::function<Vec3(const Vec3&)>& u, double time = 0.0);
+  /// Body force density f_b(x) (N/m^3), sampled on faces.
+  void set_body_force(const std::function<Vec3(const Vec3&)>& f);
+  /// Dynamic viscosity mu(x) (Pa s) per cell.
+  void set_viscosity(const std::function<double(const Vec3&)>& mu);
+
+  /// Solid cells (cell masks aligned with the grid): solid(x) at cell
+  /// centres. Solid cells hold no flow; their faces with fluid cells are
+  /// no-slip walls (linear closure) closed to the flow. Call before set_velocity.
+  void set_solid(const std::function<bool(const Vec3&)>& solid);
+  [[nodiscard]] const BlockField& solid() const { return solid_; }
+
+  /// Largest stable step: min(dt_max, cfl h / max|uf|).
+  [[nodiscard]] double stable_dt() const;
+  /// Advances by dt.
+  StepReport step(double dt);
+
+  [[nodiscard]] double time() const { return time_; }
+  [[nodiscard]] const Forest& forest() const { return forest_; }
+  [[nodiscard]] VectorField& velocity() { return u_; }
+  [[nodiscard]] const VectorField& velocity() const { return u_; }
+  [[nodiscard]] const FaceField& face_velocity() const { return uf_; }
+  [[nodiscard]] FaceField& face_velocity() { return uf_; }
+  [[nodiscard]] BlockField& pressure() { return p_; }
+  [[nodiscard]] const BlockField& pressure() const { return p_; }
+  [[nodiscard]] const BlockField& viscosity() const { return mu_; }
+  [[nodiscard]] BlockField& viscosity() { return mu_; }
+  [[nodiscard]] const VectorField& pressure_gradient() const { return g_; }
+  [[nodiscard]] VectorField& pressure_gradient() { return g_; }
+  [[nodiscard]] const Fluid& fluid() const { return fluid_; }
+  [[nodiscard]] const std::array<FlowBoundary, 6>& boundaries() const { return boundaries_; }
+  void set_time(double t) { time_ = t; }
+
+  /// Largest |div uf| over all cells (1/s): zero to the projection tolerance.
+  [[nodiscard]] double max_divergence() const;
+  /// |curl u| at cell centres (1/s), central differences.
+  [[nodiscard]] BlockField vorticity_magnitude();
+  /// Fills the ghost cells of the velocity (width 2) with the boundary conditions.
+  void fill_velocity_ghosts(VectorField& u, int width = kGhost);
+  /// The last multigrid report of the final projection.
+  [[nodiscard]] const MultigridReport& last_pressure_report() const { return pressure_report_; }
+
+ private:
+  void predict_face_velocity(double dt);
+  void advect(double dt);
+  void viscous_step(double dt, StepReport& report);
+  void face_average_plus_acceleration(double dt);
+  MultigridReport project(BlockField& phi);
+  void set_boundary_faces(FaceField& uf) const;
+  void fill_face_ghosts(FaceField& uf);
+  void fill_scalar_neumann(BlockField& f, int width);
+  void update_viscous_coefficients(double dt);
+  void close_solid_faces(FaceField& uf) const;
+  void add_transpose_stress(double dt);
+  void clear_solid_cells(VectorField& u) const;
+
+  const Forest& forest_;
+  std::array<FlowBoundary, 6> boundaries_;
+  Fluid fluid_;
+  NavierStokesOptions options_;
+  double time_ = 0.0;
+  double bc_time_ = 0.0;  ///< time at which inflow profiles are evaluated
+
+  VectorField u_;        ///< cell-centred velocity (m/s)
+  VectorField g_;        ///< cell-centred a - grad p / rho (m/s^2)
+  BlockField p_;         ///< cell-centred pressure (Pa)
+  BlockField phi_;       ///< projection potential (dt/rho) p of the predictor, warm start
+  FaceField uf_;         ///< face velocity, exactly divergence-free after a step (m/s)
+  FaceField accel_;      ///< body force / rho on faces (m/s^2)
+  BlockField mu_;        ///< dynamic viscosity per cell (Pa s)
+  VectorField scratch_;  ///< u* and other temporaries
+
+  std::array<ScalarBoundary, 3> velocity_bc_;  ///< per velocity component
+  ScalarBoundary pressure_bc_;
+  Multigrid pressure_mg_;
+  Multigrid viscous_mg_;
+  double viscous_dt_ = -1.0;  ///< dt the viscous coefficients were built for
+  bool viscosity_changed_ = true;
+  bool has_solids_ = false;
+  bool variable_viscosity_ = false;  ///< mu not uniform: the grad u^T stress is added
+  BlockField solid_;                 ///< 1 in solid cells, 0 in fluid cells
+  FaceField
+      open_;  ///< 1 on faces between two fluid cells (or fluid and the domain boundary), else 0
+  MultigridReport pressure_report_;
+};
+
+}  // namespace sanguis::flow

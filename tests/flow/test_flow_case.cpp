@@ -1,0 +1,162 @@
+// Flow case files: strict reading, an end-to-end run with its outputs, and a
+// restart that continues bit for bit.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <string>
+
+#include "core/config.hpp"
+#include "flow/flow_case.hpp"
+#include "flow/flow_run.hpp"
+
+namespace sanguis::flow {
+namespace {
+
+const std::string kChannel = R"(
+[simulation]
+name = "channel"
+end_time_s = 0.04
+threads = 1
+
+[flow.grid]
+size_m = [0.5, 1.0, 0.5]
+cells = [8, 16, 8]
+
+[flow.fluid]
+density_kg_m3 = 1.0
+viscosity_Pa_s = 1.0
+
+[flow.boundary]
+x_min = { type = "periodic" }
+x_max = { type = "periodic" }
+y_min = { type = "wall" }
+y_max = { type = "wall", velocity_m_s = [0.5, 0.0, 0.0] }
+z_min = { type = "periodic" }
+z_max = { type = "periodic" }
+
+[flow]
+body_force_N_m3 = [2.0, 0.0, 0.0]
+
+[flow.time]
+max_time_step_s = 0.005
+
+[output]
+interval_s = 0.01
+)";
+
+FlowCase parse(const std::string& text) {
+  return load_flow_case(ConfigTable::parse_string(text, "case.toml"), "case.toml");
+}
+
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return text.replace(at, from.size(), to);
+}
+
+void expect_input_error(const std::string& text, const std::string& fragment) {
+  try {
+    parse(text);
+    ADD_FAILURE() << "no error; expected one mentioning " << fragment;
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+  }
+}
+
+std::string read_bytes(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+TEST(FlowCase, ValidCaseResolvesGridBoundariesAndFluid) {
+  const FlowCase c = parse(kChannel);
+  EXPECT_EQ(c.name, "channel");
+  EXPECT_EQ(c.cells[1], 16);
+  EXPECT_EQ(c.forest.block_cells, 8);
+  EXPECT_EQ(c.forest.trees[0] * (8 << c.forest.level), 8);
+  EXPECT_EQ(c.forest.trees[1] * (8 << c.forest.level), 16);
+  EXPECT_TRUE(c.forest.periodic[0]);
+  EXPECT_FALSE(c.forest.periodic[1]);
+  EXPECT_EQ(c.boundaries[face_index(1, 1)].kind, FlowBoundaryKind::Wall);
+  EXPECT_DOUBLE_EQ(c.boundaries[face_index(1, 1)].wall_velocity.x, 0.5);
+  EXPECT_DOUBLE_EQ(c.body_force.x, 2.0);
+  EXPECT_DOUBLE_EQ(c.options.dt_max, 0.005);
+}
+
+TEST(FlowCase, SolidBoxesAreReadAndRun) {
+  const std::string text = kChannel + R"(
+[[flow.solid]]
+min_m = [0.0, 0.4, 0.0]
+max_m = [0.25, 0.6, 0.5]
+)";
+  const FlowCase c = parse(text);
+  ASSERT_EQ(c.solid_boxes.size(), 1u);
+  EXPECT_DOUBLE_EQ(c.solid_boxes[0][1].y, 0.6);
+  expect_input_error(replaced(text, "max_m = [0.25, 0.6, 0.5]", "max_m = [0.25, 0.3, 0.5]"),
+                     "flow.solid[0].max_m");
+  const auto dir = std::filesystem::temp_directory_path() / "sanguis_flow_solid_test";
+  std::filesystem::remove_all(dir);
+  FlowRunOptions options;
+  options.output_dir = dir;
+  options.quiet = true;
+  std::ostringstream console;
+  const auto summary = run_flow_case(c, options, console);
+  EXPECT_NEAR(summary.simulated_time, 0.04, 1e-12);
+  const std::string log = read_bytes(dir / "run.log");
+  EXPECT_NE(log.find("solid box"), std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(FlowCaseErrors, UnknownKeysNonCubicCellsAndOneSidedPeriodicityAreErrors) {
+  expect_input_error(replaced(kChannel, "viscosity_Pa_s", "viscosity_Pas"), "viscosity_Pa_s");
+  expect_input_error(replaced(kChannel, "cells = [8, 16, 8]", "cells = [8, 16, 16]"), "cubes");
+  expect_input_error(replaced(kChannel, "cells = [8, 16, 8]", "cells = [8, 12, 8]"), "multiple");
+  expect_input_error(
+      replaced(kChannel, "x_max = { type = \"periodic\" }", "x_max = { type = \"wall\" }"),
+      "periodic");
+  expect_input_error(
+      replaced(kChannel, "y_max = { type = \"wall\", velocity_m_s = [0.5, 0.0, 0.0] }",
+               "y_max = { type = \"wall\", velocity_m_s = [0.0, 0.5, 0.0] }"),
+      "tangentially");
+  expect_input_error(replaced(kChannel, "type = \"wall\" }", "type = \"wal\" }"), "y_min.type");
+  expect_input_error(replaced(kChannel, "interval_s = 0.01", "interval_s = 0.01\nsnapshots = 3"),
+                     "snapshots");
+}
+
+TEST(FlowRun, WritesFramesDiagnosticsAndRestartsBitForBit) {
+  const auto base = std::filesystem::temp_directory_path() / "sanguis_flow_run_test";
+  std::filesystem::remove_all(base);
+  const FlowCase c = parse(kChannel);
+  std::ostringstream console;
+
+  FlowRunOptions whole;
+  whole.output_dir = base / "whole";
+  whole.quiet = true;
+  const auto summary = run_flow_case(c, whole, console);
+  EXPECT_NEAR(summary.simulated_time, 0.04, 1e-12);
+  EXPECT_TRUE(std::filesystem::exists(whole.output_dir / "flow.pvd"));
+  EXPECT_TRUE(std::filesystem::exists(whole.output_dir / "flow" / "flow_00000004.vtu"));
+  EXPECT_TRUE(std::filesystem::exists(whole.output_dir / "run.log"));
+  const std::string csv = read_bytes(whole.output_dir / "diagnostics.csv");
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 6);  // header + t = 0, 0.01, ..., 0.04
+
+  FlowRunOptions split = whole;
+  split.output_dir = base / "split";
+  split.stop_at = 0.02;
+  run_flow_case(c, split, console);
+  split.stop_at = -1.0;
+  split.restart = true;
+  run_flow_case(c, split, console);
+  EXPECT_EQ(read_bytes(whole.output_dir / "checkpoint.bin"),
+            read_bytes(split.output_dir / "checkpoint.bin"));
+  EXPECT_EQ(read_bytes(whole.output_dir / "diagnostics.csv"),
+            read_bytes(split.output_dir / "diagnostics.csv"));
+  EXPECT_EQ(read_bytes(whole.output_dir / "flow.pvd"), read_bytes(split.output_dir / "flow.pvd"));
+  std::filesystem::remove_all(base);
+}
+
+}  // namespace
+}  // namespace sanguis::flow

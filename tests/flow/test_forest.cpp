@@ -1,0 +1,119 @@
+// Forest of blocks: brick geometry, neighbours, ghost exchange (periodic wrap
+// included) and boundary ghost filling.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "flow/boundary.hpp"
+#include "flow/forest.hpp"
+
+namespace sanguis::flow {
+namespace {
+
+/// A value that identifies a global cell (wrapped into the domain).
+double cell_tag(std::int64_t gx, std::int64_t gy, std::int64_t gz) {
+  return static_cast<double>(gx) + 1000.0 * static_cast<double>(gy) + 1e6 * static_cast<double>(gz);
+}
+
+TEST(FlowForest, BrickOfAnyAspectRatioHasTheRightBlocksAndExtent) {
+  ForestSpec spec;
+  spec.trees = {1, 2, 3};
+  spec.level = 1;
+  spec.block_cells = 4;
+  spec.tree_length = 0.5;
+  const Forest forest(spec);
+  EXPECT_EQ(forest.global_blocks(), 6 * 8);
+  EXPECT_EQ(forest.local_blocks() * forest.ranks(), forest.global_blocks());
+  EXPECT_DOUBLE_EQ(forest.extent().z, 1.5);
+  const auto n = forest.blocks_per_direction(1);
+  EXPECT_EQ(n[0], 2);
+  EXPECT_EQ(n[2], 6);
+  for (int b = 0; b < forest.local_blocks(); ++b) {
+    const Block& block = forest.block(b);
+    EXPECT_DOUBLE_EQ(block.length, 0.25);
+    EXPECT_DOUBLE_EQ(block.lower.y, 0.25 * static_cast<double>(block.coord[1]));
+  }
+}
+
+TEST(FlowForest, GhostExchangeCopiesNeighbourCellsWithPeriodicWrap) {
+  ForestSpec spec;
+  spec.trees = {2, 1, 1};
+  spec.periodic = {true, true, false};
+  spec.level = 1;
+  spec.block_cells = 4;
+  const Forest forest(spec);
+  const int b = spec.block_cells;
+  const auto nb = forest.blocks_per_direction(spec.level);
+  const std::array<std::int64_t, 3> n{nb[0] * b, nb[1] * b, nb[2] * b};
+  BlockField field(forest.local_blocks(), b);
+  field.fill(-1.0);
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    const auto& c = forest.block(blk).coord;
+    for (int k = 0; k < b; ++k)
+      for (int j = 0; j < b; ++j)
+        for (int i = 0; i < b; ++i)
+          field(blk, i, j, k) = cell_tag(c[0] * b + i, c[1] * b + j, c[2] * b + k);
+  }
+  forest.exchange(field, kGhost);
+  int checked = 0;
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    const auto& c = forest.block(blk).coord;
+    for (int k = -kGhost; k < b + kGhost; ++k)
+      for (int j = -kGhost; j < b + kGhost; ++j)
+        for (int i = -kGhost; i < b + kGhost; ++i) {
+          std::int64_t g[3] = {c[0] * b + i, c[1] * b + j, c[2] * b + k};
+          bool outside = false;
+          for (int d = 0; d < 3; ++d) {
+            if (g[d] < 0 || g[d] >= n[static_cast<std::size_t>(d)]) {
+              if (spec.periodic[static_cast<std::size_t>(d)]) {
+                g[d] = (g[d] + n[static_cast<std::size_t>(d)]) % n[static_cast<std::size_t>(d)];
+              } else {
+                outside = true;
+              }
+            }
+          }
+          if (outside) {
+            EXPECT_EQ(field(blk, i, j, k), -1.0);  // left for the boundary conditions
+            continue;
+          }
+          ASSERT_EQ(field(blk, i, j, k), cell_tag(g[0], g[1], g[2]))
+              << blk << ' ' << i << ' ' << j << ' ' << k;
+          ++checked;
+        }
+  }
+  EXPECT_GT(checked, 0);
+}
+
+TEST(FlowForest, DirichletAndNeumannGhostsReproduceTheFaceValue) {
+  ForestSpec spec;
+  spec.level = 1;
+  spec.block_cells = 4;
+  const Forest forest(spec);
+  BlockField field(forest.local_blocks(), 4);
+  field.fill(1.0);
+  ScalarBoundary bc;
+  bc.kind = uniform_kinds(forest, BcKind::Dirichlet);
+  bc.kind[face_index(2, 1)] = BcKind::Neumann;
+  bc.value[face_index(0, 0)] = [](const Vec3& x) { return 3.0 + x.y; };
+  forest.exchange(field, 2);
+  fill_boundary_ghosts(forest, field, bc, 2);
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    const Block& block = forest.block(blk);
+    if (block.coord[0] == 0) {
+      const double y = block.lower.y + 1.5 * block.length / 4;
+      // Quadratic closure: the face value from the ghost and two interior cells.
+      EXPECT_DOUBLE_EQ(
+          (3 * field(blk, -1, 1, 1) + 6 * field(blk, 0, 1, 1) - field(blk, 1, 1, 1)) / 8, 3.0 + y);
+      EXPECT_DOUBLE_EQ(0.5 * (field(blk, -2, 1, 1) + field(blk, 1, 1, 1)), 3.0 + y);
+    }
+    if (block.coord[0] == 1) {
+      EXPECT_DOUBLE_EQ(field(blk, 4, 1, 1), -5.0 / 3.0);
+    }
+    if (block.coord[2] == 1) {
+      EXPECT_DOUBLE_EQ(field(blk, 1, 1, 5), 1.0);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace sanguis::flow

@@ -1,0 +1,404 @@
+// Navier-Stokes on a forest of blocks: Taylor-Green vortex (second-order
+// convergence), plane Poiseuille (flow rate), Couette at Re = 0.01 with the
+// implicit viscous step (exact linear profile, stable), exact divergence of
+// the face velocity.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "flow/navier_stokes.hpp"
+#include "poisson_problems.hpp"
+
+namespace sanguis::flow {
+namespace {
+
+using testing::cell_centre;
+using testing::kPi;
+
+std::array<FlowBoundary, 6> all_periodic() {
+  std::array<FlowBoundary, 6> bcs{};
+  for (auto& bc : bcs) bc.kind = FlowBoundaryKind::Periodic;
+  return bcs;
+}
+
+/// Channel periodic in x and z, walls at y = 0 and y = H (the upper one moving with `lid`).
+std::array<FlowBoundary, 6> channel(double lid) {
+  auto bcs = all_periodic();
+  bcs[face_index(1, 0)].kind = FlowBoundaryKind::Wall;
+  bcs[face_index(1, 1)].kind = FlowBoundaryKind::Wall;
+  bcs[face_index(1, 1)].wall_velocity = {lid, 0.0, 0.0};
+  return bcs;
+}
+
+/// Taylor-Green vortex in the unit square (periodic, one block thick in z),
+/// max velocity error at t_end with dt proportional to h.
+double taylor_green_error(int cells, double nu, double t_end) {
+  ForestSpec spec;
+  spec.block_cells = 8;
+  spec.trees = {cells / 8, cells / 8, 1};
+  spec.tree_length = 1.0 / (cells / 8);
+  spec.periodic = {true, true, true};
+  const Forest forest(spec);
+  NavierStokesOptions options;
+  options.viscous_theta = 0.5;
+  options.pressure.tolerance = 1e-10;
+  options.viscous.tolerance = 1e-10;
+  NavierStokes ns(forest, all_periodic(), Fluid{1.0, nu}, options);
+  auto exact = [nu](const Vec3& x, double t) {
+    const double decay = std::exp(-8.0 * kPi * kPi * nu * t);
+    return Vec3{std::sin(2 * kPi * x.x) * std::cos(2 * kPi * x.y) * decay,
+                -std::cos(2 * kPi * x.x) * std::sin(2 * kPi * x.y) * decay, 0.0};
+  };
+  ns.set_velocity([&](const Vec3& x) { return exact(x, 0.0); });
+  const double h = 1.0 / cells;
+  const int steps = static_cast<int>(std::lround(t_end / (0.25 * h)));
+  const double dt = t_end / steps;
+  for (int s = 0; s < steps; ++s) ns.step(dt);
+  EXPECT_LT(ns.max_divergence(), 1e-7);
+  double error = 0.0;
+  for (int blk = 0; blk < forest.local_blocks(); ++blk)
+    for (int k = 0; k < 8; ++k)
+      for (int j = 0; j < 8; ++j)
+        for (int i = 0; i < 8; ++i) {
+          const Vec3 e = exact(cell_centre(forest, blk, i, j, k), ns.time());
+          for (int c = 0; c < 3; ++c)
+            error = std::max(error, std::abs(ns.velocity()[c](blk, i, j, k) - e[c]));
+        }
+  return forest.max(error);
+}
+
+TEST(FlowNavierStokes, TaylorGreenVortexConvergesAtSecondOrder) {
+  const double e16 = taylor_green_error(16, 0.01, 0.25);
+  const double e32 = taylor_green_error(32, 0.01, 0.25);
+  const double e64 = taylor_green_error(64, 0.01, 0.25);
+  std::printf(
+      "Taylor-Green (nu 0.01, t 0.25, dt = h/4): max error 16^2 %.3e, 32^2 %.3e, 64^2 %.3e, "
+      "orders %.2f %.2f\n",
+      e16, e32, e64, std::log2(e16 / e32), std::log2(e32 / e64));
+  EXPECT_GT(std::log2(e32 / e64), 1.8);
+}
+
+/// The 3D Arnold-Beltrami-Childress flow on the periodic unit cube, an exact
+/// decaying Navier-Stokes solution (u x curl u = 0: the advection is a
+/// pressure gradient): max velocity error at t_end with dt = h/5.
+double abc_flow_error(int cells, double nu, double t_end) {
+  ForestSpec spec;
+  spec.level = cells == 16 ? 1 : 2;
+  spec.periodic = {true, true, true};
+  const Forest forest(spec);
+  NavierStokesOptions options;
+  options.viscous_theta = 0.5;
+  options.pressure.tolerance = 1e-10;
+  options.viscous.tolerance = 1e-10;
+  NavierStokes ns(forest, all_periodic(), Fluid{1.0, nu}, options);
+  auto exact = [nu](const Vec3& x, double t) {
+    const double k = 2 * kPi, decay = std::exp(-k * k * nu * t);
+    return Vec3{std::sin(k * x.z) + std::cos(k * x.y), std::sin(k * x.x) + std::cos(k * x.z),
+                std::sin(k * x.y) + std::cos(k * x.x)} *
+           decay;
+  };
+  ns.set_velocity([&](const Vec3& x) { return exact(x, 0.0); });
+  const int steps = static_cast<int>(std::lround(t_end * cells * 5.0));
+  for (int s = 0; s < steps; ++s) ns.step(t_end / steps);
+  double error = 0.0;
+  const int b = forest.block_cells();
+  for (int blk = 0; blk < forest.local_blocks(); ++blk)
+    for (int k = 0; k < b; ++k)
+      for (int j = 0; j < b; ++j)
+        for (int i = 0; i < b; ++i) {
+          const Vec3 e = exact(cell_centre(forest, blk, i, j, k), ns.time());
+          for (int c = 0; c < 3; ++c)
+            error = std::max(error, std::abs(ns.velocity()[c](blk, i, j, k) - e[c]));
+        }
+  return forest.max(error);
+}
+
+TEST(FlowNavierStokes, ThreeDimensionalBeltramiFlowConvergesAtSecondOrder) {
+  const double e16 = abc_flow_error(16, 0.05, 0.1);
+  const double e32 = abc_flow_error(32, 0.05, 0.1);
+  std::printf(
+      "ABC (Beltrami) flow 3D (nu 0.05, t 0.1, dt = h/5): max error 16^3 %.3e, 32^3 %.3e, order "
+      "%.2f\n",
+      e16, e32, std::log2(e16 / e32));
+  EXPECT_GT(std::log2(e16 / e32), 1.8);
+}
+
+/// Mean over x and z of u_x at cell row j of the channel (y cells = 16).
+std::vector<double> profile(const Forest& forest, const NavierStokes& ns, int rows) {
+  std::vector<double> sum(static_cast<std::size_t>(rows), 0.0),
+      count(static_cast<std::size_t>(rows), 0.0);
+  const int b = forest.block_cells();
+  for (int blk = 0; blk < forest.local_blocks(); ++blk)
+    for (int k = 0; k < b; ++k)
+      for (int j = 0; j < b; ++j)
+        for (int i = 0; i < b; ++i) {
+          const auto row = static_cast<std::size_t>(forest.block(blk).coord[1] * b + j);
+          sum[row] += ns.velocity()[0](blk, i, j, k);
+          count[row] += 1.0;
+        }
+  for (std::size_t r = 0; r < sum.size(); ++r) sum[r] = forest.sum(sum[r]) / forest.sum(count[r]);
+  return sum;
+}
+
+Forest make_channel_forest() {
+  ForestSpec spec;
+  spec.trees = {1, 2, 1};
+  spec.tree_length = 0.5;  // H = 1, 16 cells across
+  spec.periodic = {true, false, true};
+  return Forest(spec);
+}
+
+TEST(FlowNavierStokes, PlanePoiseuilleFlowRateWithinHalfAPercentAt16CellsAcross) {
+  const Forest forest = make_channel_forest();
+  const double G = 2.0, mu = 1.0, H = 1.0;  // body force density (= -dp/dx), viscosity
+  NavierStokesOptions options;
+  options.dt_max = 0.01;
+  options.viscous.tolerance = 1e-10;
+  NavierStokes ns(forest, channel(0.0), Fluid{1.0, mu}, options);
+  ns.set_velocity([](const Vec3&) { return Vec3{}; });
+  ns.set_body_force([G](const Vec3&) { return Vec3{G, 0.0, 0.0}; });
+  for (int s = 0; s < 300; ++s) ns.step(ns.stable_dt());  // 3 diffusion times H^2 rho/mu
+  const auto u = profile(forest, ns, 16);
+  const double h = H / 16;
+  double flow_rate = 0.0, worst = 0.0;
+  for (int j = 0; j < 16; ++j) {
+    const double y = (j + 0.5) * h;
+    flow_rate += u[static_cast<std::size_t>(j)] * h;
+    worst = std::max(worst, std::abs(u[static_cast<std::size_t>(j)] - G / (2 * mu) * y * (H - y)));
+  }
+  const double exact = G * H * H * H / (12 * mu);
+  std::printf("Poiseuille: flow rate %.6f exact %.6f (rel. error %.2e), max profile error %.2e\n",
+              flow_rate, exact, std::abs(flow_rate / exact - 1), worst);
+  EXPECT_LT(std::abs(flow_rate / exact - 1.0), 5e-3);
+  EXPECT_LT(ns.max_divergence(), 1e-8);
+}
+
+TEST(FlowNavierStokes, CouetteAtReynolds0p01IsExactlyLinearAndStable) {
+  const Forest forest = make_channel_forest();
+  const double U = 1.0, H = 1.0, rho = 1.0;
+  const double mu = rho * U * H / 0.01;  // Re = rho U H / mu = 0.01
+  const double dt = 1e-3 * H / U;        // shear rate x dt = 1e-3
+  NavierStokesOptions options;
+  options.pressure.tolerance = 1e-10;
+  options.viscous.tolerance = 1e-10;
+  NavierStokes ns(forest, channel(U), Fluid{rho, mu}, options);
+  ns.set_velocity([](const Vec3&) { return Vec3{}; });
+  // The diffusion time H^2 rho / mu = 0.01 = 10 dt: 500 steps reach steady
+  // state, at a viscous number mu dt / (rho h^2) = 25.6 (explicit limit 1/6).
+  double worst = 0.0;
+  for (int s = 0; s < 500; ++s) ns.step(dt);
+  const auto u = profile(forest, ns, 16);
+  for (int j = 0; j < 16; ++j) {
+    const double y = (j + 0.5) / 16.0 * H;
+    worst = std::max(worst, std::abs(u[static_cast<std::size_t>(j)] - U * y / H));
+  }
+  double vmax = 0.0;
+  for (int blk = 0; blk < forest.local_blocks(); ++blk)
+    for (int k = 0; k < 8; ++k)
+      for (int j = 0; j < 8; ++j)
+        for (int i = 0; i < 8; ++i)
+          vmax = std::max({vmax, std::abs(ns.velocity()[1](blk, i, j, k)),
+                           std::abs(ns.velocity()[2](blk, i, j, k))});
+  std::printf(
+      "Couette Re 0.01: max deviation from the linear profile %.2e (U = 1), cross flow %.2e\n",
+      worst, vmax);
+  EXPECT_LT(worst, 1e-9);
+  EXPECT_LT(forest.max(vmax), 1e-10);
+}
+
+TEST(FlowNavierStokes, SquareDuctFlowRateMatchesTheSeriesSolutionAt16CellsAcross) {
+  // Square duct of side a = 1 (walls at y, z = 0 and 1), periodic along x,
+  // driven by a body force G: Q = 4 b c^3 G/(3 mu) [1 - 192 c/(pi^5 b)
+  // sum_{i odd} tanh(i pi b / 2c) / i^5] with b = c = a/2 (White, Viscous
+  // Fluid Flow, eq. 3-48).
+  ForestSpec spec;
+  spec.trees = {1, 2, 2};
+  spec.tree_length = 0.5;
+  spec.periodic = {true, false, false};
+  const Forest forest(spec);
+  std::array<FlowBoundary, 6> bcs{};
+  bcs[face_index(0, 0)].kind = bcs[face_index(0, 1)].kind = FlowBoundaryKind::Periodic;
+  const double G = 2.0, mu = 1.0;
+  NavierStokesOptions options;
+  options.dt_max = 0.01;
+  options.viscous.tolerance = 1e-10;
+  options.pressure.tolerance = 1e-10;
+  NavierStokes ns(forest, bcs, Fluid{1.0, mu}, options);
+  ns.set_velocity([](const Vec3&) { return Vec3{}; });
+  ns.set_body_force([G](const Vec3&) { return Vec3{G, 0.0, 0.0}; });
+  for (int s = 0; s < 200; ++s) ns.step(ns.stable_dt());  // 2 diffusion times a^2 rho / mu
+  const int b = forest.block_cells();
+  double volume_flux = 0.0;
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    const double h = forest.block(blk).length / b;
+    for (int k = 0; k < b; ++k)
+      for (int j = 0; j < b; ++j)
+        for (int i = 0; i < b; ++i) volume_flux += ns.velocity()[0](blk, i, j, k) * h * h * h;
+  }
+  const double rate = forest.sum(volume_flux) / 0.5;  // over the duct length 0.5
+  double series = 0.0;
+  for (int i = 1; i < 200; i += 2) series += std::tanh(i * kPi / 2.0) / std::pow(i, 5);
+  const double half = 0.5;
+  const double exact =
+      4.0 * half * half * half * half * G / (3.0 * mu) * (1.0 - 192.0 / std::pow(kPi, 5) * series);
+  std::printf("square duct, 16 x 16 cells: flow rate %.6f, series %.6f, relative error %.2e\n",
+              rate, exact, rate / exact - 1.0);
+  EXPECT_LT(std::abs(rate / exact - 1.0), 5e-3);
+}
+
+TEST(FlowNavierStokes, OpenMpThreadsOverBlocksGiveTheSameResultBitForBit) {
+  auto run = [](int threads) {
+    ForestSpec spec;
+    spec.level = 1;  // 16^3 cells in 8 blocks
+    spec.threads = threads;
+    const Forest forest(spec);
+    std::array<FlowBoundary, 6> bcs{};
+    bcs[face_index(1, 1)].wall_velocity = {1.0, 0.0, 0.0};
+    NavierStokes ns(forest, bcs, Fluid{1.0, 0.01});
+    ns.set_velocity([](const Vec3&) { return Vec3{}; });
+    for (int s = 0; s < 5; ++s) ns.step(0.02);
+    return std::array<std::vector<double>, 2>{ns.velocity()[0].raw(), ns.pressure().raw()};
+  };
+  const auto one = run(1), two = run(2);
+  EXPECT_EQ(one[0], two[0]);
+  EXPECT_EQ(one[1], two[1]);
+}
+
+TEST(FlowNavierStokes, TwoLayerCouetteWithAViscosityJumpIsExact) {
+  // mu = 1 below y = 0.5, 4 above (the jump on a face); lid U = 1 at y = 1.
+  // Steady: uniform shear stress tau = U / (0.5/1 + 0.5/4) = 1.6, u piecewise linear.
+  const Forest forest = make_channel_forest();
+  NavierStokesOptions options;
+  options.dt_max = 0.01;
+  options.pressure.tolerance = 1e-10;
+  options.viscous.tolerance = 1e-10;
+  NavierStokes ns(forest, channel(1.0), Fluid{1.0, 1.0}, options);
+  ns.set_viscosity([](const Vec3& x) { return x.y < 0.5 ? 1.0 : 4.0; });
+  ns.set_velocity([](const Vec3&) { return Vec3{}; });
+  for (int s = 0; s < 400; ++s) ns.step(ns.stable_dt());
+  const auto u = profile(forest, ns, 16);
+  const double tau = 1.6;
+  double worst = 0.0;
+  for (int j = 0; j < 16; ++j) {
+    const double y = (j + 0.5) / 16.0;
+    const double exact = y < 0.5 ? tau * y : tau * 0.5 + tau * (y - 0.5) / 4.0;
+    worst = std::max(worst, std::abs(u[static_cast<std::size_t>(j)] - exact));
+  }
+  std::printf("two-layer Couette (viscosity ratio 4): max deviation %.2e\n", worst);
+  EXPECT_LT(worst, 1e-8);
+}
+
+/// Channel of height 1 between two solid slabs (cell masks) in a periodic box
+/// 0.5 x 1.5 x 0.5, driven by a body force: flow rate relative error and the
+/// largest velocity inside the solids.
+std::pair<double, double> masked_channel(int level) {
+  ForestSpec spec;
+  spec.trees = {1, 3, 1};
+  spec.tree_length = 0.5;
+  spec.level = level;
+  spec.periodic = {true, true, true};
+  const Forest forest(spec);
+  const double G = 2.0, mu = 1.0;
+  NavierStokesOptions options;
+  options.dt_max = 0.01;
+  options.viscous.tolerance = 1e-10;
+  options.pressure.tolerance = 1e-10;
+  NavierStokes ns(forest, all_periodic(), Fluid{1.0, mu}, options);
+  auto solid = [](const Vec3& x) { return x.y < 0.25 || x.y > 1.25; };
+  ns.set_solid(solid);
+  ns.set_velocity([](const Vec3&) { return Vec3{}; });
+  ns.set_body_force([G](const Vec3&) { return Vec3{G, 0.0, 0.0}; });
+  for (int s = 0; s < 300; ++s) ns.step(ns.stable_dt());
+  const int b = forest.block_cells();
+  const double h = forest.block(0).length / b;
+  double flux = 0.0, inside = 0.0, area = 0.0;
+  for (int blk = 0; blk < forest.local_blocks(); ++blk)
+    for (int k = 0; k < b; ++k)
+      for (int j = 0; j < b; ++j)
+        for (int i = 0; i < b; ++i) {
+          const Vec3 x = cell_centre(forest, blk, i, j, k);
+          const double u = ns.velocity()[0](blk, i, j, k);
+          if (solid(x)) {
+            inside = std::max({inside, std::abs(u), std::abs(ns.velocity()[1](blk, i, j, k))});
+          } else {
+            flux += u * h * h * h;  // volume integral of u = flow rate x length x depth
+          }
+          area += h * h * h;
+        }
+  const double length_depth = 0.5 * 0.5;
+  const double rate = forest.sum(flux) / length_depth;
+  const double exact = G / (12 * mu);
+  EXPECT_LT(ns.max_divergence(), 1e-7);
+  return {rate / exact - 1.0, forest.max(inside)};
+}
+
+TEST(FlowNavierStokes, SolidCellMasksActAsNoSlipWallsAtSecondOrder) {
+  const auto [e16, inside16] = masked_channel(0);
+  const auto [e32, inside32] = masked_channel(1);
+  std::printf(
+      "channel between solid masks: flow rate error %.3e (16 across), %.3e (32), order %.2f; "
+      "max velocity in solids %.1e\n",
+      e16, e32, std::log2(std::abs(e16 / e32)), std::max(inside16, inside32));
+  EXPECT_LT(std::abs(e16), 0.01);
+  EXPECT_GT(std::log2(std::abs(e16 / e32)), 1.8);
+  EXPECT_EQ(inside16, 0.0);
+  EXPECT_EQ(inside32, 0.0);
+}
+
+/// Channel 2 x 1 (x 0.5, periodic in z), walls at y = 0 and 1, parabolic
+/// inflow of mean velocity 1 at x = 0, outflow at x = 2; mu = rho = 1.
+/// Steady state: the same parabola everywhere, p = 12 mu U (2 - x) / H^2.
+/// Returns the largest velocity and pressure errors at t = 1.5 (steady).
+std::pair<double, double> inflow_outflow_errors(int level) {
+  ForestSpec spec;
+  spec.trees = {4, 2, 1};
+  spec.tree_length = 0.5;
+  spec.level = level;
+  spec.periodic = {false, false, true};
+  const Forest forest(spec);
+  std::array<FlowBoundary, 6> bcs{};
+  bcs[face_index(0, 0)].kind = FlowBoundaryKind::Inflow;
+  bcs[face_index(0, 0)].inflow = [](const Vec3& x, double) {
+    return Vec3{6.0 * x.y * (1.0 - x.y), 0.0, 0.0};
+  };
+  bcs[face_index(0, 1)].kind = FlowBoundaryKind::Outflow;
+  bcs[face_index(2, 0)].kind = bcs[face_index(2, 1)].kind = FlowBoundaryKind::Periodic;
+  NavierStokesOptions options;
+  options.dt_max = 0.02;
+  options.pressure.tolerance = 1e-8;
+  options.viscous.tolerance = 1e-8;
+  NavierStokes ns(forest, bcs, Fluid{1.0, 1.0}, options);
+  ns.set_velocity([](const Vec3&) { return Vec3{}; });
+  while (ns.time() < 1.5) ns.step(ns.stable_dt());  // 1.5 diffusion times: steady to 4e-7
+  EXPECT_LT(ns.max_divergence(), 1e-6);
+  const int b = forest.block_cells();
+  double velocity_error = 0.0, pressure_error = 0.0;
+  for (int blk = 0; blk < forest.local_blocks(); ++blk)
+    for (int k = 0; k < b; ++k)
+      for (int j = 0; j < b; ++j)
+        for (int i = 0; i < b; ++i) {
+          const Vec3 x = cell_centre(forest, blk, i, j, k);
+          const double u = ns.velocity()[0](blk, i, j, k), v = ns.velocity()[1](blk, i, j, k);
+          velocity_error =
+              std::max({velocity_error, std::abs(u - 6.0 * x.y * (1.0 - x.y)), std::abs(v)});
+          pressure_error =
+              std::max(pressure_error, std::abs(ns.pressure()(blk, i, j, k) - 12.0 * (2.0 - x.x)));
+        }
+  return {forest.max(velocity_error), forest.max(pressure_error)};
+}
+
+TEST(FlowNavierStokes, ParabolicInflowAndOutflowKeepFullyDevelopedChannelFlow) {
+  const auto [u16, p16] = inflow_outflow_errors(0);
+  const auto [u32, p32] = inflow_outflow_errors(1);
+  std::printf(
+      "inflow/outflow channel, 16 / 32 cells across: max velocity error %.2e / %.2e (U = 1, "
+      "order %.2f), max pressure error %.2e / %.2e (p_in = 24)\n",
+      u16, u32, std::log2(u16 / u32), p16, p32);
+  EXPECT_LT(u16, 5e-3);                  // 0.5 % of the mean velocity, at the inlet
+  EXPECT_LT(p16, 0.24);                  // 1 % of the inlet pressure
+  EXPECT_GT(std::log2(u16 / u32), 0.9);  // the inlet error shrinks with h
+}
+
+}  // namespace
+}  // namespace sanguis::flow
