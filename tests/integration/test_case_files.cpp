@@ -16,7 +16,8 @@ TEST(ShippedCases, EveryDemCaseLoadsAndSteps) {
     if (entry.path().extension() != ".toml") continue;
     SCOPED_TRACE(entry.path().string());
     DemCase c = load_dem_case(entry.path());
-    EXPECT_GT(c.setup.particles.size(), 0u);
+    // Particles at t = 0, or poured during the run.
+    EXPECT_GT(c.setup.particles.size() + c.setup.pour.size(), 0u);
     c.setup.threads = 1;
     DemSimulation sim(c.setup);
     for (int n = 0; n < 20; ++n) sim.step();
