@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "cli_harness.hpp"
 #include "core/config.hpp"
 #include "dem/dem_case.hpp"
 
@@ -25,10 +26,7 @@ namespace {
 namespace fs = std::filesystem;
 
 std::string read_file(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
+  return testing_cli::read_text_file(path);
 }
 
 void write_file(const fs::path& path, const std::string& text) {
@@ -37,9 +35,7 @@ void write_file(const fs::path& path, const std::string& text) {
 }
 
 std::string quoted(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
+  return testing_cli::shell_quoted(s);
 }
 
 std::vector<std::string> lines_of(const std::string& text) {
@@ -183,41 +179,8 @@ class JsonReader {
 
 // --- Fixture ----------------------------------------------------------------------
 
-struct Result {
-  int code = -1;
-  std::string out, err;
-};
-
-class CliTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    const std::string test_name = ::testing::UnitTest::GetInstance()->current_test_info()->name();
-    std::random_device entropy;
-    dir_ = fs::temp_directory_path() /
-           ("sanguis_test_cli_" + test_name + "_" + std::to_string(entropy()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    std::error_code ignored;
-    fs::remove_all(dir_, ignored);
-  }
-
-  // Runs `sanguis ARGS` with stdout and stderr captured to files.
-  Result sanguis(const std::string& args) {
-    const fs::path out = dir_ / "stdout.txt";
-    const fs::path err = dir_ / "stderr.txt";
-    const std::string command = quoted(SANGUIS_BINARY) + " " + args + " >" + quoted(out.string()) +
-                                " 2>" + quoted(err.string()) + " </dev/null";
-    const int status = std::system(command.c_str());
-    Result r;
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = read_file(out);
-    r.err = read_file(err);
-    return r;
-  }
-
-  fs::path dir_;
-};
+using Result = testing_cli::CommandResult;
+class CliTest : public testing_cli::SanguisCommandTest {};
 
 // 30 glass spheres (R = 1 mm) dropped with a little random velocity onto a steel
 // floor; 10000 steps of 2 us (Tc/21.7), output every 2500 steps.
