@@ -5,8 +5,11 @@ Runs each validation/dem/*.py (except this one) with `--build BUILD`, one after
 another, then reads the JSON summary each writes to validation/dem/results/NAME.json
 and writes docs/validation/dem.md: per case its figures, the measured numbers next to
 the thesis' numbers with the tolerance and PASS/FAIL, the run time, and the hardware and
-date of the run. Exits 1 if any script fails. `make validate-dem` calls it; it takes
-about 6.5 minutes on 2 cores (almost all of it the settling runs; `--quick` about 2).
+date of the run. Exits 1 if any script fails. `make validate-dem` calls it; on the
+2-core development machine it takes about 1.5 hours: the cross columns (pour ~15 min,
+memory pair ~12 min, tangential map ~40 min), the friction calibration (~11 min), the
+run-out scaling (~10 min) and the settling runs (~6.5 min); `--quick` runs reduced
+variants where a script has one. `--only NAME` reruns one case.
 
 Usage: /usr/bin/python3 validation/dem/run_all.py [--build build] [--quick]
                                                   [--only NAME ...] [--report-only]
