@@ -383,42 +383,52 @@ void DemSimulation::compute_forces() {
   } else {
     // Threads: every contact writes its own slot, then each particle sums its contacts in
     // increasing contact index, walls last: exactly the order of the serial loop, so the
-    // result is bitwise the same for any number of threads (no atomics).
+    // result is bitwise the same for any number of threads (no atomics). A contact that
+    // does not touch writes only its one-byte flag: most Verlet candidates are apart, and
+    // the outcome slots are the memory traffic that limits this path.
     const int nt = threads_;
 #pragma omp parallel num_threads(nt)
     {
 #pragma omp for schedule(static) reduction(max : worst) reduction(+ : touching_pairs)
       for (std::size_t k = 0; k < n_pairs; ++k) {
-        pair_buffer_[k] = pair_outcome(k);
-        if (pair_buffer_[k].touching) {
+        const ContactOutcome o = pair_outcome(k);
+        pair_touching_[k] = o.touching;
+        if (o.touching) {
+          pair_buffer_[k] = o;
           ++touching_pairs;
-          worst = std::max(worst, pair_buffer_[k].overlap_ratio);
+          worst = std::max(worst, o.overlap_ratio);
         }
       }
 #pragma omp for schedule(static) reduction(max : worst) reduction(+ : touching_walls)
       for (std::size_t k = 0; k < n_walls; ++k) {
-        wall_buffer_[k] = wall_outcome(k);
-        if (wall_buffer_[k].touching) {
+        const ContactOutcome o = wall_outcome(k);
+        wall_touching_[k] = o.touching;
+        if (o.touching) {
+          wall_buffer_[k] = o;
           ++touching_walls;
-          worst = std::max(worst, wall_buffer_[k].overlap_ratio);
+          worst = std::max(worst, o.overlap_ratio);
         }
       }
 #pragma omp for schedule(dynamic, 64) reduction(max : worst) reduction(+ : touching_pairs, deep)
       for (std::size_t k = 0; k < n_body_pairs; ++k) {
-        body_pair_buffer_[k] = body_pair_outcome(k);
-        if (body_pair_buffer_[k].touching) {
+        const ContactOutcome o = body_pair_outcome(k);
+        body_pair_touching_[k] = o.touching;
+        if (o.touching) {
+          body_pair_buffer_[k] = o;
           ++touching_pairs;
-          deep += body_pair_buffer_[k].deep;
-          worst = std::max(worst, body_pair_buffer_[k].overlap_ratio);
+          deep += o.deep;
+          worst = std::max(worst, o.overlap_ratio);
         }
       }
 #pragma omp for schedule(dynamic, 64) reduction(max : worst) reduction(+ : touching_walls, deep)
       for (std::size_t k = 0; k < n_body_walls; ++k) {
-        body_wall_buffer_[k] = body_wall_outcome(k);
-        if (body_wall_buffer_[k].touching) {
+        const ContactOutcome o = body_wall_outcome(k);
+        body_wall_touching_[k] = o.touching;
+        if (o.touching) {
+          body_wall_buffer_[k] = o;
           ++touching_walls;
-          deep += body_wall_buffer_[k].deep;
-          worst = std::max(worst, body_wall_buffer_[k].overlap_ratio);
+          deep += o.deep;
+          worst = std::max(worst, o.overlap_ratio);
         }
       }
 #pragma omp for schedule(static)
@@ -427,10 +437,11 @@ void DemSimulation::compute_forces() {
         std::int32_t count = 0;
         const auto add_pairs = [&](const std::vector<std::uint32_t>& offset,
                                    const std::vector<std::uint32_t>& entries,
-                                   const std::vector<ContactOutcome>& outcomes) {
+                                   const std::vector<ContactOutcome>& outcomes,
+                                   const std::vector<std::uint8_t>& touching) {
           for (std::uint32_t e = offset[i]; e < offset[i + 1]; ++e) {
+            if (!touching[entries[e] >> 1]) continue;
             const ContactOutcome& o = outcomes[entries[e] >> 1];
-            if (!o.touching) continue;
             if ((entries[e] & 1u) == 0) {
               force += o.force;
               torque += o.torque_first;
@@ -442,19 +453,22 @@ void DemSimulation::compute_forces() {
           }
         };
         const auto add_walls = [&](const std::vector<std::uint32_t>& offset,
-                                   const std::vector<ContactOutcome>& outcomes) {
+                                   const std::vector<ContactOutcome>& outcomes,
+                                   const std::vector<std::uint8_t>& touching) {
           for (std::uint32_t k = offset[i]; k < offset[i + 1]; ++k) {
-            if (!outcomes[k].touching) continue;
+            if (!touching[k]) continue;
             force += outcomes[k].force;
             torque += outcomes[k].torque_first;
             ++count;
           }
         };
         // The order of the serial loop: sphere pairs, body pairs, sphere walls, body walls.
-        add_pairs(incident_offset_, incident_, pair_buffer_);
-        if (has_bodies_) add_pairs(body_incident_offset_, body_incident_, body_pair_buffer_);
-        add_walls(wall_offset_, wall_buffer_);
-        if (has_bodies_) add_walls(body_wall_offset_, body_wall_buffer_);
+        add_pairs(incident_offset_, incident_, pair_buffer_, pair_touching_);
+        if (has_bodies_) {
+          add_pairs(body_incident_offset_, body_incident_, body_pair_buffer_, body_pair_touching_);
+        }
+        add_walls(wall_offset_, wall_buffer_, wall_touching_);
+        if (has_bodies_) add_walls(body_wall_offset_, body_wall_buffer_, body_wall_touching_);
         f[i] = force;
         tq[i] = torque;
         coord[i] = count;
@@ -621,6 +635,10 @@ void DemSimulation::build_incidence() {
   wall_buffer_.resize(walls_.size());
   body_pair_buffer_.resize(body_pairs_.size());
   body_wall_buffer_.resize(body_walls_.size());
+  pair_touching_.resize(pairs_.size());
+  wall_touching_.resize(walls_.size());
+  body_pair_touching_.resize(body_pairs_.size());
+  body_wall_touching_.resize(body_walls_.size());
 }
 
 void DemSimulation::check_state() const {
