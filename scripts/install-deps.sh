@@ -2,7 +2,7 @@
 # Installs the Debian packages sanguis needs. Idempotent: when every package is
 # already present it does nothing (no apt-get update, no network).
 #   scripts/install-deps.sh            build + test + validation plots
-#   scripts/install-deps.sh --bench    also the peer codes used by bench/ (LAMMPS)
+#   scripts/install-deps.sh --bench    also the peer codes used by bench/ (LAMMPS, Gerris)
 set -euo pipefail
 
 packages=(
@@ -12,7 +12,7 @@ packages=(
   python3 python3-numpy python3-matplotlib
 )
 if [[ "${1:-}" == "--bench" ]]; then
-  packages+=(lammps)
+  packages+=(lammps gerris)
 fi
 
 missing=()
