@@ -48,6 +48,30 @@ inline double applied(const double* x, const BlockCoefficients& k, std::ptrdiff_
   return ax;
 }
 
+// Restriction to the next coarser level: each coarse cell (i, j, k) of every block
+// folds its 8 children (2i + di, 2j + dj, 2k + dk), in the order dk, dj, di, with
+// `combine` from 0, and stores `finish` of the result. The one loop behind the
+// coefficient averages, the activity flags and the residual transfer.
+template <typename Combine, typename Finish>
+void restrict_children(const Forest& forest, const BlockField& fine, BlockField& coarse,
+                       int coarse_cells, Combine combine, Finish finish) {
+  forest.for_each_block([&](int blk) {
+    for (int k = 0; k < coarse_cells; ++k)
+      for (int j = 0; j < coarse_cells; ++j)
+        for (int i = 0; i < coarse_cells; ++i) {
+          double acc = 0.0;
+          for (int dk = 0; dk < 2; ++dk)
+            for (int dj = 0; dj < 2; ++dj)
+              for (int di = 0; di < 2; ++di)
+                acc = combine(acc, fine(blk, 2 * i + di, 2 * j + dj, 2 * k + dk));
+          coarse(blk, i, j, k) = finish(acc);
+        }
+  });
+}
+
+constexpr auto kAdd = [](double acc, double v) { return acc + v; };
+constexpr auto kMean8 = [](double sum) { return sum / 8.0; };
+
 }  // namespace
 
 double MultigridReport::mean_reduction() const {
@@ -107,17 +131,8 @@ void Multigrid::set_coefficients(const BlockField* alpha, const FaceField* beta)
     const Level& f = levels_[m - 1];
     Level& c = levels_[m];
     const int bc = c.cells;
+    restrict_children(forest_, f.alpha, c.alpha, bc, kAdd, kMean8);
     forest_.for_each_block([&](int blk) {
-      for (int k = 0; k < bc; ++k)
-        for (int j = 0; j < bc; ++j)
-          for (int i = 0; i < bc; ++i) {
-            double sum = 0.0;
-            for (int dk = 0; dk < 2; ++dk)
-              for (int dj = 0; dj < 2; ++dj)
-                for (int di = 0; di < 2; ++di)
-                  sum += f.alpha(blk, 2 * i + di, 2 * j + dj, 2 * k + dk);
-            c.alpha(blk, i, j, k) = sum / 8.0;
-          }
       for (int d = 0; d < 3; ++d) {
         std::array<int, 3> hi{bc, bc, bc};
         hi[D(d)] = bc + 1;  // faces 0..bc along d
@@ -164,18 +179,9 @@ void Multigrid::compute_activity() {
     const Level& f = levels_[m - 1];
     Level& c = levels_[m];
     const int bc = c.cells;
-    forest_.for_each_block([&](int blk) {
-      for (int k = 0; k < bc; ++k)
-        for (int j = 0; j < bc; ++j)
-          for (int i = 0; i < bc; ++i) {
-            double any = 0.0;
-            for (int dk = 0; dk < 2; ++dk)
-              for (int dj = 0; dj < 2; ++dj)
-                for (int di = 0; di < 2; ++di)
-                  any = std::max(any, f.active(blk, 2 * i + di, 2 * j + dj, 2 * k + dk));
-            c.active(blk, i, j, k) = any;
-          }
-    });
+    restrict_children(
+        forest_, f.active, c.active, bc, [](double any, double v) { return std::max(any, v); },
+        [](double any) { return any; });
   }
   for (Level& level : levels_) {
     forest_.exchange(level.active, 1);
@@ -441,19 +447,7 @@ void Multigrid::vcycle(int level, BlockField& x, const BlockField& rhs, const Sc
   Level& fine = levels_[D(level)];
   Level& coarse = levels_[D(level + 1)];
   compute_residual(level, x, rhs, bc, fine.res);
-  const int bc_cells = coarse.cells;
-  forest_.for_each_block([&](int blk) {
-    for (int k = 0; k < bc_cells; ++k)
-      for (int j = 0; j < bc_cells; ++j)
-        for (int i = 0; i < bc_cells; ++i) {
-          double sum = 0.0;
-          for (int dk = 0; dk < 2; ++dk)
-            for (int dj = 0; dj < 2; ++dj)
-              for (int di = 0; di < 2; ++di)
-                sum += fine.res(blk, 2 * i + di, 2 * j + dj, 2 * k + dk);
-          coarse.rhs(blk, i, j, k) = sum / 8.0;
-        }
-  });
+  restrict_children(forest_, fine.res, coarse.rhs, coarse.cells, kAdd, kMean8);
   coarse.x.fill(0.0);
   vcycle(level + 1, coarse.x, coarse.rhs, nullptr);
   fill_ghosts(level + 1, coarse.x, nullptr);

@@ -87,20 +87,16 @@ std::array<BcKind, 6> velocity_kinds(const std::array<FlowBoundary, 6>& bcs) {
   return kinds;
 }
 
+// The pressure's condition is the dual of the velocity's: where the velocity is
+// given (walls, inflow) the pressure has a zero normal gradient, and at an
+// outflow, where the velocity has one, the pressure is given.
 std::array<BcKind, 6> pressure_kinds(const std::array<FlowBoundary, 6>& bcs) {
-  std::array<BcKind, 6> kinds{};
-  for (std::size_t f = 0; f < 6; ++f) {
-    switch (bcs[f].kind) {
-      case FlowBoundaryKind::Periodic:
-        kinds[f] = BcKind::Periodic;
-        break;
-      case FlowBoundaryKind::Wall:
-      case FlowBoundaryKind::Inflow:
-        kinds[f] = BcKind::Neumann;
-        break;
-      case FlowBoundaryKind::Outflow:
-        kinds[f] = BcKind::Dirichlet;
-        break;
+  std::array<BcKind, 6> kinds = velocity_kinds(bcs);
+  for (BcKind& k : kinds) {
+    if (k == BcKind::Dirichlet) {
+      k = BcKind::Neumann;
+    } else if (k == BcKind::Neumann) {
+      k = BcKind::Dirichlet;
     }
   }
   return kinds;

@@ -31,6 +31,9 @@ import time
 
 import matplotlib
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from _outputs import read_summary  # noqa: E402
+
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
@@ -43,11 +46,6 @@ TRUE_MU = 0.1
 VALUES = [0.05, 0.1, 0.15, 0.3, 0.5]
 QUICK_VALUES = [0.05, 0.15]
 PARAMETER = "interaction[0].friction"
-
-
-def summary_row(run_dir):
-    with open(os.path.join(run_dir, "analysis", "summary.csv"), newline="") as f:
-        return {k: float(v) for k, v in next(csv.DictReader(f)).items()}
 
 
 def main():
@@ -66,7 +64,7 @@ def main():
                         "--seed", str(seed), "--set", f"{PARAMETER}={TRUE_MU}"],
                        check=True, stdout=subprocess.DEVNULL)
         subprocess.run([exe, "analyze", out], check=True, stdout=subprocess.DEVNULL)
-        truth.append(summary_row(out)["repose_angle_deg"])
+        truth.append(read_summary(out)["repose_angle_deg"])
     target = sum(truth) / len(truth)
     target_std = abs(truth[0] - truth[1]) / 2.0  # std of the mean of two
     print(f"target: repose angle {target:.2f} +- {target_std:.2f} deg at mu_c = {TRUE_MU}")
@@ -88,7 +86,7 @@ def main():
     for i, v in enumerate(values):
         for seed in (1, 2):
             d = os.path.join(calib, f"value_{i}", f"seed_{seed}")
-            seeds.setdefault(v, []).append(summary_row(d)["repose_angle_deg"])
+            seeds.setdefault(v, []).append(read_summary(d)["repose_angle_deg"])
     elapsed = time.time() - t0
 
     checks = []

@@ -23,7 +23,6 @@ continuations side by side ~5-10 min (2 cores).
 Usage: /usr/bin/python3 validation/dem/crosses_memory.py [--build build] [--rerun-pour]
 """
 import argparse
-import csv
 import json
 import os
 import shutil
@@ -38,7 +37,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _vtk_frames import read_arrays, read_pvd  # noqa: E402
+from _outputs import read_arrays, read_pvd, read_summary  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 CASE = os.path.join(ROOT, "cases", "dem", "dam-break-crosses-memory.toml")
@@ -76,11 +75,6 @@ def base_creep(run, base_ids):
     return series
 
 
-def summary(run):
-    with open(os.path.join(run, "analysis", "summary.csv")) as f:
-        return {k: float(v) for k, v in next(csv.DictReader(f)).items()}
-
-
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--build", default="build")
@@ -108,7 +102,7 @@ def main():
         subprocess.run([exe, "analyze", d, "--plot"], check=True, stdout=subprocess.DEVNULL)
     elapsed = time.time() - t0
 
-    s0 = summary(runs["memory"])
+    s0 = read_summary(runs["memory"])
     gate_frame = [p for t, p in frames(pour) if abs(t - GATE_TIME) < 1e-6 or t <= GATE_TIME][-1]
     ids, x = positions_by_id(gate_frame)
     l0, h0 = s0["L0_m"], s0["H0_m"]
@@ -136,7 +130,7 @@ def main():
     ]
     rows = []
     for name, d in runs.items():
-        s = summary(d)
+        s = read_summary(d)
         rows.append([name, f"{100 * s['L0_m']:.1f}", f"{100 * s['H0_m']:.1f}", f"{100 * s['Linf_m']:.1f}",
                      f"{100 * s['Hinf_m']:.1f}", ["stable", "fractured", "collapsed"][int(s["regime"])],
                      f"{1e3 * final[name]:.3g}"])

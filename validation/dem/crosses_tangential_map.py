@@ -21,7 +21,6 @@ docs/validation/figures/crosses_tangential_map.png.
 Usage: /usr/bin/python3 validation/dem/crosses_tangential_map.py [--build build] [--quick]
 """
 import argparse
-import csv
 import json
 import os
 import shutil
@@ -36,7 +35,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _vtk_frames import read_arrays, read_pvd  # noqa: E402
+from _outputs import read_arrays, read_pvd, read_summary  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 CASE = os.path.join(ROOT, "cases", "dem", "dam-break-crosses-memory.toml")
@@ -67,8 +66,7 @@ def by_id(path):
 
 
 def classify(run):
-    with open(os.path.join(run, "analysis", "summary.csv")) as f:
-        s = {k: float(v) for k, v in next(csv.DictReader(f)).items()}
+    s = read_summary(run)
     frames = read_pvd(os.path.join(run, "particles.pvd"))
     opening = [p for t, p in frames if t <= GATE_TIME + 1e-9][-1]
     ids, x0 = by_id(opening)

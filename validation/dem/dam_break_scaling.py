@@ -21,7 +21,6 @@ docs/validation/figures/dam_break_scaling.png. `--quick`: one seed, two gate pos
 Usage: /usr/bin/python3 validation/dem/dam_break_scaling.py [--build build] [--quick]
 """
 import argparse
-import csv
 import json
 import math
 import os
@@ -30,6 +29,9 @@ import sys
 import time
 
 import matplotlib
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from _outputs import read_summary  # noqa: E402
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -83,8 +85,7 @@ def main():
             print(" ".join(cmd), flush=True)
             subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
         for k in range(seeds):
-            with open(os.path.join(out, f"seed_{k + 1}", "analysis", "summary.csv")) as f:
-                s = {key: float(v) for key, v in next(csv.DictReader(f)).items()}
+            s = read_summary(os.path.join(out, f"seed_{k + 1}"))
             s["gate_m"] = l0
             points.append(s)
     elapsed = time.time() - t0

@@ -234,12 +234,13 @@ PolyMesh read_polymesh_vtp(const std::filesystem::path& path) {
 }
 
 std::vector<PvdIndex::Entry> read_pvd(const std::filesystem::path& path) {
-  PvdIndex index(path);
-  index.load_existing(std::numeric_limits<double>::infinity());
-  std::vector<PvdIndex::Entry> entries = index.entries();
+  // load_existing() takes a missing index for an empty one (restart before any frame).
   if (!std::filesystem::exists(path)) {
     throw std::runtime_error("cannot open '" + path.string() + "' for reading");
   }
+  PvdIndex index(path);
+  index.load_existing(std::numeric_limits<double>::infinity());
+  std::vector<PvdIndex::Entry> entries = index.entries();
   for (PvdIndex::Entry& e : entries) e.dataset = (path.parent_path() / e.dataset).string();
   return entries;
 }

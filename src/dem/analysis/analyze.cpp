@@ -4,7 +4,6 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <limits>
 #include <ostream>
 #include <stdexcept>
@@ -14,29 +13,6 @@
 
 namespace sanguis::dem::analysis {
 namespace {
-
-// Removal time of the first obstacle removed during the run (obstacles.csv).
-std::optional<double> first_removal_time(const std::filesystem::path& dir) {
-  std::ifstream in(dir / "obstacles.csv");
-  std::string line;
-  std::getline(in, line);  // index,type,remove_at_s,name
-  std::optional<double> first;
-  while (std::getline(in, line)) {
-    std::array<std::size_t, 3> comma{};
-    std::size_t at = 0;
-    bool ok = true;
-    for (std::size_t& c : comma) {
-      c = line.find(',', at);
-      if (c == std::string::npos) ok = false;
-      if (!ok) break;
-      at = c + 1;
-    }
-    if (!ok) continue;
-    const double t = std::strtod(line.c_str() + comma[1] + 1, nullptr);
-    if (std::isfinite(t) && (!first || t < *first)) first = t;
-  }
-  return first;
-}
 
 struct Extent {
   double x_min = std::numeric_limits<double>::infinity(), x_max = -x_min;
@@ -134,7 +110,7 @@ RunAnalysis analyze_run(const RunOutput& run, const AnalysisOptions& o) {
   a.run = run.dir().string();
   a.gravity = o.gravity;
   const std::optional<double> gate_time =
-      o.initial_time ? o.initial_time : first_removal_time(run.dir());
+      o.initial_time ? o.initial_time : run.first_removal_time();
   std::size_t first = gate_time ? run.frame_at(*gate_time) : 0;
   const std::size_t last = run.frame_at(o.final_time);
   if (last < first) throw std::runtime_error("the final frame comes before the initial frame");

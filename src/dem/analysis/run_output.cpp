@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <stdexcept>
 
@@ -50,18 +51,18 @@ RunOutput::RunOutput(std::filesystem::path dir) : dir_(std::move(dir)) {
       body_files_.emplace_back(e.time, e.dataset);
   }
 
-  std::ifstream names(dir_ / "obstacles.csv");
+  // obstacles.csv: index,type,remove_at_s,name (the name last: it may hold commas).
+  std::ifstream table(dir_ / "obstacles.csv");
   std::string line;
-  std::getline(names,
-               line);  // header: index,type,remove_at_s,name (the name last: it may hold commas)
-  while (std::getline(names, line)) {
-    std::size_t at = 0;
-    for (int comma = 0; comma < 3 && at != std::string::npos; ++comma) {
-      at = line.find(',', at);
-      if (at != std::string::npos) ++at;
-    }
-    if (at == std::string::npos) continue;
-    obstacle_names_.push_back(line.substr(at));
+  std::getline(table, line);  // header
+  while (std::getline(table, line)) {
+    const std::size_t type = line.find(',');
+    const std::size_t removal = type == std::string::npos ? type : line.find(',', type + 1);
+    const std::size_t name = removal == std::string::npos ? removal : line.find(',', removal + 1);
+    if (name == std::string::npos) continue;
+    obstacle_names_.push_back(line.substr(name + 1));
+    const double t = std::strtod(line.c_str() + removal + 1, nullptr);  // "inf": never removed
+    if (std::isfinite(t) && (!first_removal_ || t < *first_removal_)) first_removal_ = t;
   }
 }
 

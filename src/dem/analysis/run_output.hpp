@@ -71,6 +71,8 @@ class RunOutput {
   // Obstacle names by index (obstacles.csv); "obstacle K" when the file is absent.
   std::string obstacle_name(std::int64_t index) const;
   std::size_t obstacle_count() const { return obstacle_names_.size(); }
+  // When the first obstacle removed during the run (the gate) went; none if none was.
+  std::optional<double> first_removal_time() const { return first_removal_; }
 
  private:
   std::filesystem::path dir_;
@@ -78,6 +80,7 @@ class RunOutput {
   std::vector<std::string> particle_files_, contact_files_, branch_files_;
   std::vector<std::pair<double, std::string>> body_files_;  // by time: may start later
   std::vector<std::string> obstacle_names_;
+  std::optional<double> first_removal_;
 };
 
 }  // namespace sanguis::dem::analysis

@@ -1,7 +1,9 @@
-"""Reads the particle frames that sanguis writes (VTK XML, binary base64, UInt64
-headers, Float64 / Int64 arrays) into numpy arrays. Shared by the validation
-scripts; not a general VTK reader."""
+"""What the validation scripts read from sanguis run folders: the frames (VTK XML,
+binary base64, UInt64 headers, Float64 / Int64 arrays) as numpy arrays, and the
+summary row of `sanguis analyze`. Not a general VTK reader."""
 import base64
+import csv
+import os
 import re
 import xml.etree.ElementTree as ET
 
@@ -34,8 +36,13 @@ def read_arrays(path):
 
 def read_pvd(path):
     """(time, absolute dataset path) of every frame of a .pvd index."""
-    import os
     root = ET.parse(path).getroot()
     base = os.path.dirname(os.path.abspath(path))
     return [(float(d.get("timestep")), os.path.join(base, d.get("file")))
             for d in root.iter("DataSet")]
+
+
+def read_summary(run_dir):
+    """The one row of RUN/analysis/summary.csv (written by `sanguis analyze`) as floats."""
+    with open(os.path.join(run_dir, "analysis", "summary.csv"), newline="") as f:
+        return {k: float(v) for k, v in next(csv.DictReader(f)).items()}
