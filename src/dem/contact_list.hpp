@@ -4,6 +4,7 @@
 // list is rebuilt the histories of pairs that are still candidates are carried
 // over, so a rebuild never erases memory (see NeighborSearch::rebuild).
 #include <cstdint>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -90,5 +91,20 @@ inline void carry_history(const BodyContactList& previous, BodyContactList& fres
     }
   }
 }
+
+// One contact and its memory keyed by particle ids instead of local indices, so that
+// it survives a renumbering of the particles (domain decomposition: particles move
+// between processes with the memories of their contacts).
+struct ContactMemory {
+  enum Kind : std::uint8_t { kSpherePair = 0, kSphereWall = 1, kBodyPair = 2, kBodyWall = 3 };
+  std::uint8_t kind = kSpherePair;
+  std::uint16_t element_first = 0, element_second = 0;
+  std::int64_t first_id = 0;   // particle id (the smaller one for pairs)
+  std::int64_t second_id = 0;  // particle id, or obstacle index for walls
+  ContactHistory history;
+  geometry::GjkWarmStart warm;  // body contacts only
+
+  auto key() const { return std::tuple{kind, first_id, second_id, element_first, element_second}; }
+};
 
 }  // namespace sanguis::dem

@@ -105,7 +105,8 @@ void NeighborSearch::bin(const ParticleStore& particles) {
 }
 
 void NeighborSearch::rebuild(ParticleStore& particles, const std::vector<Obstacle>& obstacles,
-                             double time, ContactList& pairs, ContactList& walls) {
+                             double time, ContactList& pairs, ContactList& walls,
+                             const std::uint8_t* ghost) {
   const std::size_t n = particles.size();
   for (auto& x : particles.position) domain_.wrap(x);
   bin(particles);
@@ -145,7 +146,7 @@ void NeighborSearch::rebuild(ParticleStore& particles, const std::vector<Obstacl
           const auto c = static_cast<std::size_t>((cz * cells_[1] + cy) * cells_[0] + cx);
           for (std::uint32_t m = cell_start_[c]; m < cell_start_[c + 1]; ++m) {
             const std::uint32_t j = cell_members_[m];
-            if (j <= i) continue;
+            if (j <= i || (ghost != nullptr && ghost[i] && ghost[j])) continue;
             const double cut = ri + particles.radius[j] + skin_;
             const Vec3 d = domain_.minimum_image(particles.position[j] - xi);
             if (norm2(d) < cut * cut) candidates_.push_back(j);
@@ -162,6 +163,7 @@ void NeighborSearch::rebuild(ParticleStore& particles, const std::vector<Obstacl
   // Particle-obstacle pairs, sorted by (particle, obstacle).
   scratch_.clear();
   for (std::size_t i = 0; i < n; ++i) {
+    if (ghost != nullptr && ghost[i]) continue;
     for (std::size_t o = 0; o < obstacles.size(); ++o) {
       if (!obstacles[o].active(time)) continue;
       const SphereObstacleGap gap =

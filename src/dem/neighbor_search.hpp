@@ -25,9 +25,10 @@ class NeighborSearch {
                      double time) const;
 
   // Wraps periodic positions, bins particles and rebuilds both lists, carrying the
-  // contact histories over. Obstacles inactive at `time` get no entries.
+  // contact histories over. Obstacles inactive at `time` get no entries. With `ghost`
+  // (one flag per particle), pairs of two ghosts and ghost-obstacle pairs are left out.
   void rebuild(ParticleStore& particles, const std::vector<Obstacle>& obstacles, double time,
-               ContactList& pairs, ContactList& walls);
+               ContactList& pairs, ContactList& walls, const std::uint8_t* ghost = nullptr);
 
   std::int64_t rebuild_count() const { return rebuilds_; }
   double skin() const { return skin_; }

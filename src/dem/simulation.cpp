@@ -82,7 +82,16 @@ void DemSimulation::step() {
   if (!setup_.pour.empty()) pour_particles();
   integrator_.advance(p, setup_.gravity, dt);
   ++step_;
-  if (search_.needs_rebuild(p, setup_.obstacles, time())) rebuild_lists();
+  if (exchange_ == nullptr) {
+    if (search_.needs_rebuild(p, setup_.obstacles, time())) rebuild_lists();
+  } else {
+    // Ghosts first take their owners' drifted state, so every process sees the same
+    // displacements and all rebuild at the step a single process would.
+    exchange_->refresh_ghosts(*this);
+    if (exchange_->any(search_.needs_rebuild(p, setup_.obstacles, time()))) {
+      exchange_->redistribute(*this);
+    }
+  }
   compute_forces();
   integrator_.finish(p, setup_.gravity, dt);
   if (step_ % 64 == 0) check_state();
@@ -491,7 +500,8 @@ void DemSimulation::compute_forces() {
 }
 
 void DemSimulation::rebuild_lists() {
-  search_.rebuild(setup_.particles, setup_.obstacles, time(), pairs_, walls_);
+  search_.rebuild(setup_.particles, setup_.obstacles, time(), pairs_, walls_,
+                  ghost_.empty() ? nullptr : ghost_.data());
   if (has_bodies_) split_body_contacts();
   build_incidence();
 }
@@ -659,7 +669,10 @@ DemDiagnostics DemSimulation::diagnostics() const {
   const ParticleStore& p = setup_.particles;
   DemDiagnostics d;
   d.time = time();
+  std::size_t owned = 0;
   for (std::size_t i = 0; i < p.size(); ++i) {
+    if (is_ghost(i)) continue;
+    ++owned;
     const double v2 = norm2(p.velocity[i]);
     const double w2 = norm2(p.angular_velocity[i]);
     d.kinetic_energy_translational += 0.5 * p.mass[i] * v2;
@@ -672,15 +685,133 @@ DemDiagnostics DemSimulation::diagnostics() const {
     d.max_velocity = std::max(d.max_velocity, speed);
     d.mean_angular_velocity += std::sqrt(w2);
   }
-  if (p.size() > 0) {
-    d.mean_velocity /= static_cast<double>(p.size());
-    d.mean_angular_velocity /= static_cast<double>(p.size());
+  if (owned > 0) {
+    d.mean_velocity /= static_cast<double>(owned);
+    d.mean_angular_velocity /= static_cast<double>(owned);
   }
   d.particle_contacts = touching_pairs_;
   d.wall_contacts = touching_walls_;
   d.max_overlap_ratio = max_overlap_ratio_;
   d.deep_contacts = deep_contacts_;
+  if (!ghost_.empty()) {
+    // A pair with a ghost is evaluated by both processes: count it where its first (smaller
+    // id) particle is owned. A contact touched at the last evaluation keeps its normal.
+    const auto touching = [](const ContactHistory& h) {
+      return h.normal.x != 0.0 || h.normal.y != 0.0 || h.normal.z != 0.0;
+    };
+    d.particle_contacts = 0;
+    for (std::size_t k = 0; k < pairs_.size(); ++k) {
+      d.particle_contacts += !is_ghost(pairs_.first[k]) && touching(pairs_.history[k]);
+    }
+    for (std::size_t k = 0; k < body_pairs_.size(); ++k) {
+      d.particle_contacts += !is_ghost(body_pairs_.first[k]) && touching(body_pairs_.history[k]);
+    }
+  }
   return d;
+}
+
+// ---------------------------------------------------------------- domain decomposition
+
+std::size_t DemSimulation::owned_count() const {
+  if (ghost_.empty()) return setup_.particles.size();
+  return static_cast<std::size_t>(std::count(ghost_.begin(), ghost_.end(), std::uint8_t{0}));
+}
+
+std::vector<ContactMemory> DemSimulation::export_contacts() const {
+  const std::vector<std::int64_t>& id = setup_.particles.id;
+  std::vector<ContactMemory> out;
+  out.reserve(pairs_.size() + walls_.size() + body_pairs_.size() + body_walls_.size());
+  const auto add_list = [&](const ContactList& list, std::uint8_t kind, bool wall) {
+    for (std::size_t k = 0; k < list.size(); ++k) {
+      ContactMemory r;
+      r.kind = kind;
+      r.first_id = id[list.first[k]];
+      r.second_id = wall ? std::int64_t{list.second[k]} : id[list.second[k]];
+      r.history = list.history[k];
+      out.push_back(r);
+    }
+  };
+  const auto add_body_list = [&](const BodyContactList& list, std::uint8_t kind, bool wall) {
+    for (std::size_t k = 0; k < list.size(); ++k) {
+      ContactMemory r;
+      r.kind = kind;
+      r.first_id = id[list.first[k]];
+      r.second_id = wall ? std::int64_t{list.second[k]} : id[list.second[k]];
+      r.element_first = list.element_first[k];
+      r.element_second = list.element_second[k];
+      r.history = list.history[k];
+      r.warm = list.warm[k];
+      out.push_back(r);
+    }
+  };
+  add_list(pairs_, ContactMemory::kSpherePair, false);
+  add_list(walls_, ContactMemory::kSphereWall, true);
+  add_body_list(body_pairs_, ContactMemory::kBodyPair, false);
+  add_body_list(body_walls_, ContactMemory::kBodyWall, true);
+  return out;
+}
+
+void DemSimulation::import_contacts(std::span<const ContactMemory> contacts) {
+  const std::vector<std::int64_t>& id = setup_.particles.id;
+  const auto find = [&](const ContactMemory& probe) -> const ContactMemory* {
+    const auto it = std::lower_bound(
+        contacts.begin(), contacts.end(), probe,
+        [](const ContactMemory& a, const ContactMemory& b) { return a.key() < b.key(); });
+    return it != contacts.end() && it->key() == probe.key() ? &*it : nullptr;
+  };
+  const auto fill_list = [&](ContactList& list, std::uint8_t kind, bool wall) {
+    for (std::size_t k = 0; k < list.size(); ++k) {
+      ContactMemory probe;
+      probe.kind = kind;
+      probe.first_id = id[list.first[k]];
+      probe.second_id = wall ? std::int64_t{list.second[k]} : id[list.second[k]];
+      if (const ContactMemory* r = find(probe)) list.history[k] = r->history;
+    }
+  };
+  const auto fill_body_list = [&](BodyContactList& list, std::uint8_t kind, bool wall) {
+    for (std::size_t k = 0; k < list.size(); ++k) {
+      ContactMemory probe;
+      probe.kind = kind;
+      probe.first_id = id[list.first[k]];
+      probe.second_id = wall ? std::int64_t{list.second[k]} : id[list.second[k]];
+      probe.element_first = list.element_first[k];
+      probe.element_second = list.element_second[k];
+      if (const ContactMemory* r = find(probe)) {
+        list.history[k] = r->history;
+        list.warm[k] = r->warm;
+      }
+    }
+  };
+  fill_list(pairs_, ContactMemory::kSpherePair, false);
+  fill_list(walls_, ContactMemory::kSphereWall, true);
+  fill_body_list(body_pairs_, ContactMemory::kBodyPair, false);
+  fill_body_list(body_walls_, ContactMemory::kBodyWall, true);
+}
+
+void DemSimulation::replace_particles(ParticleStore particles, std::vector<std::uint8_t> ghost,
+                                      std::vector<Vec3> half_velocity,
+                                      std::vector<Vec3> half_angular,
+                                      std::span<const ContactMemory> contacts) {
+  const std::size_t n = particles.size();
+  if (ghost.size() != n || half_velocity.size() != n || half_angular.size() != n) {
+    throw std::invalid_argument("replace_particles: per-particle arrays differ in size");
+  }
+  for (std::size_t i = 1; i < n; ++i) {
+    // Pairs are oriented by local index; increasing ids orient them as one process would.
+    if (particles.id[i] <= particles.id[i - 1]) {
+      throw std::invalid_argument("replace_particles: particles not in increasing id order");
+    }
+  }
+  setup_.particles = std::move(particles);
+  ghost_ = std::move(ghost);
+  integrator_.half_velocity() = std::move(half_velocity);
+  integrator_.half_angular_velocity() = std::move(half_angular);
+  pairs_.clear();
+  walls_.clear();
+  body_pairs_.clear();
+  body_walls_.clear();
+  rebuild_lists();
+  import_contacts(contacts);
 }
 
 // ---------------------------------------------------------------- checkpoints

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <random>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,7 @@
 #include "dem/domain.hpp"
 #include "dem/neighbor_search.hpp"
 #include "dem/obstacles.hpp"
+#include "dem/particle_exchange.hpp"
 #include "dem/particle_shape.hpp"
 #include "dem/particle_store.hpp"
 #include "dem/time_integrator.hpp"
@@ -132,6 +134,24 @@ class DemSimulation {
   // Recomputes forces at the current state (after the state was edited by hand).
   void refresh_forces();
 
+  // Domain decomposition (particle_exchange.hpp). The exchange is not owned; nullptr: alone.
+  void set_exchange(ParticleExchange* exchange) { exchange_ = exchange; }
+  // Per particle, 1 for a ghost (a copy of a particle another process owns); empty when
+  // every particle is owned. Ghosts take part in contacts with owned particles only, and
+  // count in no diagnostic.
+  const std::vector<std::uint8_t>& ghost_flags() const { return ghost_; }
+  bool is_ghost(std::size_t i) const { return !ghost_.empty() && ghost_[i] != 0; }
+  std::size_t owned_count() const;
+  // Every contact with its memory, keyed by particle ids.
+  std::vector<ContactMemory> export_contacts() const;
+  // Replaces the particles mid-step (between the drift and the forces): the new set must
+  // be in increasing id order, `half_velocity` / `half_angular` are leapfrog's mid-step
+  // values per particle; the lists are rebuilt and each contact takes its memory from
+  // `contacts` (sorted by ContactMemory::key) when found there.
+  void replace_particles(ParticleStore particles, std::vector<std::uint8_t> ghost,
+                         std::vector<Vec3> half_velocity, std::vector<Vec3> half_angular,
+                         std::span<const ContactMemory> contacts);
+
  private:
   void compute_forces();
   void rebuild_lists();
@@ -139,8 +159,11 @@ class DemSimulation {
   void split_body_contacts();
   void pour_particles();
   void check_state() const;
+  void import_contacts(std::span<const ContactMemory> contacts);
 
   DemSetup setup_;
+  ParticleExchange* exchange_ = nullptr;
+  std::vector<std::uint8_t> ghost_;
   TimeIntegrator integrator_;
   NeighborSearch search_;
   ContactList pairs_, walls_;

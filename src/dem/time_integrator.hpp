@@ -57,6 +57,10 @@ class TimeIntegrator {
 
   MultistepHistory& history() { return history_; }
   const MultistepHistory& history() const { return history_; }
+  // Leapfrog's mid-step velocities between advance() and finish(), per particle: they move
+  // with the particles when a domain decomposition renumbers them within a step.
+  std::vector<Vec3>& half_velocity() { return half_velocity_; }
+  std::vector<Vec3>& half_angular_velocity() { return half_angular_velocity_; }
 
  private:
   IntegratorKind kind_;

@@ -1,0 +1,417 @@
+#include "dem/domain_decomposition.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <numeric>
+#include <span>
+#include <stdexcept>
+#include <type_traits>
+
+namespace sanguis::dem {
+
+struct SlabDecomposition::ParticleRecord {
+  std::int64_t id;
+  std::int32_t material, species;
+  std::uint8_t spherical;
+  double radius, mass, inverse_mass;
+  Vec3 inertia_body, inverse_inertia_body;
+  Quaternion orientation;
+  Vec3 position, velocity, angular_velocity;
+  Vec3 half_velocity, half_angular;  // leapfrog's mid-step values
+};
+
+struct SlabDecomposition::GhostState {
+  Quaternion orientation;
+  Vec3 position, velocity, angular_velocity;
+};
+
+namespace {
+
+static_assert(std::is_trivially_copyable_v<ContactMemory>);
+
+// Sends buckets[d] to process d; returns what every process sent here, by source.
+template <typename T>
+std::vector<std::vector<T>> all_to_all(MPI_Comm comm, const std::vector<std::vector<T>>& buckets,
+                                       std::int64_t& bytes_sent) {
+  static_assert(std::is_trivially_copyable_v<T>);
+  const int ranks = static_cast<int>(buckets.size());
+  std::vector<long long> send_count(static_cast<std::size_t>(ranks)),
+      receive_count(static_cast<std::size_t>(ranks));
+  for (int d = 0; d < ranks; ++d) {
+    send_count[static_cast<std::size_t>(d)] =
+        static_cast<long long>(buckets[static_cast<std::size_t>(d)].size() * sizeof(T));
+  }
+  MPI_Alltoall(send_count.data(), 1, MPI_LONG_LONG, receive_count.data(), 1, MPI_LONG_LONG, comm);
+  std::vector<int> sc(static_cast<std::size_t>(ranks)), rc(static_cast<std::size_t>(ranks)),
+      sd(static_cast<std::size_t>(ranks), 0), rd(static_cast<std::size_t>(ranks), 0);
+  for (std::size_t d = 0; d < sc.size(); ++d) {
+    if (send_count[d] > INT32_MAX || receive_count[d] > INT32_MAX) {
+      throw std::runtime_error("domain decomposition: a transfer exceeds 2 GB");
+    }
+    sc[d] = static_cast<int>(send_count[d]);
+    rc[d] = static_cast<int>(receive_count[d]);
+    if (d > 0) {
+      sd[d] = sd[d - 1] + sc[d - 1];
+      rd[d] = rd[d - 1] + rc[d - 1];
+    }
+  }
+  std::vector<char> send(static_cast<std::size_t>(sd.back() + sc.back()));
+  for (std::size_t d = 0; d < sc.size(); ++d) {
+    if (sc[d] > 0)
+      std::memcpy(send.data() + sd[d], buckets[d].data(), static_cast<std::size_t>(sc[d]));
+    bytes_sent += sc[d];
+  }
+  std::vector<char> receive(static_cast<std::size_t>(rd.back() + rc.back()));
+  MPI_Alltoallv(send.data(), sc.data(), sd.data(), MPI_BYTE, receive.data(), rc.data(), rd.data(),
+                MPI_BYTE, comm);
+  std::vector<std::vector<T>> out(static_cast<std::size_t>(ranks));
+  for (std::size_t s = 0; s < out.size(); ++s) {
+    out[s].resize(static_cast<std::size_t>(rc[s]) / sizeof(T));
+    if (rc[s] > 0)
+      std::memcpy(out[s].data(), receive.data() + rd[s], static_cast<std::size_t>(rc[s]));
+  }
+  return out;
+}
+
+std::size_t index_of_id(const std::vector<std::int64_t>& ids, std::int64_t id) {
+  const auto it = std::lower_bound(ids.begin(), ids.end(), id);
+  if (it == ids.end() || *it != id) {
+    throw std::logic_error("domain decomposition: particle id not found");
+  }
+  return static_cast<std::size_t>(it - ids.begin());
+}
+
+}  // namespace
+
+SlabDecomposition::SlabDecomposition(MPI_Comm comm, int axis) : comm_(comm), requested_axis_(axis) {
+  MPI_Comm_rank(comm_, &rank_);
+  MPI_Comm_size(comm_, &ranks_);
+  if (axis < -1 || axis > 2) throw std::invalid_argument("slab axis must be 0, 1, 2 or -1");
+  send_lists_.resize(static_cast<std::size_t>(ranks_));
+  receive_lists_.resize(static_cast<std::size_t>(ranks_));
+}
+
+int SlabDecomposition::owner_of(double c) const {
+  // bounds_ is increasing; the last slab takes everything beyond (closed domains).
+  const auto it = std::upper_bound(bounds_.begin() + 1, bounds_.end() - 1, c);
+  return static_cast<int>(it - (bounds_.begin() + 1));
+}
+
+bool SlabDecomposition::near_slab(double c, int slab) const {
+  const double lo = bounds_[static_cast<std::size_t>(slab)];
+  const double hi = bounds_[static_cast<std::size_t>(slab) + 1];
+  const auto distance = [&](double x) { return x < lo ? lo - x : (x > hi ? x - hi : 0.0); };
+  double d = distance(c);
+  if (periodic_axis_) {
+    const double length = axis_max_ - axis_min_;
+    d = std::min({d, distance(c - length), distance(c + length)});
+  }
+  return d < band_;
+}
+
+// Slab bounds at equal particle counts, from a histogram of the owned particles along
+// the axis summed over the processes (cheap: no particle list travels).
+void SlabDecomposition::balance(const ParticleStore& p, const std::vector<std::uint8_t>& ghost) {
+  constexpr int kBins = 4096;
+  std::vector<long long> histogram(kBins, 0);
+  const double length = axis_max_ - axis_min_;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (!ghost.empty() && ghost[i]) continue;
+    const double u = (p.position[i][axis_] - axis_min_) / length;
+    ++histogram[static_cast<std::size_t>(std::clamp(static_cast<int>(u * kBins), 0, kBins - 1))];
+  }
+  MPI_Allreduce(MPI_IN_PLACE, histogram.data(), kBins, MPI_LONG_LONG, MPI_SUM, comm_);
+  const long long total = std::accumulate(histogram.begin(), histogram.end(), 0LL);
+  bounds_.assign(static_cast<std::size_t>(ranks_) + 1, axis_min_);
+  bounds_.back() = axis_max_;
+  long long seen = 0;
+  int next = 1;
+  for (int b = 0; b < kBins && next < ranks_; ++b) {
+    seen += histogram[static_cast<std::size_t>(b)];
+    while (next < ranks_ && seen * ranks_ >= total * next) {
+      bounds_[static_cast<std::size_t>(next++)] = axis_min_ + length * (b + 1) / kBins;
+    }
+  }
+  for (; next < ranks_; ++next) bounds_[static_cast<std::size_t>(next)] = axis_max_;
+}
+
+DemSetup SlabDecomposition::local_setup(const DemSetup& full) {
+  if (full.integrator != IntegratorKind::kLeapfrog) {
+    throw std::invalid_argument("several MPI processes need the leapfrog integrator");
+  }
+  if (!full.pour.empty()) {
+    throw std::invalid_argument("pouring during the run is not available on several MPI processes");
+  }
+  const Vec3 extent = full.domain.length();
+  axis_ = requested_axis_;
+  if (axis_ < 0)
+    axis_ = extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
+  periodic_axis_ = full.domain.periodic[static_cast<std::size_t>(axis_)];
+  axis_min_ = full.domain.min[axis_];
+  axis_max_ = full.domain.max[axis_];
+  const ParticleStore& p = full.particles;
+  // Each process reads the whole setup: the histogram of one is that of all.
+  std::vector<std::uint8_t> not_mine(p.size(), static_cast<std::uint8_t>(rank_ != 0));
+  balance(p, not_mine);
+
+  DemSetup local = full;
+  local.particles = ParticleStore{};
+  std::vector<std::size_t> order(p.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return p.id[a] < p.id[b]; });
+  for (std::size_t i : order) {
+    if (owner_of(p.position[i][axis_]) != rank_) continue;
+    ParticleStore& q = local.particles;
+    q.id.push_back(p.id[i]);
+    q.material.push_back(p.material[i]);
+    q.radius.push_back(p.radius[i]);
+    q.mass.push_back(p.mass[i]);
+    q.inverse_mass.push_back(p.inverse_mass[i]);
+    q.species.push_back(p.species[i]);
+    q.spherical.push_back(p.spherical[i]);
+    q.inertia_body.push_back(p.inertia_body[i]);
+    q.inverse_inertia_body.push_back(p.inverse_inertia_body[i]);
+    q.orientation.push_back(p.orientation[i]);
+    q.position.push_back(p.position[i]);
+    q.velocity.push_back(p.velocity[i]);
+    q.angular_velocity.push_back(p.angular_velocity[i]);
+    q.force.push_back({});
+    q.torque.push_back({});
+    q.coordination.push_back(0);
+  }
+  // The ghost band: every pair that can be a candidate of an owned particle.
+  double r_max = 0.0;
+  for (double r : p.radius) r_max = std::max(r_max, r);
+  band_ = 2.0 * r_max;  // the skin is added in attach(), once the simulation has chosen it
+  return local;
+}
+
+void SlabDecomposition::attach(DemSimulation& simulation) {
+  band_ += simulation.neighbor_search().skin();
+  simulation.set_exchange(this);
+  ParticleStore& p = simulation.particles();
+  std::vector<ParticleRecord> owned(p.size());
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    owned[i] = {p.id[i],
+                p.material[i],
+                p.species[i],
+                p.spherical[i],
+                p.radius[i],
+                p.mass[i],
+                p.inverse_mass[i],
+                p.inertia_body[i],
+                p.inverse_inertia_body[i],
+                p.orientation[i],
+                p.position[i],
+                p.velocity[i],
+                p.angular_velocity[i],
+                Vec3{},
+                Vec3{}};
+  }
+  // No contact memory yet: the initial forces are evaluated once, as in one process.
+  exchange_ghosts(simulation, std::move(owned), {});
+  simulation.refresh_forces();
+}
+
+bool SlabDecomposition::any(bool local) {
+  int flag = local ? 1 : 0;
+  MPI_Allreduce(MPI_IN_PLACE, &flag, 1, MPI_INT, MPI_LOR, comm_);
+  return flag != 0;
+}
+
+void SlabDecomposition::refresh_ghosts(DemSimulation& simulation) {
+  if (ranks_ == 1) return;
+  ParticleStore& p = simulation.particles();
+  std::vector<std::vector<GhostState>> buckets(static_cast<std::size_t>(ranks_));
+  for (std::size_t d = 0; d < buckets.size(); ++d) {
+    for (std::uint32_t i : send_lists_[d]) {
+      buckets[d].push_back({p.orientation[i], p.position[i], p.velocity[i], p.angular_velocity[i]});
+    }
+  }
+  const auto received = all_to_all(comm_, buckets, bytes_sent_);
+  for (std::size_t s = 0; s < received.size(); ++s) {
+    const auto& states = received[s];
+    for (std::size_t k = 0; k < states.size(); ++k) {
+      const std::uint32_t i = receive_lists_[s][k];
+      p.orientation[i] = states[k].orientation;
+      p.position[i] = states[k].position;
+      p.velocity[i] = states[k].velocity;
+      p.angular_velocity[i] = states[k].angular_velocity;
+    }
+  }
+}
+
+void SlabDecomposition::redistribute(DemSimulation& simulation) {
+  ParticleStore& p = simulation.particles();
+  const std::vector<std::uint8_t>& ghost = simulation.ghost_flags();
+  auto& half_v = simulation.integrator().half_velocity();
+  auto& half_w = simulation.integrator().half_angular_velocity();
+  balance(p, ghost);
+
+  // Owned particles to their new owners.
+  std::vector<std::vector<ParticleRecord>> particle_buckets(static_cast<std::size_t>(ranks_));
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (simulation.is_ghost(i)) continue;
+    particle_buckets[static_cast<std::size_t>(owner_of(p.position[i][axis_]))].push_back(
+        {p.id[i], p.material[i], p.species[i], p.spherical[i], p.radius[i], p.mass[i],
+         p.inverse_mass[i], p.inertia_body[i], p.inverse_inertia_body[i], p.orientation[i],
+         p.position[i], p.velocity[i], p.angular_velocity[i], half_v[i], half_w[i]});
+  }
+  // Contact memories to the new owners of both particles (walls: of the particle).
+  std::vector<std::vector<ContactMemory>> contact_buckets(static_cast<std::size_t>(ranks_));
+  for (const ContactMemory& r : simulation.export_contacts()) {
+    const int a = owner_of(p.position[index_of_id(p.id, r.first_id)][axis_]);
+    contact_buckets[static_cast<std::size_t>(a)].push_back(r);
+    if (r.kind == ContactMemory::kSpherePair || r.kind == ContactMemory::kBodyPair) {
+      const int b = owner_of(p.position[index_of_id(p.id, r.second_id)][axis_]);
+      if (b != a) contact_buckets[static_cast<std::size_t>(b)].push_back(r);
+    }
+  }
+  std::vector<ParticleRecord> owned;
+  for (auto& from : all_to_all(comm_, particle_buckets, bytes_sent_)) {
+    owned.insert(owned.end(), from.begin(), from.end());
+  }
+  std::vector<ContactMemory> contacts;
+  for (auto& from : all_to_all(comm_, contact_buckets, bytes_sent_)) {
+    contacts.insert(contacts.end(), from.begin(), from.end());
+  }
+  exchange_ghosts(simulation, std::move(owned), std::move(contacts));
+}
+
+// Sends copies of the owned particles near other slabs, merges owned and ghosts in id
+// order and hands everything to the simulation.
+void SlabDecomposition::exchange_ghosts(DemSimulation& simulation,
+                                        std::vector<ParticleRecord> owned,
+                                        std::vector<ContactMemory> contacts) {
+  const auto by_id = [](const ParticleRecord& a, const ParticleRecord& b) { return a.id < b.id; };
+  std::sort(owned.begin(), owned.end(), by_id);
+  std::vector<std::vector<ParticleRecord>> buckets(static_cast<std::size_t>(ranks_));
+  for (auto& list : send_lists_) list.clear();
+  std::vector<std::vector<std::int64_t>> sent_ids(static_cast<std::size_t>(ranks_));
+  for (const ParticleRecord& r : owned) {
+    for (int d = 0; d < ranks_; ++d) {
+      if (d == rank_ || !near_slab(r.position[axis_], d)) continue;
+      buckets[static_cast<std::size_t>(d)].push_back(r);
+      sent_ids[static_cast<std::size_t>(d)].push_back(r.id);
+    }
+  }
+  const auto received = all_to_all(comm_, buckets, bytes_sent_);
+
+  std::vector<ParticleRecord> all = owned;
+  std::vector<std::uint8_t> is_ghost_record(owned.size(), 0);
+  for (const auto& from : received) {
+    all.insert(all.end(), from.begin(), from.end());
+    is_ghost_record.insert(is_ghost_record.end(), from.size(), 1);
+  }
+  std::vector<std::size_t> order(all.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return all[a].id < all[b].id; });
+
+  ParticleStore store;
+  std::vector<std::uint8_t> ghost;
+  std::vector<Vec3> half_v, half_w;
+  for (std::size_t k : order) {
+    const ParticleRecord& r = all[k];
+    store.id.push_back(r.id);
+    store.material.push_back(r.material);
+    store.radius.push_back(r.radius);
+    store.mass.push_back(r.mass);
+    store.inverse_mass.push_back(r.inverse_mass);
+    store.species.push_back(r.species);
+    store.spherical.push_back(r.spherical);
+    store.inertia_body.push_back(r.inertia_body);
+    store.inverse_inertia_body.push_back(r.inverse_inertia_body);
+    store.orientation.push_back(r.orientation);
+    store.position.push_back(r.position);
+    store.velocity.push_back(r.velocity);
+    store.angular_velocity.push_back(r.angular_velocity);
+    store.force.push_back({});
+    store.torque.push_back({});
+    store.coordination.push_back(0);
+    ghost.push_back(is_ghost_record[k]);
+    half_v.push_back(r.half_velocity);
+    half_w.push_back(r.half_angular);
+  }
+  // Local indices of what goes out and comes in at each ghost refresh.
+  for (std::size_t d = 0; d < sent_ids.size(); ++d) {
+    for (std::int64_t id : sent_ids[d]) {
+      send_lists_[d].push_back(static_cast<std::uint32_t>(index_of_id(store.id, id)));
+    }
+  }
+  ghost_count_ = 0;
+  for (std::size_t s = 0; s < received.size(); ++s) {
+    receive_lists_[s].clear();
+    for (const ParticleRecord& r : received[s]) {
+      receive_lists_[s].push_back(static_cast<std::uint32_t>(index_of_id(store.id, r.id)));
+    }
+    ghost_count_ += static_cast<std::int64_t>(received[s].size());
+  }
+  // A pair next to a slab boundary arrives from both processes that evaluated it, with
+  // the same memory: keep one.
+  std::sort(contacts.begin(), contacts.end(),
+            [](const ContactMemory& a, const ContactMemory& b) { return a.key() < b.key(); });
+  contacts.erase(std::unique(contacts.begin(), contacts.end(),
+                             [](const ContactMemory& a, const ContactMemory& b) {
+                               return a.key() == b.key();
+                             }),
+                 contacts.end());
+  simulation.replace_particles(std::move(store), std::move(ghost), std::move(half_v),
+                               std::move(half_w), contacts);
+}
+
+DemDiagnostics SlabDecomposition::diagnostics(const DemSimulation& simulation) const {
+  DemDiagnostics d = simulation.diagnostics();
+  const auto owned = static_cast<double>(simulation.owned_count());
+  double sums[5] = {d.kinetic_energy_translational, d.kinetic_energy_rotational,
+                    d.mean_velocity * owned, d.mean_angular_velocity * owned, owned};
+  MPI_Allreduce(MPI_IN_PLACE, sums, 5, MPI_DOUBLE, MPI_SUM, comm_);
+  double maxima[2] = {d.max_velocity, d.max_overlap_ratio};
+  MPI_Allreduce(MPI_IN_PLACE, maxima, 2, MPI_DOUBLE, MPI_MAX, comm_);
+  long long counts[3] = {d.particle_contacts, d.wall_contacts, d.deep_contacts};
+  MPI_Allreduce(MPI_IN_PLACE, counts, 3, MPI_LONG_LONG, MPI_SUM, comm_);
+  d.kinetic_energy_translational = sums[0];
+  d.kinetic_energy_rotational = sums[1];
+  d.mean_velocity = sums[4] > 0 ? sums[2] / sums[4] : 0.0;
+  d.mean_angular_velocity = sums[4] > 0 ? sums[3] / sums[4] : 0.0;
+  d.max_velocity = maxima[0];
+  d.max_overlap_ratio = maxima[1];
+  d.particle_contacts = counts[0];
+  d.wall_contacts = counts[1];
+  d.deep_contacts = counts[2];
+  return d;
+}
+
+ParticleStore SlabDecomposition::gather(const DemSimulation& simulation, int root) const {
+  const ParticleStore& p = simulation.particles();
+  std::vector<std::vector<ParticleRecord>> buckets(static_cast<std::size_t>(ranks_));
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (simulation.is_ghost(i)) continue;
+    buckets[static_cast<std::size_t>(root)].push_back(
+        {p.id[i], p.material[i], p.species[i], p.spherical[i], p.radius[i], p.mass[i],
+         p.inverse_mass[i], p.inertia_body[i], p.inverse_inertia_body[i], p.orientation[i],
+         p.position[i], p.velocity[i], p.angular_velocity[i], p.force[i], p.torque[i]});
+  }
+  std::int64_t ignored = 0;
+  std::vector<ParticleRecord> all;
+  for (auto& from : all_to_all(comm_, buckets, ignored))
+    all.insert(all.end(), from.begin(), from.end());
+  std::sort(all.begin(), all.end(),
+            [](const ParticleRecord& a, const ParticleRecord& b) { return a.id < b.id; });
+  ParticleStore out;
+  for (const ParticleRecord& r : all) {
+    const std::size_t i =
+        out.add_body(r.id, r.material, r.species, r.radius, r.mass, r.inertia_body, r.orientation,
+                     r.position, r.velocity, r.angular_velocity);
+    out.spherical[i] = r.spherical;
+    out.inverse_mass[i] = r.inverse_mass;
+    out.inverse_inertia_body[i] = r.inverse_inertia_body;
+    out.force[i] = r.half_velocity;  // gather() carries force and torque in these slots
+    out.torque[i] = r.half_angular;
+  }
+  return out;
+}
+
+}  // namespace sanguis::dem

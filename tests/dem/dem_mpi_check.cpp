@@ -1,0 +1,215 @@
+// The DEM domain decomposition (src/dem/domain_decomposition.hpp) against one process,
+// run under mpirun with any number of processes. Every process also runs the whole
+// system alone and compares its owned particles with it, id by id. Particles are summed
+// in the same order in both (increasing ids), so positions, velocities and angular
+// velocities must agree bit for bit; only the diagnostics' reductions may differ
+// (checked to 1e-12 relative).
+//
+// Scenarios: the tiny sphere dam break of the integration tests through its gate
+// removal (walls, a removed obstacle, slabs along x); spheres in a box periodic along
+// the slab axis (particles and contacts crossing the periodic seam between the first
+// and the last process); crosses (element contacts with GJK warm starts) colliding.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <string>
+
+#include <mpi.h>
+
+#include "dem/dem_case.hpp"
+#include "dem/domain_decomposition.hpp"
+#include "dem/simulation.hpp"
+
+using namespace sanguis;
+using namespace sanguis::dem;
+
+namespace {
+
+double largest_difference(const DemSimulation& mine, const ParticleStore& alone) {
+  const ParticleStore& p = mine.particles();
+  double worst = 0.0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (mine.is_ghost(i)) continue;
+    const auto it = std::lower_bound(alone.id.begin(), alone.id.end(), p.id[i]);
+    if (it == alone.id.end() || *it != p.id[i]) return INFINITY;
+    const auto j = static_cast<std::size_t>(it - alone.id.begin());
+    worst = std::max({worst, norm(p.position[i] - alone.position[j]),
+                      norm(p.velocity[i] - alone.velocity[j]),
+                      norm(p.angular_velocity[i] - alone.angular_velocity[j])});
+  }
+  return worst;
+}
+
+// Runs `setup` alone and decomposed for `steps` steps; returns true when they agree.
+bool compare(const std::string& name, const DemSetup& setup, std::int64_t steps, int axis) {
+  int rank = 0, ranks = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  DemSimulation alone(setup);
+  SlabDecomposition decomposition(MPI_COMM_WORLD, axis);
+  DemSimulation mine(decomposition.local_setup(setup));
+  decomposition.attach(mine);
+  // Touching contacts summed over the steps: at least 1000 evaluations, so that a memory
+  // lost or duplicated on the way between processes would show in the states.
+  long long contact_steps = 0;
+  for (std::int64_t s = 0; s < steps; ++s) {
+    alone.step();
+    mine.step();
+    const DemDiagnostics d = alone.diagnostics();
+    contact_steps += d.particle_contacts + d.wall_contacts;
+  }
+  double worst = largest_difference(mine, alone.particles());
+  MPI_Allreduce(MPI_IN_PLACE, &worst, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  long long owned = static_cast<long long>(mine.owned_count());
+  MPI_Allreduce(MPI_IN_PLACE, &owned, 1, MPI_LONG_LONG, MPI_SUM, MPI_COMM_WORLD);
+  const DemDiagnostics a = alone.diagnostics();
+  const DemDiagnostics b = decomposition.diagnostics(mine);
+  const double energy_error =
+      std::abs(a.kinetic_energy_translational - b.kinetic_energy_translational) /
+      std::max(a.kinetic_energy_translational, 1e-300);
+  const bool counts_agree = owned == static_cast<long long>(alone.particles().size()) &&
+                            a.particle_contacts == b.particle_contacts &&
+                            a.wall_contacts == b.wall_contacts;
+  long long ghosts = decomposition.ghosts();
+  MPI_Allreduce(MPI_IN_PLACE, &ghosts, 1, MPI_LONG_LONG, MPI_SUM, MPI_COMM_WORLD);
+  const bool ok = worst == 0.0 && energy_error < 1e-12 && counts_agree && contact_steps >= 1000;
+  if (rank == 0) {
+    std::printf(
+        "%s %s: %d processes, %lld particles, %lld ghosts, %lld steps, %lld rebuilds, "
+        "largest state difference %.3g, kinetic energy %.3g relative, contacts %lld/%lld "
+        "pairs %lld/%lld walls at the end, %.1f contacts per step on average\n",
+        ok ? "PASS" : "FAIL", name.c_str(), ranks, owned, ghosts, static_cast<long long>(steps),
+        static_cast<long long>(mine.neighbor_search().rebuild_count()), worst, energy_error,
+        static_cast<long long>(a.particle_contacts), static_cast<long long>(b.particle_contacts),
+        static_cast<long long>(a.wall_contacts), static_cast<long long>(b.wall_contacts),
+        static_cast<double>(contact_steps) / static_cast<double>(steps));
+  }
+  return ok;
+}
+
+DemSetup dam_break() {
+  DemCase c = load_dem_case(std::string(SANGUIS_SOURCE_DIR) +
+                            "/tests/integration/data/dam-break-tiny.toml");
+  return c.setup;
+}
+
+// Spheres with random velocities in a box periodic along x, on a floor, under gravity.
+DemSetup periodic_spheres() {
+  DemSetup s = dam_break();
+  s.obstacles.resize(1);  // the floor only
+  s.domain.periodic = {true, true, false};
+  s.domain.min = {0.0, 0.0, 0.0};
+  s.domain.max = {0.06, 0.016, 0.1};
+  s.particles = ParticleStore{};
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-0.3, 0.3);
+  std::int64_t id = 0;
+  const double r = 0.002;
+  for (int k = 0; k < 4; ++k) {
+    for (int j = 0; j < 3; ++j) {
+      for (int i = 0; i < 13; ++i) {
+        const Vec3 x{(i + 0.5) * 0.06 / 13, (j + 0.5) * 0.016 / 3, r + 0.0043 * k};
+        s.particles.add_sphere(id++, 0, r * (0.9 + 0.1 * ((i + j + k) % 2)), 2500.0, x,
+                               {u(rng), u(rng), u(rng)}, {});
+      }
+    }
+  }
+  return s;
+}
+
+// Crosses (Table 3.1 shape and contacts) on a lattice, random orientations and velocities.
+DemSetup crosses() {
+  const std::string text = R"(
+[simulation]
+name = "crosses"
+end_time_s = 0.01
+time_step_s = 2.5e-6
+[domain]
+min_m = [0.0, 0.0, 0.0]
+max_m = [0.18, 0.06, 0.12]
+[[shape]]
+name = "cross"
+type = "cross"
+length_m = 0.027
+width_m = 0.002
+thickness_m = 0.003
+crust_m = 1.0e-4
+[[material]]
+name = "plastic"
+density_kg_m3 = 770.0
+[[material]]
+name = "acrylic"
+[[interaction]]
+materials = ["plastic", "plastic"]
+mode = "explicit"
+normal_stiffness_N_m = 4.5e5
+normal_restitution = 0.85
+tangential_stiffness_N_m = 3.0e2
+tangential_damping_rate_1_s = 1.0e3
+friction = 0.46
+[[interaction]]
+materials = ["plastic", "acrylic"]
+mode = "explicit"
+normal_stiffness_N_m = 4.5e5
+normal_restitution = 0.85
+tangential_stiffness_N_m = 3.0e2
+tangential_damping_rate_1_s = 1.0e3
+friction = 0.62
+[[obstacle]]
+name = "floor"
+type = "plane"
+material = "acrylic"
+point_m = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+[[particles]]
+material = "plastic"
+shape = "cross"
+arrangement = "list"
+positions_m = [[0.09, 0.03, 0.06]]
+)";
+  DemSetup s = load_dem_case(ConfigTable::parse_string(text, "crosses.toml"), "crosses.toml").setup;
+  s.particles = ParticleStore{};  // replaced by the lattice below
+  const ParticleShape& cross = s.shapes.at(0);
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> g(0.0, 1.0);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::int64_t id = 0;
+  const double spacing = 2.0 * cross.bounding_radius + 0.001;
+  const Vec3 centre{3.0 * spacing, spacing, 0.015 + spacing};
+  for (int k = 0; k < 3; ++k) {
+    for (int j = 0; j < 2; ++j) {
+      for (int i = 0; i < 6; ++i) {
+        const Vec3 x{(i + 0.5) * spacing, (j + 0.5) * spacing, 0.015 + k * spacing};
+        const Quaternion q = normalized({g(rng), g(rng), g(rng), g(rng)});
+        // Converging on the lattice's centre: the crosses collide and entangle.
+        const Vec3 v = 60.0 * (centre - x) + Vec3{0.3 * u(rng), 0.3 * u(rng), 0.3 * u(rng)};
+        s.particles.add_body(id++, 0, 0, cross.bounding_radius, 770.0 * cross.volume,
+                             770.0 * cross.inertia_per_density, q, x, v,
+                             {20.0 * u(rng), 20.0 * u(rng), 20.0 * u(rng)});
+      }
+    }
+  }
+  return s;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  MPI_Init(&argc, &argv);
+  bool ok = true;
+  try {
+    // 0.35 s: the column settles, the gate goes at 0.25 s and the front runs out.
+    const DemSetup d = dam_break();
+    ok &= compare("sphere dam break", d, static_cast<std::int64_t>(0.35 / d.time_step), 0);
+    ok &= compare("periodic spheres", periodic_spheres(), 20000, 0);
+    ok &= compare("crosses", crosses(), 10000, 0);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "dem_mpi_check: %s\n", e.what());
+    ok = false;
+  }
+  int all_ok = ok ? 1 : 0;
+  MPI_Allreduce(MPI_IN_PLACE, &all_ok, 1, MPI_INT, MPI_LAND, MPI_COMM_WORLD);
+  MPI_Finalize();
+  return all_ok ? 0 : 1;
+}
