@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <numbers>
@@ -18,6 +19,7 @@
 #include "dem/parameter_procedure.hpp"
 #include "flow/flow_case.hpp"
 #include "flow/flow_run.hpp"
+#include "flow/mpi_session.hpp"
 
 namespace {
 
@@ -120,6 +122,16 @@ struct RunArgs {
   std::vector<std::string> overrides;
 };
 
+// True when mpirun started this program on several processes (Open MPI or a PMI launcher):
+// a DEM run is then decomposed over them. Alone, a DEM run never starts MPI.
+bool several_mpi_processes() {
+  for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE"}) {
+    const char* value = std::getenv(name);
+    if (value != nullptr && std::atoi(value) > 1) return true;
+  }
+  return false;
+}
+
 int run_command(const RunArgs& args) {
   ConfigTable cfg = ConfigTable::parse_file(args.case_file);
   for (const std::string& o : args.overrides) cfg.set_override(o);
@@ -151,6 +163,7 @@ int run_command(const RunArgs& args) {
       output.empty() ? std::filesystem::path("output") / c.name : std::filesystem::path(output);
   options.restart = restart;
   options.quiet = quiet;
+  if (several_mpi_processes()) options.comm = flow::MpiSession::ensure().world();
   if (std::filesystem::exists(options.output_dir) &&
       !std::filesystem::is_directory(options.output_dir)) {
     throw InputError(options.output_dir.string(), "--output", "exists and is not a directory");

@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <memory>
+#include <optional>
 #include <sstream>
 
 #include "core/error.hpp"
@@ -16,6 +18,7 @@
 #include "core/progress.hpp"
 #include "core/version.hpp"
 #include "dem/body_contacts.hpp"
+#include "dem/domain_decomposition.hpp"
 
 namespace sanguis::dem {
 
@@ -199,6 +202,15 @@ io::PolyMesh body_mesh(const std::vector<ParticleShape>& shapes, const ParticleS
   return mesh;
 }
 
+ParticleStore owned_particles(const DemSimulation& sim) {
+  if (sim.ghost_flags().empty()) return sim.particles();
+  ParticleStore owned;
+  for (std::size_t i = 0; i < sim.particles().size(); ++i) {
+    if (!sim.is_ghost(i)) owned.append_from(sim.particles(), i);
+  }
+  return owned;
+}
+
 std::vector<ContactRecord> touching_contacts(const DemSimulation& sim) {
   const DemSetup& s = sim.setup();
   const ParticleStore& p = sim.particles();
@@ -236,7 +248,7 @@ std::vector<ContactRecord> touching_contacts(const DemSimulation& sim) {
   const ContactList& pairs = sim.particle_contacts();
   for (std::size_t k = 0; k < pairs.size(); ++k) {
     const std::uint32_t i = pairs.first[k], j = pairs.second[k];
-    if (!finite(i) || !finite(j)) continue;
+    if (!finite(i) || !finite(j) || sim.is_ghost(i)) continue;  // ghost first: another's share
     Vec3 d = x[j] - x[i];
     if (periodic) d = domain.near_image(d);
     const double sum_r = rad[i] + rad[j];
@@ -302,7 +314,7 @@ std::vector<ContactRecord> touching_contacts(const DemSimulation& sim) {
   const BodyContactList& body_pairs = sim.body_contacts();
   for (std::size_t k = 0; k < body_pairs.size(); ++k) {
     const std::uint32_t i = body_pairs.first[k], j = body_pairs.second[k];
-    if (!finite(i) || !finite(j)) continue;
+    if (!finite(i) || !finite(j) || sim.is_ghost(i)) continue;
     Vec3 d = x[j] - x[i];
     if (periodic) d = domain.near_image(d);
     const Vec3 xj = x[i] + d;
@@ -422,9 +434,11 @@ namespace {
 // particles (fixed for a run: particles never change shape).
 class SnapshotWriter {
  public:
+  // With several processes each writes its piece (`_rN` files) and the first one the
+  // indexes, with one part per process at each time (a multiblock dataset in ParaView).
   SnapshotWriter(const std::filesystem::path& dir, bool enabled, bool bodies, bool restart,
-                 double t)
-      : dir_(dir), enabled_(enabled), bodies_(bodies) {
+                 double t, int rank = 0, int ranks = 1)
+      : dir_(dir), enabled_(enabled), bodies_(bodies), rank_(rank), ranks_(ranks) {
     if (!enabled_) return;
     const std::vector<std::string> names =
         bodies_
@@ -444,20 +458,27 @@ class SnapshotWriter {
     if (!enabled_) return;
     char number[64];
     std::snprintf(number, sizeof number, "%08lld", static_cast<long long>(next_frame_++));
-    const std::string frame(number);
-    const std::string files[5] = {
-        "particles/particles_" + frame + ".vtu", "obstacles/obstacles_" + frame + ".vtp",
-        "contacts/contacts_" + frame + ".vtu", "contacts/branches_" + frame + ".vtp",
-        "bodies/bodies_" + frame + ".vtp"};
-    io::write_point_cloud_vtu(dir_ / files[0], particle_cloud(sim.particles()));
-    io::write_polymesh_vtp(dir_ / files[1], obstacle_mesh(sim.setup(), sim.time()));
+    const auto piece = [&](int r) {
+      return ranks_ == 1 ? std::string(number) : std::string(number) + "_r" + std::to_string(r);
+    };
+    const auto files = [&](int r) {
+      return std::vector<std::string>{
+          "particles/particles_" + piece(r) + ".vtu", "obstacles/obstacles_" + piece(0) + ".vtp",
+          "contacts/contacts_" + piece(r) + ".vtu", "contacts/branches_" + piece(r) + ".vtp",
+          "bodies/bodies_" + piece(r) + ".vtp"};
+    };
+    const std::vector<std::string> mine = files(rank_);
+    const ParticleStore owned = owned_particles(sim);
+    io::write_point_cloud_vtu(dir_ / mine[0], particle_cloud(owned));
+    if (rank_ == 0) io::write_polymesh_vtp(dir_ / mine[1], obstacle_mesh(sim.setup(), sim.time()));
     const ContactNetwork net = contact_network(sim);
-    io::write_point_cloud_vtu(dir_ / files[2], net.points);
-    io::write_polymesh_vtp(dir_ / files[3], net.branches);
-    if (bodies_)
-      io::write_polymesh_vtp(dir_ / files[4], body_mesh(sim.setup().shapes, sim.particles()));
+    io::write_point_cloud_vtu(dir_ / mine[2], net.points);
+    io::write_polymesh_vtp(dir_ / mine[3], net.branches);
+    if (bodies_) io::write_polymesh_vtp(dir_ / mine[4], body_mesh(sim.setup().shapes, owned));
+    if (rank_ != 0) return;
     for (std::size_t k = 0; k < series_.size(); ++k) {
-      series_[k].add(sim.time(), files[k]);
+      const int parts = k == 1 ? 1 : ranks_;  // one obstacle file
+      for (int r = 0; r < parts; ++r) series_[k].add(sim.time(), files(r)[k], r);
       series_[k].write();
     }
   }
@@ -466,6 +487,7 @@ class SnapshotWriter {
   std::filesystem::path dir_;
   bool enabled_;
   bool bodies_;
+  int rank_ = 0, ranks_ = 1;
   std::vector<io::PvdIndex> series_;  // in the order of the files of write()
   std::int64_t next_frame_ = 0;
 };
@@ -500,11 +522,41 @@ RunSummary run_dem_case(const DemCase& c, const RunOptions& options, std::ostrea
   const fs::path dir = options.output_dir;
   const fs::path checkpoint = dir / "checkpoint.bin";
   const fs::path csv_path = dir / "diagnostics.csv";
+  int rank = 0, ranks = 1;
+  if (options.comm != MPI_COMM_NULL) {
+    MPI_Comm_rank(options.comm, &rank);
+    MPI_Comm_size(options.comm, &ranks);
+  }
+  const bool root = rank == 0;
   if (options.restart && !fs::exists(checkpoint)) {
     throw InputError(checkpoint.string(), "", "no checkpoint to restart from");
   }
+  if (options.restart && ranks > 1) {
+    throw InputError(checkpoint.string(), "",
+                     "restart on several MPI processes is not available yet: restart on one");
+  }
 
-  DemSimulation sim(c.setup);
+  // Several processes: each runs its slab of the domain (domain_decomposition.hpp).
+  std::unique_ptr<SlabDecomposition> decomposition;
+  if (ranks > 1) {
+    try {
+      decomposition = std::make_unique<SlabDecomposition>(options.comm);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(c.source.string(), "", e.what());
+    }
+  }
+  const auto local_setup = [&]() {
+    try {
+      return decomposition->local_setup(c.setup);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(c.source.string(), "", e.what());
+    }
+  };
+  DemSimulation sim(decomposition ? local_setup() : c.setup);
+  if (decomposition) decomposition->attach(sim);
+  const auto diagnostics = [&]() {
+    return decomposition ? decomposition->diagnostics(sim) : sim.diagnostics();
+  };
   const double dt = sim.time_step();
   if (options.restart) {
     sim.load_checkpoint(checkpoint);
@@ -512,34 +564,55 @@ RunSummary run_dem_case(const DemCase& c, const RunOptions& options, std::ostrea
   }
   fs::create_directories(dir);
 
-  // run.log: resolved parameters first, then events.
-  std::ofstream log(dir / "run.log", options.restart ? std::ios::app : std::ios::trunc);
-  if (!log) throw InputError((dir / "run.log").string(), "", "cannot write the run log");
-  log << (options.restart ? "\n--- restart from checkpoint at t = " : "sanguis ")
-      << (options.restart ? std::to_string(sim.time()) + " s" : std::string(kVersion)) << "\n"
-      << describe(c) << std::flush;
+  // run.log: resolved parameters first, then events (first process only).
+  std::ofstream log;
+  if (root) {
+    log.open(dir / "run.log", options.restart ? std::ios::app : std::ios::trunc);
+    if (!log) throw InputError((dir / "run.log").string(), "", "cannot write the run log");
+    log << (options.restart ? "\n--- restart from checkpoint at t = " : "sanguis ")
+        << (options.restart ? std::to_string(sim.time()) + " s" : std::string(kVersion)) << "\n"
+        << describe(c);
+    if (decomposition) {
+      log << "domain decomposition: " << ranks << " MPI processes, slabs along "
+          << "xyz"[decomposition->axis()] << "; no checkpoints on several processes yet\n";
+    }
+    log << std::flush;
+  }
 
   const std::int64_t total_steps = steps_for(c.stop.end_time, dt);
   const std::int64_t stop_step =
       options.stop_at >= 0 ? std::min(total_steps, steps_for(options.stop_at, dt)) : total_steps;
   const std::int64_t output_every = steps_for(c.output.interval, dt);
-  const std::int64_t checkpoint_every =
-      c.output.checkpoint_interval > 0 ? steps_for(c.output.checkpoint_interval, dt) : 0;
+  const std::int64_t checkpoint_every = c.output.checkpoint_interval > 0 && !decomposition
+                                            ? steps_for(c.output.checkpoint_interval, dt)
+                                            : 0;
   const std::int64_t settle_after = std::llround(c.stop.settle_check_after / dt);
 
-  write_obstacle_table(dir / "obstacles.csv", c.setup.obstacles);
-  SnapshotWriter snapshots(dir, c.output.vtk, has_bodies(sim.setup(), sim.particles()),
-                           options.restart, sim.time());
-  io::CsvWriter csv(csv_path, kDiagnosticColumns, options.restart && fs::exists(csv_path));
+  if (root) write_obstacle_table(dir / "obstacles.csv", c.setup.obstacles);
+  SnapshotWriter snapshots(dir, c.output.vtk, has_bodies(c.setup, c.setup.particles),
+                           options.restart, sim.time(), rank, ranks);
+  std::optional<io::CsvWriter> csv;
+  if (root) csv.emplace(csv_path, kDiagnosticColumns, options.restart && fs::exists(csv_path));
   const auto record = [&]() {
+    // Ghosts take their owners' end-of-step velocities: the contact forces written for
+    // pairs across processes use them (the state the step leaves ghosts in is stale).
+    if (decomposition) decomposition->refresh_ghosts(sim);
     snapshots.write(sim);
-    csv.row(diagnostic_row(sim.diagnostics()));
+    const DemDiagnostics d = diagnostics();
+    if (csv) csv->row(diagnostic_row(d));
   };
   if (!options.restart) record();
 
-  console << "sanguis run: " << c.name << ": " << sim.particles().size() << " particles, "
-          << total_steps << " steps of " << dt << " s, output to " << dir.string() << "\n";
-  ProgressReporter progress(std::cerr, !options.quiet && isatty(STDERR_FILENO) != 0);
+  const auto particle_count = [&]() {
+    return decomposition ? c.setup.particles.size() : sim.particles().size();
+  };
+  if (root) {
+    console << "sanguis run: " << c.name << ": " << particle_count() << " particles, "
+            << total_steps << " steps of " << dt << " s, ";
+    if (decomposition) console << ranks << " MPI processes, ";
+    console << "output to " << dir.string() << "\n";
+  }
+  ProgressReporter progress(std::cerr, root && !options.quiet && isatty(STDERR_FILENO) != 0);
   const std::int64_t first_step = sim.step_index();
   double particle_steps = 0.0;  // summed per step: pouring changes the count
 
@@ -547,19 +620,19 @@ RunSummary run_dem_case(const DemCase& c, const RunOptions& options, std::ostrea
   try {
     while (sim.step_index() < stop_step) {
       sim.step();
-      particle_steps += static_cast<double>(sim.particles().size());
+      particle_steps += static_cast<double>(particle_count());
       const std::int64_t s = sim.step_index();
       const bool output_now = s % output_every == 0;
       if (output_now) record();
       if (checkpoint_every > 0 && s % checkpoint_every == 0) sim.save_checkpoint(checkpoint);
       if (output_now && c.stop.mean_velocity_below && s >= settle_after &&
-          sim.diagnostics().mean_velocity < *c.stop.mean_velocity_below) {
+          diagnostics().mean_velocity < *c.stop.mean_velocity_below) {
         summary.settled = true;
         log << "settled at t = " << sim.time() << " s: mean velocity below "
             << *c.stop.mean_velocity_below << " m/s\n";
         break;
       }
-      if (!options.quiet && (s & 255) == 0) {
+      if (root && !options.quiet && (s & 255) == 0) {
         char status[128];
         std::snprintf(status, sizeof status, "t = %.4g / %.4g s", sim.time(), c.stop.end_time);
         progress.update(static_cast<double>(s) / static_cast<double>(total_steps), status,
@@ -576,12 +649,13 @@ RunSummary run_dem_case(const DemCase& c, const RunOptions& options, std::ostrea
   // for a later restart, so that a split run writes exactly the rows of a whole one.
   const bool stopped_early = sim.step_index() < total_steps && !summary.settled;
   if (sim.step_index() % output_every != 0 && !stopped_early) record();
-  sim.save_checkpoint(checkpoint);
+  if (!decomposition) sim.save_checkpoint(checkpoint);
 
   summary.steps = sim.step_index() - first_step;
   summary.simulated_time = sim.time();
   summary.wall_seconds = progress.elapsed_seconds();
-  summary.last = sim.diagnostics();
+  summary.last = diagnostics();
+  if (!root) return summary;
   std::ostringstream done;
   done.precision(4);
   done << "done: t = " << sim.time() << " s, " << summary.steps << " steps in "
@@ -593,10 +667,11 @@ RunSummary run_dem_case(const DemCase& c, const RunOptions& options, std::ostrea
   console << "outputs:\n"
           << "  ParaView    " << (dir / "particles.pvd").string()
           << "  (and obstacles.pvd, contacts.pvd, branches.pvd"
-          << (has_bodies(sim.setup(), sim.particles()) ? ", bodies.pvd" : "") << ")\n"
+          << (has_bodies(c.setup, c.setup.particles) ? ", bodies.pvd" : "") << ")"
+          << (decomposition ? ", one block per process" : "") << "\n"
           << "  diagnostics " << csv_path.string() << "\n"
-          << "  log         " << (dir / "run.log").string() << "\n"
-          << "  checkpoint  " << checkpoint.string() << "\n";
+          << "  log         " << (dir / "run.log").string() << "\n";
+  if (!decomposition) console << "  checkpoint  " << checkpoint.string() << "\n";
   return summary;
 }
 

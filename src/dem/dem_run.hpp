@@ -9,6 +9,8 @@
 #include <iosfwd>
 #include <vector>
 
+#include <mpi.h>
+
 #include "core/io/vtk.hpp"
 #include "dem/dem_case.hpp"
 
@@ -19,6 +21,10 @@ struct RunOptions {
   bool restart = false;   // continue from output_dir/checkpoint.bin
   bool quiet = false;     // no progress line
   double stop_at = -1.0;  // stop (with a checkpoint) at this time instead of end_time; < 0: off
+  // Processes sharing the run (domain_decomposition.hpp); null or one process: alone. Each
+  // process writes its piece of every frame (a block per process in the .pvd: one dataset
+  // in ParaView); the first process writes the indexes, diagnostics.csv and run.log.
+  MPI_Comm comm = MPI_COMM_NULL;
 };
 
 struct RunSummary {
@@ -49,6 +55,9 @@ io::PolyMesh obstacle_mesh(const DemSetup& s, double time);
 
 // True when some particle is not a sphere (the run then writes body surfaces).
 bool has_non_spherical(const ParticleStore& p);
+
+// The particles the simulation owns (all of them when it runs alone).
+ParticleStore owned_particles(const DemSimulation& sim);
 
 // The surface mesh of every non-spherical particle (ParticleShape::mesh) at its pose, as
 // triangles, with cell data id, material, species and velocity (the particle's, per
@@ -91,6 +100,8 @@ struct ContactRecord {
 // velocity v_n + dt a_n, not the v_{n+1} available here, so the damping terms differ by
 // eta dt (a_{n+1} - a_n) / 2: visible during impacts, nil at rest.
 // Contacts of particles with non-finite positions (a blown-up state) are left out.
+// In a decomposed run (domain_decomposition.hpp) a process returns its share: the
+// contacts whose first particle it owns.
 std::vector<ContactRecord> touching_contacts(const DemSimulation& sim);
 
 // The contact frame, written as two files since a .vtp here carries only cell data:

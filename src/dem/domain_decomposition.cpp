@@ -163,23 +163,7 @@ DemSetup SlabDecomposition::local_setup(const DemSetup& full) {
             [&](std::size_t a, std::size_t b) { return p.id[a] < p.id[b]; });
   for (std::size_t i : order) {
     if (owner_of(p.position[i][axis_]) != rank_) continue;
-    ParticleStore& q = local.particles;
-    q.id.push_back(p.id[i]);
-    q.material.push_back(p.material[i]);
-    q.radius.push_back(p.radius[i]);
-    q.mass.push_back(p.mass[i]);
-    q.inverse_mass.push_back(p.inverse_mass[i]);
-    q.species.push_back(p.species[i]);
-    q.spherical.push_back(p.spherical[i]);
-    q.inertia_body.push_back(p.inertia_body[i]);
-    q.inverse_inertia_body.push_back(p.inverse_inertia_body[i]);
-    q.orientation.push_back(p.orientation[i]);
-    q.position.push_back(p.position[i]);
-    q.velocity.push_back(p.velocity[i]);
-    q.angular_velocity.push_back(p.angular_velocity[i]);
-    q.force.push_back({});
-    q.torque.push_back({});
-    q.coordination.push_back(0);
+    local.particles.append_from(p, i);
   }
   // The ghost band: every pair that can be a candidate of an owned particle.
   double r_max = 0.0;

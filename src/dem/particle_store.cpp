@@ -38,4 +38,23 @@ std::size_t ParticleStore::add_body(std::int64_t particle_id, std::int32_t mater
   return position.size() - 1;
 }
 
+void ParticleStore::append_from(const ParticleStore& o, std::size_t i) {
+  id.push_back(o.id[i]);
+  material.push_back(o.material[i]);
+  radius.push_back(o.radius[i]);
+  mass.push_back(o.mass[i]);
+  inverse_mass.push_back(o.inverse_mass[i]);
+  species.push_back(o.species[i]);
+  spherical.push_back(o.spherical[i]);
+  inertia_body.push_back(o.inertia_body[i]);
+  inverse_inertia_body.push_back(o.inverse_inertia_body[i]);
+  orientation.push_back(o.orientation[i]);
+  position.push_back(o.position[i]);
+  velocity.push_back(o.velocity[i]);
+  angular_velocity.push_back(o.angular_velocity[i]);
+  force.push_back(o.force[i]);
+  torque.push_back(o.torque[i]);
+  coordination.push_back(o.coordination[i]);
+}
+
 }  // namespace sanguis::dem

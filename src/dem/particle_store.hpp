@@ -32,6 +32,9 @@ struct ParticleStore {
 
   std::size_t size() const { return position.size(); }
 
+  // Appends particle i of `other`, every field as it is.
+  void append_from(const ParticleStore& other, std::size_t i);
+
   // Appends a sphere of the given radius and density; returns its index.
   std::size_t add_sphere(std::int64_t particle_id, std::int32_t material_index, double r,
                          double density, const Vec3& x, const Vec3& v, const Vec3& w,

@@ -84,17 +84,31 @@ void DemSimulation::step() {
   ++step_;
   if (exchange_ == nullptr) {
     if (search_.needs_rebuild(p, setup_.obstacles, time())) rebuild_lists();
-  } else {
-    // Ghosts first take their owners' drifted state, so every process sees the same
-    // displacements and all rebuild at the step a single process would.
-    exchange_->refresh_ghosts(*this);
-    if (exchange_->any(search_.needs_rebuild(p, setup_.obstacles, time()))) {
-      exchange_->redistribute(*this);
-    }
+    compute_forces();
+    integrator_.finish(p, setup_.gravity, dt);
+    if (step_ % 64 == 0) check_state();
+    return;
   }
-  compute_forces();
-  integrator_.finish(p, setup_.gravity, dt);
-  if (step_ % 64 == 0) check_state();
+  // Ghosts first take their owners' drifted state, so every process sees the same
+  // displacements and all rebuild at the step a single process would.
+  exchange_->refresh_ghosts(*this);
+  if (exchange_->any(search_.needs_rebuild(p, setup_.obstacles, time()))) {
+    exchange_->redistribute(*this);
+  }
+  // A blow-up seen by one process stops them all (none may wait in a collective).
+  std::string error;
+  try {
+    compute_forces();
+    integrator_.finish(p, setup_.gravity, dt);
+    if (step_ % 64 == 0) check_state();
+  } catch (const SimulationError& e) {
+    error = e.what();
+  }
+  if (exchange_->any(!error.empty())) {
+    throw SimulationError(error.empty() ? "step " + std::to_string(step_) +
+                                              ": another process stopped the run (see its message)"
+                                        : error);
+  }
 }
 
 void DemSimulation::pour_particles() {

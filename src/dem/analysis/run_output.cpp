@@ -12,11 +12,69 @@
 namespace sanguis::dem::analysis {
 namespace {
 
-std::vector<std::string> dataset_files(const std::filesystem::path& pvd) {
-  std::vector<std::string> files;
-  if (!std::filesystem::exists(pvd)) return files;
-  for (const auto& e : io::read_pvd(pvd)) files.push_back(e.dataset);
+// The frames of a .pvd index: a decomposed run writes one part per process at each time.
+std::vector<std::pair<double, std::vector<std::string>>> frames_of(
+    const std::filesystem::path& pvd) {
+  std::vector<std::pair<double, std::vector<std::string>>> frames;
+  if (!std::filesystem::exists(pvd)) return frames;
+  for (const auto& e : io::read_pvd(pvd)) {
+    if (e.part > 0 && !frames.empty() && frames.back().first == e.time) {
+      frames.back().second.push_back(e.dataset);
+    } else {
+      frames.push_back({e.time, {e.dataset}});
+    }
+  }
+  return frames;
+}
+
+std::vector<std::vector<std::string>> dataset_files(const std::filesystem::path& pvd) {
+  std::vector<std::vector<std::string>> files;
+  for (auto& frame : frames_of(pvd)) files.push_back(std::move(frame.second));
   return files;
+}
+
+// Pieces of one frame written by the same writer: the same arrays in the same order.
+template <typename Array>
+void append_arrays(std::vector<Array>& to, const std::vector<Array>& from) {
+  if (to.empty()) {
+    to = from;
+    return;
+  }
+  for (std::size_t k = 0; k < to.size() && k < from.size(); ++k) {
+    to[k].values.insert(to[k].values.end(), from[k].values.begin(), from[k].values.end());
+  }
+}
+
+io::PointCloud read_clouds(const std::vector<std::string>& files) {
+  io::PointCloud all;
+  for (const std::string& file : files) {
+    const io::PointCloud piece = io::read_point_cloud_vtu(file);
+    all.points.insert(all.points.end(), piece.points.begin(), piece.points.end());
+    append_arrays(all.point_data, piece.point_data);
+    append_arrays(all.int_point_data, piece.int_point_data);
+  }
+  return all;
+}
+
+io::PolyMesh read_meshes(const std::vector<std::string>& files) {
+  io::PolyMesh all;
+  for (const std::string& file : files) {
+    const io::PolyMesh piece = io::read_polymesh_vtp(file);
+    const auto offset = static_cast<std::int64_t>(all.points.size());
+    all.points.insert(all.points.end(), piece.points.begin(), piece.points.end());
+    for (auto cell : piece.lines) {
+      for (auto& v : cell) v += offset;
+      all.lines.push_back(std::move(cell));
+    }
+    for (auto cell : piece.polygons) {
+      for (auto& v : cell) v += offset;
+      all.polygons.push_back(std::move(cell));
+    }
+    // Cell data: lines then polygons per piece; pieces here hold only one of the two.
+    append_arrays(all.cell_data, piece.cell_data);
+    append_arrays(all.int_cell_data, piece.int_cell_data);
+  }
+  return all;
 }
 
 std::vector<Vec3> as_vectors(const std::vector<double>& xyz) {
@@ -25,8 +83,8 @@ std::vector<Vec3> as_vectors(const std::vector<double>& xyz) {
   return v;
 }
 
-const std::string& file_of(const std::vector<std::string>& files, std::size_t frame,
-                           const std::string& what) {
+const std::vector<std::string>& file_of(const std::vector<std::vector<std::string>>& files,
+                                        std::size_t frame, const std::string& what) {
   if (frame >= files.size()) {
     throw std::runtime_error("frame " + std::to_string(frame) + " has no " + what + " file");
   }
@@ -40,16 +98,13 @@ RunOutput::RunOutput(std::filesystem::path dir) : dir_(std::move(dir)) {
   if (!std::filesystem::exists(pvd)) {
     throw InputError(dir_.string(), "", "not a sanguis DEM output folder (no particles.pvd)");
   }
-  for (const auto& e : io::read_pvd(pvd)) {
-    times_.push_back(e.time);
-    particle_files_.push_back(e.dataset);
+  for (auto& frame : frames_of(pvd)) {
+    times_.push_back(frame.first);
+    particle_files_.push_back(std::move(frame.second));
   }
   contact_files_ = dataset_files(dir_ / "contacts.pvd");
   branch_files_ = dataset_files(dir_ / "branches.pvd");
-  if (std::filesystem::exists(dir_ / "bodies.pvd")) {
-    for (const auto& e : io::read_pvd(dir_ / "bodies.pvd"))
-      body_files_.emplace_back(e.time, e.dataset);
-  }
+  body_files_ = frames_of(dir_ / "bodies.pvd");
 
   // obstacles.csv: index,type,remove_at_s,name (the name last: it may hold commas).
   std::ifstream table(dir_ / "obstacles.csv");
@@ -74,8 +129,7 @@ std::size_t RunOutput::frame_at(double t) const {
 }
 
 ParticleFrame RunOutput::particles(std::size_t frame) const {
-  const io::PointCloud cloud =
-      io::read_point_cloud_vtu(file_of(particle_files_, frame, "particle"));
+  const io::PointCloud cloud = read_clouds(file_of(particle_files_, frame, "particle"));
   ParticleFrame f;
   f.time = times_.at(frame);
   f.position = cloud.points;
@@ -89,7 +143,7 @@ ParticleFrame RunOutput::particles(std::size_t frame) const {
 }
 
 ContactPointFrame RunOutput::contacts(std::size_t frame) const {
-  const io::PointCloud cloud = io::read_point_cloud_vtu(file_of(contact_files_, frame, "contact"));
+  const io::PointCloud cloud = read_clouds(file_of(contact_files_, frame, "contact"));
   ContactPointFrame f;
   f.point = cloud.points;
   f.force = as_vectors(io::find_array(cloud.point_data, "force").values);
@@ -100,7 +154,7 @@ ContactPointFrame RunOutput::contacts(std::size_t frame) const {
 }
 
 BranchFrame RunOutput::branches(std::size_t frame) const {
-  const io::PolyMesh mesh = io::read_polymesh_vtp(file_of(branch_files_, frame, "branch"));
+  const io::PolyMesh mesh = read_meshes(file_of(branch_files_, frame, "branch"));
   BranchFrame f;
   for (const auto& line : mesh.lines) {
     f.from.push_back(mesh.points.at(static_cast<std::size_t>(line.front())));
@@ -124,7 +178,7 @@ BodySurfaceFrame RunOutput::bodies(std::size_t frame) const {
                              ": no body surfaces (bodies.pvd) at t = " + std::to_string(t) +
                              " s, the time of particle frame " + std::to_string(frame));
   }
-  const io::PolyMesh mesh = io::read_polymesh_vtp(match->second);
+  const io::PolyMesh mesh = read_meshes(match->second);
   for (const auto& polygon : mesh.polygons) {
     // Fan triangulation (the writer emits triangles; this keeps quads correct too).
     for (std::size_t k = 1; k + 1 < polygon.size(); ++k) {

@@ -77,8 +77,9 @@ class RunOutput {
  private:
   std::filesystem::path dir_;
   std::vector<double> times_;
-  std::vector<std::string> particle_files_, contact_files_, branch_files_;
-  std::vector<std::pair<double, std::string>> body_files_;  // by time: may start later
+  // Per frame, its files: one, or one piece per process of a decomposed run.
+  std::vector<std::vector<std::string>> particle_files_, contact_files_, branch_files_;
+  std::vector<std::pair<double, std::vector<std::string>>> body_files_;  // by time: may start later
   std::vector<std::string> obstacle_names_;
   std::optional<double> first_removal_;
 };
