@@ -81,7 +81,7 @@ double MultigridReport::mean_reduction() const {
 }
 
 Multigrid::Multigrid(const Forest& forest, const std::array<BcKind, 6>& kinds)
-    : forest_(forest), kinds_(kinds) {
+    : forest_(forest), kinds_(kinds), composite_(!forest.uniform()) {
   for (int d = 0; d < 3; ++d) {
     const bool periodic = forest.spec().periodic[D(d)];
     for (int side = 0; side < 2; ++side) {
@@ -104,6 +104,9 @@ Multigrid::Multigrid(const Forest& forest, const std::array<BcKind, 6>& kinds)
     level.alpha = BlockField(n, b, ghost);
     level.beta = make_vector_field(n, b, ghost);
     level.active = BlockField(n, b, ghost);
+    if (composite_ && b >= 2) {
+      for (BlockField& flux : level.face_flux) flux = BlockField(n, b, ghost);
+    }
     levels_.push_back(std::move(level));
   }
   shifted_rhs_ = BlockField(n, forest.block_cells());
@@ -190,6 +193,10 @@ void Multigrid::compute_activity() {
 }
 
 void Multigrid::build_coarse_operator() {
+  if (composite_) {
+    build_composite_operator();
+    return;
+  }
   const int level = forest_.spec().level;
   coarse_n_ = forest_.blocks_per_direction(level);
   coarse_h_ = forest_.spec().tree_length / static_cast<double>(std::int64_t{1} << level);
@@ -237,6 +244,10 @@ void Multigrid::build_coarse_operator() {
 }
 
 void Multigrid::coarse_solve() {
+  if (composite_) {
+    composite_solve();
+    return;
+  }
   Level& c = levels_.back();
   const auto [nx, ny, nz] = coarse_n_;
   const auto cells = static_cast<std::size_t>(nx * ny * nz);
@@ -436,6 +447,7 @@ void Multigrid::compute_residual(int level, BlockField& x, const BlockField& rhs
           rb[c] = (fb[c] - applied(xb, k, c, s, inv_h2)) * ab[c];
         }
   });
+  if (composite_) reflux(level, x, r);
 }
 
 void Multigrid::vcycle(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc) {
@@ -490,13 +502,18 @@ double Multigrid::mean(const BlockField& f) const {
   const int b = f.cells();
   const BlockField& active = levels_.front().active;
   double local = 0.0, count = 0.0;
-  for (int blk = 0; blk < forest_.local_blocks(); ++blk)
+  for (int blk = 0; blk < forest_.local_blocks(); ++blk) {
+    // Composite grids: weighted by the cell volume (in finest-cell units, so
+    // that a uniform forest keeps the plain count).
+    const double volume =
+        composite_ ? std::ldexp(1.0, 3 * (forest_.max_level() - forest_.block(blk).level)) : 1.0;
     for (int k = 0; k < b; ++k)
       for (int j = 0; j < b; ++j)
         for (int i = 0; i < b; ++i) {
-          local += active(blk, i, j, k) * f(blk, i, j, k);
-          count += active(blk, i, j, k);
+          local += volume * active(blk, i, j, k) * f(blk, i, j, k);
+          count += volume * active(blk, i, j, k);
         }
+  }
   const double cells = forest_.sum(count);
   return cells > 0.0 ? forest_.sum(local) / cells : 0.0;
 }

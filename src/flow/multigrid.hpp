@@ -19,6 +19,18 @@
 // inactive: they keep their value, and the prolongation interpolates from
 // active coarse cells only (renormalised weights), so that masked walls act
 // as Neumann boundaries on every level.
+//
+// Composite grids (blocks at several levels, issue #7): every in-block level
+// is itself a composite grid with the same 2:1 structure, so the V-cycle is
+// unchanged: Forest::exchange fills fine ghosts from coarser blocks by
+// quadratic interpolation and coarse ghosts from finer blocks by averaging.
+// The residual is made conservative ("refluxing"): at a coarse-fine face the
+// coarse cell's flux is replaced by the mean of the 4 fine fluxes computed on
+// the fine side (see reflux()); the smoother keeps the plain ghost-based
+// stencil. The bottom level (one cell per block) is the graph of leaves,
+// gathered on every rank and solved by CG with a two-point flux between
+// blocks of different size (distance 1.5 h_fine). A forest that adapts needs
+// a new Multigrid.
 
 #include <array>
 #include <vector>
@@ -80,6 +92,7 @@ class Multigrid {
     BlockField x, rhs, res, alpha;
     FaceField beta;
     BlockField active;  ///< 1 where the cell takes part (some open face or alpha > 0), else 0
+    std::array<BlockField, 6> face_flux;  ///< composite grids: fine-side fluxes by face (reflux)
   };
   void fill_ghosts(int level, BlockField& x, const ScalarBoundary* bc,
                    bool faces_only = false) const;
@@ -90,6 +103,10 @@ class Multigrid {
   void vcycle(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc);
   void coarse_solve();
   void build_coarse_operator();
+  void build_composite_operator();  ///< the bottom level of a non-uniform forest
+  void composite_solve();
+  /// Conservative correction of r at coarse cells beside finer blocks.
+  void reflux(int level, const BlockField& x, BlockField& r);
   double rms(const BlockField& f) const;
   double mean(const BlockField& f) const;  ///< over the active cells of the finest level
   void compute_activity();
@@ -99,6 +116,15 @@ class Multigrid {
   bool has_alpha_ = false;
   bool singular_ = false;
   std::vector<Level> levels_;  ///< 0 finest (b = B), last one cell per block
+  bool composite_ = false;     ///< blocks at more than one level
+
+  /// The bottom level of a composite grid: one cell per leaf in global p8est
+  /// order, the volume-weighted (symmetric) operator in compressed rows.
+  struct CompositeOperator {
+    std::vector<double> volume, active, diagonal;
+    std::vector<std::int64_t> row_start, column;
+    std::vector<double> value;  ///< off-diagonal entries
+  } composite_op_;
 
   // The grid of blocks, one cell each, gathered on every rank.
   std::array<std::int64_t, 3> coarse_n_{};

@@ -1,0 +1,201 @@
+// Adaptive forest (issue #7): refinement with 2:1 balance, the neighbour
+// table across levels, coarse-fine ghost filling, and the data transfer of
+// adapt() (restriction by volume average, limited linear prolongation).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "adapt_problems.hpp"
+#include "flow/forest.hpp"
+
+namespace sanguis::flow {
+namespace {
+
+using testing::block_centre;
+using testing::fill_cells;
+using testing::ghost_error;
+using testing::refine_where;
+
+double linear(const Vec3& x) {
+  return 1.0 + 2.0 * x.x - 3.0 * x.y + 0.5 * x.z;
+}
+double quadratic(const Vec3& x) {
+  return linear(x) + x.x * x.x - 2.0 * x.y * x.y + 3.0 * x.z * x.z + x.x * x.y - x.y * x.z;
+}
+
+ForestSpec small_spec(bool periodic) {
+  ForestSpec spec;
+  spec.level = 1;
+  spec.block_cells = 4;
+  spec.periodic = {periodic, periodic, periodic};
+  return spec;
+}
+
+TEST(FlowAdapt, RefiningOneBlockLinksNeighboursAcrossLevels) {
+  Forest forest(small_spec(false));
+  refine_where(forest, [](const Vec3& c) { return c.x < 0.5 && c.y < 0.5 && c.z < 0.5; });
+  EXPECT_EQ(forest.global_blocks(), 7 + 8);
+  EXPECT_EQ(forest.min_level(), 1);
+  EXPECT_EQ(forest.max_level(), 2);
+  EXPECT_FALSE(forest.uniform());
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    const Block& block = forest.block(blk);
+    const Neighbour& right = block.neighbours[neighbour_slot(1, 0, 0)];
+    if (block.level == 2 && block.coord[0] == 1) {
+      // A child on the x = 1/2 face sees the coarse block beyond it.
+      EXPECT_EQ(right.jump, LevelJump::Coarser);
+      EXPECT_EQ(forest.block(right.index).level, 1);
+    }
+    if (block.level == 1 && block.coord == std::array<std::int64_t, 3>{1, 0, 0}) {
+      // Across the face at x = 1/2: the 4 children with x-bit 1 are set.
+      const Neighbour& left = block.neighbours[neighbour_slot(-1, 0, 0)];
+      EXPECT_EQ(left.jump, LevelJump::Finer);
+      for (int c = 0; c < 8; ++c) {
+        EXPECT_EQ(left.children[static_cast<std::size_t>(c)].link != Link::Boundary, (c & 1) == 1);
+      }
+      // Across the edge towards (-x, +y): the y-bit must be 0 too.
+      const Neighbour& edge = block.neighbours[neighbour_slot(-1, 1, 0)];
+      EXPECT_EQ(edge.jump, LevelJump::Same);  // (0,1,0) is an unrefined level-1 block
+    }
+  }
+}
+
+TEST(FlowAdapt, BalanceRefinesAcrossFacesEdgesAndCorners) {
+  Forest forest(small_spec(false));
+  refine_where(forest, [](const Vec3& c) { return c.x < 0.5 && c.y < 0.5 && c.z < 0.5; });
+  // The level-2 block [1/4, 1/2]^3 touches all 7 other level-1 blocks (3 by
+  // faces, 3 by edges, 1 by a corner): refining it forces all 7 to level 2.
+  refine_where(forest, [](const Vec3& c) {
+    return std::abs(c.x - 0.375) < 1e-12 && std::abs(c.y - 0.375) < 1e-12 &&
+           std::abs(c.z - 0.375) < 1e-12;
+  });
+  EXPECT_EQ(forest.global_blocks(), 64 + 7);
+  EXPECT_EQ(forest.min_level(), 2);
+  EXPECT_EQ(forest.max_level(), 3);
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    const Block& block = forest.block(blk);
+    for (const Neighbour& nb : block.neighbours) {
+      if (nb.link != Link::Local) continue;
+      EXPECT_EQ(forest.block(nb.index).level, block.level + static_cast<int>(nb.jump));
+    }
+  }
+}
+
+TEST(FlowAdapt, CoarseningMergesFamiliesBack) {
+  Forest forest(small_spec(true));
+  refine_where(forest, [](const Vec3& c) { return c.x < 0.5; });
+  EXPECT_EQ(forest.global_blocks(), 4 + 4 * 8);
+  const bool changed = forest.adapt(
+      [](const Block& b) { return b.level == 2 ? AdaptFlag::Coarsen : AdaptFlag::Keep; }, {});
+  EXPECT_TRUE(changed);
+  EXPECT_EQ(forest.global_blocks(), 8);
+  EXPECT_TRUE(forest.uniform());
+  EXPECT_FALSE(forest.adapt([](const Block&) { return AdaptFlag::Keep; }, {}));
+}
+
+TEST(FlowAdapt, GhostsReproduceLinearFunctionsAcrossLevels) {
+  Forest forest(small_spec(false));
+  refine_where(forest, [](const Vec3& c) { return c.x < 0.5 && c.y < 0.5; });
+  ASSERT_GT(testing::blocks_with(forest, LevelJump::Coarser), 0.0);
+  ASSERT_GT(testing::blocks_with(forest, LevelJump::Finer), 0.0);
+  BlockField field(forest.local_blocks(), 4);
+  fill_cells(forest, field, linear);
+  forest.exchange(field, kGhost);
+  // Values of order 1-5: round-off only (interpolation weights sum to 1).
+  for (const LevelJump jump : {LevelJump::Same, LevelJump::Coarser, LevelJump::Finer}) {
+    EXPECT_LT(ghost_error(forest, field, linear, jump, kGhost), 1e-13);
+  }
+}
+
+TEST(FlowAdapt, FineGhostsReproduceQuadraticsAndCoarseGhostsAverageThem) {
+  Forest forest(small_spec(false));
+  refine_where(forest, [](const Vec3& c) { return c.x < 0.5 && c.y < 0.5; });
+  BlockField field(forest.local_blocks(), 4);
+  fill_cells(forest, field, quadratic);
+  forest.exchange(field, kGhost);
+  // Tensor-quadratic interpolation of the coarse interior: exact.
+  EXPECT_LT(ghost_error(forest, field, quadratic, LevelJump::Coarser, kGhost), 1e-13);
+  // Coarse ghosts are the mean of the 8 fine cells: for a x^2 + b y^2 + c z^2
+  // + cross terms the mean exceeds the centre value by (a + b + c) (h_f/2)^2,
+  // exactly (the cross terms average out): (1 - 2 + 3) / 4 * (1/16)^2 here.
+  const double h_fine = 0.25 / 4;
+  const double excess = (1.0 - 2.0 + 3.0) * 0.25 * h_fine * h_fine;
+  const double restricted = ghost_error(forest, field, quadratic, LevelJump::Finer, kGhost);
+  EXPECT_NEAR(restricted, excess, 1e-13);
+}
+
+TEST(FlowAdapt, RefinementAndCoarseningCarryLinearFieldsExactly) {
+  ForestSpec spec = small_spec(false);
+  spec.block_cells = 8;
+  Forest forest(spec);
+  BlockField field(forest.local_blocks(), 8), other(forest.local_blocks(), 8, 1);
+  fill_cells(forest, field, linear);
+  fill_cells(forest, other, quadratic);
+  BlockField* fields[] = {&field, &other};
+  refine_where(
+      forest, [](const Vec3& c) { return c.x < 0.5; }, fields);
+  ASSERT_EQ(forest.global_blocks(), 4 + 32);
+  ASSERT_EQ(field.blocks(), forest.local_blocks());
+  ASSERT_EQ(other.layout().ghost, 1);
+  BlockField expected(forest.local_blocks(), 8);
+  fill_cells(forest, expected, linear);
+  double error = 0.0;
+  for (std::size_t n = 0; n < field.raw().size(); ++n) {
+    error = std::max(error, std::abs(field.raw()[n] - expected.raw()[n]));
+  }
+  // minmod of two equal differences is that difference: exact to round-off,
+  // boundary cells (one-sided slopes) included.
+  EXPECT_LT(error, 1e-13);
+  forest.adapt([](const Block& b) { return b.level == 2 ? AdaptFlag::Coarsen : AdaptFlag::Keep; },
+               fields);
+  ASSERT_TRUE(forest.uniform());
+  expected = BlockField(forest.local_blocks(), 8);
+  fill_cells(forest, expected, linear);
+  error = 0.0;
+  for (std::size_t n = 0; n < field.raw().size(); ++n) {
+    error = std::max(error, std::abs(field.raw()[n] - expected.raw()[n]));
+  }
+  EXPECT_LT(error, 1e-13);
+}
+
+/// Sum of cell value times cell volume over all ranks.
+double integral(const Forest& forest, const BlockField& field) {
+  const int b = field.cells();
+  double sum = 0.0;
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    const double h = forest.block(blk).length / b;
+    for (int k = 0; k < b; ++k)
+      for (int j = 0; j < b; ++j)
+        for (int i = 0; i < b; ++i) sum += field(blk, i, j, k) * h * h * h;
+  }
+  return forest.sum(sum);
+}
+
+TEST(FlowAdapt, TransferConservesTheIntegralAndCreatesNoNewExtrema) {
+  ForestSpec spec = small_spec(true);
+  Forest forest(spec);
+  BlockField wave(forest.local_blocks(), 4), step(forest.local_blocks(), 4);
+  fill_cells(forest, wave, [](const Vec3& x) { return std::sin(6.0 * x.x) * std::cos(4.0 * x.y); });
+  fill_cells(forest, step, [](const Vec3& x) { return x.x + 0.3 * x.y < 0.6 ? 1.0 : -1.0; });
+  const double before = integral(forest, wave), step_before = integral(forest, step);
+  BlockField* fields[] = {&wave, &step};
+  refine_where(
+      forest, [](const Vec3& c) { return c.y < 0.5; }, fields);
+  // The child offsets +-h/4 cancel in pairs: the parent's mean is kept, to round-off.
+  EXPECT_NEAR(integral(forest, wave), before, 1e-15);
+  EXPECT_NEAR(integral(forest, step), step_before, 1e-15);
+  double lo = 0.0, hi = 0.0;
+  for (int blk = 0; blk < forest.local_blocks(); ++blk)
+    for (int k = 0; k < 4; ++k)
+      for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < 4; ++i) {
+          lo = std::min(lo, step(blk, i, j, k));
+          hi = std::max(hi, step(blk, i, j, k));
+        }
+  // minmod: a step stays within its two values.
+  EXPECT_GE(lo, -1.0);
+  EXPECT_LE(hi, 1.0);
+}
+
+}  // namespace
+}  // namespace sanguis::flow
