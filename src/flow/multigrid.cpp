@@ -355,15 +355,15 @@ void Multigrid::coarse_solve() {
   }
 }
 
-void Multigrid::fill_ghosts(int level, BlockField& x, const ScalarBoundary* bc,
-                            bool faces_only) const {
-  (void)level;
+void Multigrid::fill_ghosts(int level, BlockField& x, const ScalarBoundary* bc, bool faces_only,
+                            bool match) {
   forest_.exchange(x, 1, faces_only);
   if (bc) {
     fill_boundary_ghosts(forest_, x, *bc, 1, false);
   } else {
     fill_boundary_ghosts(forest_, x, kinds_, 1);
   }
+  if (composite_ && match) match_fluxes(level, x);
 }
 
 void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc,
@@ -388,8 +388,26 @@ void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const Sc
         const double* rb = rhs.block(blk);
         // Dirichlet faces of this block with the quadratic closure (finest level):
         // ghost = (8 g - 6 x0 + x1)/3 depends on x0 with weight -2.
-        std::array<bool, 6> dirichlet{};
+        std::array<bool, 6> dirichlet{}, matched{}, interface {};
         bool any = false;
+        if (composite_) {
+          // Coarse-fine faces seen from the coarse side: the ghost carries the
+          // fine flux, which does not move with this cell (weight -1 on x0).
+          // Cells beside any coarse-fine face relax without over-relaxation:
+          // their coupling across the face is lagged, and over-relaxing it
+          // slows the cycle (measured: 4.9x against 10x per V-cycle).
+          for (int d = 0; d < 3; ++d)
+            for (int side = 0; side < 2; ++side) {
+              std::array<int, 3> o{0, 0, 0};
+              o[D(d)] = side == 0 ? -1 : 1;
+              const Neighbour& nb = block.neighbours[D(neighbour_slot(o[0], o[1], o[2]))];
+              const bool on = nb.jump == LevelJump::Finer;
+              matched[D(face_index(d, side))] = on;
+              interface[D(face_index(d, side))] =
+                  nb.link != Link::Boundary && nb.jump != LevelJump::Same;
+              any = any || interface[D(face_index(d, side))];
+            }
+        }
         if (bc != nullptr) {
           for (int d = 0; d < 3; ++d)
             for (int side = 0; side < 2; ++side) {
@@ -407,17 +425,26 @@ void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const Sc
             for (int i = ((kk + j + parity + colour) & 1); i < b; i += 2) {
               const std::ptrdiff_t c = L.index(i, j, kk);
               double implicit = 0.0;
+              double weight = omega_;
               if (any) {
                 const std::array<int, 3> n{i, j, kk};
                 for (int d = 0; d < 3; ++d) {
+                  if ((interface[D(face_index(d, 0))] && n[D(d)] == 0) ||
+                      (interface[D(face_index(d, 1))] && n[D(d)] == b - 1)) {
+                    weight = 1.0;
+                  }
                   if (dirichlet[D(face_index(d, 0))] && n[D(d)] == 0)
                     implicit += 2.0 * k.beta[D(d)][c];
                   if (dirichlet[D(face_index(d, 1))] && n[D(d)] == b - 1) {
                     implicit += 2.0 * k.beta[D(d)][c + s[D(d)]];
                   }
+                  if (matched[D(face_index(d, 0))] && n[D(d)] == 0) implicit -= k.beta[D(d)][c];
+                  if (matched[D(face_index(d, 1))] && n[D(d)] == b - 1) {
+                    implicit -= k.beta[D(d)][c + s[D(d)]];
+                  }
                 }
               }
-              xb[c] += omega_ * (relaxed_value(xb, rb[c], k, c, s, inv_h2, implicit) - xb[c]);
+              xb[c] += weight * (relaxed_value(xb, rb[c], k, c, s, inv_h2, implicit) - xb[c]);
             }
       });
     }
@@ -447,7 +474,6 @@ void Multigrid::compute_residual(int level, BlockField& x, const BlockField& rhs
           rb[c] = (fb[c] - applied(xb, k, c, s, inv_h2)) * ab[c];
         }
   });
-  if (composite_) reflux(level, x, r);
 }
 
 void Multigrid::vcycle(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc) {
@@ -462,7 +488,7 @@ void Multigrid::vcycle(int level, BlockField& x, const BlockField& rhs, const Sc
   restrict_children(forest_, fine.res, coarse.rhs, coarse.cells, kAdd, kMean8);
   coarse.x.fill(0.0);
   vcycle(level + 1, coarse.x, coarse.rhs, nullptr);
-  fill_ghosts(level + 1, coarse.x, nullptr);
+  fill_ghosts(level + 1, coarse.x, nullptr, false, false);  // values, not matched fluxes
   // Trilinear prolongation of the correction (weights 3/4, 1/4 per direction).
   const int b = fine.cells;
   forest_.for_each_block([&](int blk) {
@@ -561,7 +587,7 @@ MultigridReport Multigrid::solve(BlockField& x, const BlockField& rhs, const Sca
     ++report.cycles;
     report.converged = report.residuals.back() <= target;
   }
-  fill_ghosts(0, x, &bc);
+  fill_ghosts(0, x, &bc, false, false);
   return report;
 }
 

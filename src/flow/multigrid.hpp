@@ -24,10 +24,13 @@
 // is itself a composite grid with the same 2:1 structure, so the V-cycle is
 // unchanged: Forest::exchange fills fine ghosts from coarser blocks by
 // quadratic interpolation and coarse ghosts from finer blocks by averaging.
-// The residual is made conservative ("refluxing"): at a coarse-fine face the
-// coarse cell's flux is replaced by the mean of the 4 fine fluxes computed on
-// the fine side (see reflux()); the smoother keeps the plain ghost-based
-// stencil. The bottom level (one cell per block) is the graph of leaves,
+// The operator is made conservative (flux matching): at a coarse-fine face
+// the coarse cell's flux is the mean of the 4 fine fluxes computed on the
+// fine side. match_fluxes() writes it into the coarse ghost (the value that
+// gives that flux through the coarse stencil), so the residual needs no
+// special case, and the smoother holds the matched flux fixed while it
+// relaxes the coarse cell (lagged, like the fine ghosts interpolated from the
+// coarse cells). The bottom level (one cell per block) is the graph of leaves,
 // gathered on every rank and solved by CG with a two-point flux between
 // blocks of different size (distance 1.5 h_fine). A forest that adapts needs
 // a new Multigrid.
@@ -92,10 +95,13 @@ class Multigrid {
     BlockField x, rhs, res, alpha;
     FaceField beta;
     BlockField active;  ///< 1 where the cell takes part (some open face or alpha > 0), else 0
-    std::array<BlockField, 6> face_flux;  ///< composite grids: fine-side fluxes by face (reflux)
+    std::array<BlockField, 6> face_flux;  ///< composite grids: fine-side fluxes by face
   };
-  void fill_ghosts(int level, BlockField& x, const ScalarBoundary* bc,
-                   bool faces_only = false) const;
+  /// Ghosts from the neighbours (Forest::exchange) and the boundary; on
+  /// composite grids, coarse ghosts at coarse-fine faces then carry the
+  /// matched fluxes (unless `match` is false: plain restricted values).
+  void fill_ghosts(int level, BlockField& x, const ScalarBoundary* bc, bool faces_only = false,
+                   bool match = true);
   void smooth(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc,
               int sweeps);
   void compute_residual(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc,
@@ -105,8 +111,9 @@ class Multigrid {
   void build_coarse_operator();
   void build_composite_operator();  ///< the bottom level of a non-uniform forest
   void composite_solve();
-  /// Conservative correction of r at coarse cells beside finer blocks.
-  void reflux(int level, const BlockField& x, BlockField& r);
+  /// Coarse ghosts at coarse-fine faces such that the coarse flux equals the
+  /// mean of the fine fluxes across that face.
+  void match_fluxes(int level, BlockField& x);
   double rms(const BlockField& f) const;
   double mean(const BlockField& f) const;  ///< over the active cells of the finest level
   void compute_activity();

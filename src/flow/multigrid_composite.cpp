@@ -41,18 +41,20 @@ void for_face_cells(const BlockLayout& L, int d, int side, Body&& body) {
 
 }  // namespace
 
-// Flux matching at coarse-fine faces. The residual of a cell is
+// Flux matching at coarse-fine faces. A cell's residual is
 // r = f - alpha x + (1/h) sum_faces G with G = beta (x_beyond - x) / h the
 // gradient flux through each face. A fine cell beside a coarser block takes
 // its G from the interpolated ghost; the coarse cell across the face must
 // see exactly the mean of those 4 fine fluxes (with the opposite sign), so
-// that the composite operator is conservative. The fine fluxes are stored in
-// the fine block's face layer of face_flux[face] and sent to the coarse block
-// by the exchange, whose restriction averages the 8 fine cells of a ghost
-// cell: the 4 of the face layer and 4 zeros, hence the factor 2.
-void Multigrid::reflux(int level, const BlockField& x, BlockField& r) {
+// that the composite operator is conservative (the coarse cell's flux is the
+// sum of the fine ones). The fine fluxes are stored in the fine block's face
+// layer of face_flux[face] and sent to the coarse block by the exchange,
+// whose restriction averages the 8 fine cells of a ghost cell: the 4 of the
+// face layer and 4 zeros, hence the factor 2. The coarse ghost becomes the
+// value x + h G / beta that yields that flux through the coarse stencil.
+void Multigrid::match_fluxes(int level, BlockField& x) {
   Level& lv = levels_[D(level)];
-  if (lv.face_flux[0].blocks() == 0) return;  // no fine layer: the gathered bottom level
+  if (lv.face_flux[0].blocks() == 0) return;  // one cell per block: the gathered bottom level
   const BlockLayout L = x.layout();
   const int b = L.cells;
   forest_.for_each_block([&](int blk) {
@@ -77,9 +79,7 @@ void Multigrid::reflux(int level, const BlockField& x, BlockField& r) {
   forest_.for_each_block([&](int blk) {
     const Block& block = forest_.block(blk);
     const double h = block.length / b;
-    const double* xb = x.block(blk);
-    const double* active = lv.active.block(blk);
-    double* rb = r.block(blk);
+    double* xb = x.block(blk);
     for (int d = 0; d < 3; ++d)
       for (int side = 0; side < 2; ++side) {
         if (block.neighbours[face_slot(d, side)].jump != LevelJump::Finer) continue;
@@ -88,9 +88,8 @@ void Multigrid::reflux(int level, const BlockField& x, BlockField& r) {
         const double* beta = lv.beta[D(d)].block(blk);
         for_face_cells(L, d, side, [&](std::ptrdiff_t c, std::ptrdiff_t g) {
           const double beta_face = side == 0 ? beta[c] : beta[g];
-          const double coarse_flux = beta_face * (xb[g] - xb[c]) / h;
           const double fine_flux = -2.0 * fine[g];
-          rb[c] += (fine_flux - coarse_flux) / h * active[c];
+          if (beta_face > 0.0) xb[g] = xb[c] + h * fine_flux / beta_face;
         });
       }
   });
