@@ -60,6 +60,33 @@ TEST(FlowAdapt, RefiningOneBlockLinksNeighboursAcrossLevels) {
   }
 }
 
+TEST(FlowAdapt, FinerNeighboursListFourChildrenAcrossFacesTwoAcrossEdgesOneAcrossCorners) {
+  Forest forest(small_spec(true));
+  refine_where(forest, [](const Vec3& c) { return c.x < 0.5 && c.y < 0.5 && c.z < 0.5; });
+  int seen = 0;
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    const Block& block = forest.block(blk);
+    for (int oz = -1; oz <= 1; ++oz)
+      for (int oy = -1; oy <= 1; ++oy)
+        for (int ox = -1; ox <= 1; ++ox) {
+          const Neighbour& nb = block.neighbours[neighbour_slot(ox, oy, oz)];
+          if (nb.jump != LevelJump::Finer) continue;
+          const int zeros = (ox == 0) + (oy == 0) + (oz == 0);  // 2 face, 1 edge, 0 corner
+          int children = 0;
+          for (const BlockRef& child : nb.children) {
+            if (child.link == Link::Boundary) continue;
+            ++children;
+            EXPECT_EQ(forest.block(child.index).level, block.level + 1);
+          }
+          EXPECT_EQ(children, 1 << zeros);
+          ++seen;
+        }
+  }
+  // Periodic: each of the 7 coarse blocks sees the refined octant across
+  // every offset that wraps onto it (26 in all, counted once per offset).
+  EXPECT_EQ(seen, 26);
+}
+
 TEST(FlowAdapt, BalanceRefinesAcrossFacesEdgesAndCorners) {
   Forest forest(small_spec(false));
   refine_where(forest, [](const Vec3& c) { return c.x < 0.5 && c.y < 0.5 && c.z < 0.5; });
