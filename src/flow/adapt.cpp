@@ -13,6 +13,7 @@
 // with p8est_transfer_fixed (Forest::partition).
 #include <p8est_extended.h>
 
+#include <algorithm>
 #include <stdexcept>
 #include <unordered_map>
 
@@ -108,6 +109,75 @@ void restrict_block(const BlockField& old, const std::array<int, 8>& children, B
       }
 }
 
+/// Calls body(i, j, k) for the faces of component d of one block: slots
+/// 0..b along d (slot b, in the ghost layer, is the block's upper face), 0..b-1 across.
+template <typename Body>
+void for_each_face(int b, int d, Body&& body) {
+  std::array<int, 3> end{b, b, b};
+  end[static_cast<std::size_t>(d)] = b + 1;
+  for (int k = 0; k < end[2]; ++k)
+    for (int j = 0; j < end[1]; ++j)
+      for (int i = 0; i < end[0]; ++i) body(std::array<int, 3>{i, j, k});
+}
+
+void copy_faces(const BlockField& from, int from_blk, int d, BlockField& to, int to_blk) {
+  for_each_face(to.cells(), d, [&](const std::array<int, 3>& f) {
+    to(to_blk, f[0], f[1], f[2]) = from(from_blk, f[0], f[1], f[2]);
+  });
+}
+
+/// Parent faces of component d: the mean of the 4 child faces on each (the
+/// flux through the parent face is their sum).
+void restrict_faces(const BlockField& old, const std::array<int, 8>& children, int d,
+                    BlockField& parent, int parent_blk) {
+  const int b = parent.cells();
+  const auto dd = static_cast<std::size_t>(d);
+  const auto e1 = static_cast<std::size_t>((d + 1) % 3), e2 = static_cast<std::size_t>((d + 2) % 3);
+  for_each_face(b, d, [&](const std::array<int, 3>& face) {
+    double sum = 0.0;
+    for (int t2 = 0; t2 < 2; ++t2)
+      for (int t1 = 0; t1 < 2; ++t1) {
+        std::array<int, 3> fine{};
+        fine[dd] = 2 * face[dd];  // up to 2b: the upper children's slot b
+        fine[e1] = 2 * face[e1] + t1;
+        fine[e2] = 2 * face[e2] + t2;
+        int child = 0;
+        for (std::size_t x = 0; x < 3; ++x) {
+          const int bit = std::min(fine[x] / b, 1);
+          child |= bit << x;
+          fine[x] -= bit * b;
+        }
+        sum += old(children[static_cast<std::size_t>(child)], fine[0], fine[1], fine[2]);
+      }
+    parent(parent_blk, face[0], face[1], face[2]) = sum / 4.0;
+  });
+}
+
+/// Child faces of component d: on a parent face its value, inside a parent
+/// cell the mean of the parent's two faces along d. Every child cell then
+/// has the parent cell's divergence, and the parent faces' fluxes are kept.
+void prolong_faces(const BlockField& parent, int parent_blk, const std::array<int, 3>& child_bits,
+                   int d, BlockField& child, int child_blk) {
+  const int b = child.cells();
+  const auto dd = static_cast<std::size_t>(d);
+  for_each_face(b, d, [&](const std::array<int, 3>& face) {
+    std::array<int, 3> cell{};
+    for (std::size_t x = 0; x < 3; ++x) cell[x] = (child_bits[x] * b + face[x]) >> 1;
+    const int along = child_bits[dd] * b + face[dd];  // fine face number along d, 0..2b
+    double value = 0.0;
+    if ((along & 1) == 0) {
+      cell[dd] = along / 2;
+      value = parent(parent_blk, cell[0], cell[1], cell[2]);
+    } else {
+      cell[dd] = along / 2;
+      const double below = parent(parent_blk, cell[0], cell[1], cell[2]);
+      cell[dd] += 1;
+      value = 0.5 * (below + parent(parent_blk, cell[0], cell[1], cell[2]));
+    }
+    child(child_blk, face[0], face[1], face[2]) = value;
+  });
+}
+
 std::array<bool, 6> boundary_faces(const Block& block) {
   std::array<bool, 6> wall{};
   for (int d = 0; d < 3; ++d)
@@ -124,14 +194,15 @@ std::array<bool, 6> boundary_faces(const Block& block) {
 }  // namespace
 
 bool Forest::adapt(const std::function<AdaptFlag(const Block&)>& decide,
-                   std::span<BlockField* const> fields, int max_level) {
+                   std::span<BlockField* const> fields, std::span<FaceField* const> face_fields,
+                   int max_level) {
   std::vector<AdaptFlag> flags(blocks_.size());
   for (std::size_t b = 0; b < blocks_.size(); ++b) flags[b] = decide(blocks_[b]);
-  return adapt(flags, fields, max_level);
+  return adapt(flags, fields, face_fields, max_level);
 }
 
 bool Forest::adapt(std::span<const AdaptFlag> flags, std::span<BlockField* const> fields,
-                   int max_level) {
+                   std::span<FaceField* const> face_fields, int max_level) {
   if (flags.size() != blocks_.size()) {
     throw std::invalid_argument("forest: adapt needs one flag per local block");
   }
@@ -140,6 +211,13 @@ bool Forest::adapt(std::span<const AdaptFlag> flags, std::span<BlockField* const
       throw std::invalid_argument("forest: adapt: a field does not match the block list");
     }
     exchange(*f, 1);  // neighbours' cells for the prolongation slopes
+  }
+  for (const FaceField* uf : face_fields) {
+    for (const BlockField& component : *uf) {
+      if (component.blocks() != local_blocks() || component.layout().ghost < 1) {
+        throw std::invalid_argument("forest: adapt: a face field does not match the block list");
+      }
+    }
   }
   AdaptContext ctx;
   ctx.trees = spec_.trees;
@@ -223,8 +301,34 @@ bool Forest::adapt(std::span<const AdaptFlag> flags, std::span<BlockField* const
       }
     }
   }
+  for (FaceField* uf : face_fields) {
+    for (int d = 0; d < 3; ++d) {
+      BlockField& component = (*uf)[static_cast<std::size_t>(d)];
+      const BlockField old = std::move(component);
+      component = BlockField(local_blocks(), old.cells(), old.layout().ghost);
+      for (std::size_t n = 0; n < blocks_.size(); ++n) {
+        const Source& src = sources[n];
+        const int blk = static_cast<int>(n);
+        switch (src.kind) {
+          case Source::Kind::Copy:
+            copy_faces(old, src.blocks[0], d, component, blk);
+            break;
+          case Source::Kind::Prolong:
+            prolong_faces(old, src.blocks[0], src.child_bits, d, component, blk);
+            break;
+          case Source::Kind::Restrict:
+            restrict_faces(old, src.blocks, d, component, blk);
+            break;
+        }
+      }
+    }
+  }
   MPI_Allreduce(MPI_IN_PLACE, &changed, 1, MPI_INT, MPI_MAX, comm_);
-  partition(fields);
+  std::vector<BlockField*> moving(fields.begin(), fields.end());
+  for (FaceField* uf : face_fields) {
+    for (BlockField& component : *uf) moving.push_back(&component);
+  }
+  partition(moving);
   return changed != 0;
 }
 

@@ -75,13 +75,11 @@ void Forest::rebuild_tables() {
   build_neighbours();
 }
 
-void Forest::migrate_fields(const std::vector<p4est_gloidx_t>& before,
+void Forest::migrate_fields(const std::vector<std::int64_t>& before,
                             std::span<BlockField* const> fields) {
-  // One fixed-size record per block: the interiors of all fields in turn.
+  // One fixed-size record per block: the whole storage of all fields in turn.
   std::size_t per_block = 0;
-  for (const BlockField* f : fields) {
-    per_block += static_cast<std::size_t>(f->cells()) * f->cells() * f->cells();
-  }
+  for (const BlockField* f : fields) per_block += static_cast<std::size_t>(f->layout().size());
   const auto old_blocks = static_cast<std::size_t>(before[static_cast<std::size_t>(rank_) + 1] -
                                                    before[static_cast<std::size_t>(rank_)]);
   const p8est_t* forest = p4est_->forest.get();
@@ -90,12 +88,8 @@ void Forest::migrate_fields(const std::vector<p4est_gloidx_t>& before,
   for (std::size_t blk = 0; blk < old_blocks; ++blk) {
     double* out = send.data() + blk * per_block;
     for (const BlockField* f : fields) {
-      const int b = f->cells();
-      const BlockLayout& L = f->layout();
       const double* in = f->block(static_cast<int>(blk));
-      for (int k = 0; k < b; ++k)
-        for (int j = 0; j < b; ++j)
-          for (int i = 0; i < b; ++i) *out++ = in[L.index(i, j, k)];
+      out = std::copy(in, in + f->layout().size(), out);
     }
   }
   constexpr int kTransferTag = 0x5a17;
@@ -107,12 +101,9 @@ void Forest::migrate_fields(const std::vector<p4est_gloidx_t>& before,
   for (std::size_t blk = 0; blk < new_blocks; ++blk) {
     const double* in = receive.data() + blk * per_block;
     for (BlockField* f : fields) {
-      const int b = f->cells();
-      const BlockLayout& L = f->layout();
-      double* out = f->block(static_cast<int>(blk));
-      for (int k = 0; k < b; ++k)
-        for (int j = 0; j < b; ++j)
-          for (int i = 0; i < b; ++i) out[L.index(i, j, k)] = *in++;
+      const std::ptrdiff_t size = f->layout().size();
+      std::copy(in, in + size, f->block(static_cast<int>(blk)));
+      in += size;
     }
   }
 }

@@ -147,9 +147,10 @@ class Forest {
   [[nodiscard]] std::int64_t first_global_block() const { return first_global_block_; }
 
   /// Repartitions the blocks evenly over the ranks (a no-op on uniform
-  /// forests built here) and moves the interiors of `fields` (BlockFields of
-  /// any layout, one entry per local block, e.g. also FaceField components)
-  /// with them by p8est_transfer_fixed; ghosts are left for the next exchange.
+  /// forests built here) and moves `fields` (BlockFields of any layout, one
+  /// entry per local block, e.g. also FaceField components) with them by
+  /// p8est_transfer_fixed: each block's whole storage, ghosts included (so a
+  /// face field keeps its slot b; cell ghosts are stale until the next exchange).
   void partition(std::span<BlockField* const> fields = {});
 
   /// Refines and coarsens blocks by `flags` (one per local block), restores
@@ -160,13 +161,19 @@ class Forest {
   /// parent's cell plus minmod-limited slopes (second order, exact for linear
   /// fields). The fields' ghosts are filled by an exchange (and, for cells on
   /// the domain boundary, one-sided slopes are used) before refining, and are
-  /// left unfilled after. Refinement beyond `max_level` is ignored.
-  /// Returns whether any block changed (on any rank).
+  /// left unfilled after. `face_fields` (faces 0..b of every block valid,
+  /// slot b included) are carried so that fluxes and divergence are kept: a
+  /// parent face is the mean of its 4 child faces, a child face on a parent
+  /// face takes that face's value and a child face inside a parent cell the
+  /// mean of the parent's two faces along its normal (exact for components
+  /// linear along their own direction; constant across). Refinement beyond
+  /// `max_level` is ignored. Returns whether any block changed (on any rank).
   bool adapt(std::span<const AdaptFlag> flags, std::span<BlockField* const> fields,
-             int max_level = 18);
+             std::span<FaceField* const> face_fields = {}, int max_level = 18);
   /// The same with the flag of every block given by a callback.
   bool adapt(const std::function<AdaptFlag(const Block&)>& decide,
-             std::span<BlockField* const> fields, int max_level = 18);
+             std::span<BlockField* const> fields, std::span<FaceField* const> face_fields = {},
+             int max_level = 18);
 
  private:
   void build_blocks();

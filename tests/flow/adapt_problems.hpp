@@ -41,6 +41,47 @@ void fill_cells(const Forest& forest, BlockField& field, F&& f) {
   }
 }
 
+/// Component d of a face field set to f_d at the face centres (faces 0..b along d).
+template <typename F>
+void fill_faces(const Forest& forest, FaceField& uf, F&& f) {
+  const int b = uf[0].cells();
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    const Block& block = forest.block(blk);
+    const double h = block.length / b;
+    for (int d = 0; d < 3; ++d) {
+      std::array<int, 3> end{b, b, b};
+      end[static_cast<std::size_t>(d)] = b + 1;
+      for (int k = 0; k < end[2]; ++k)
+        for (int j = 0; j < end[1]; ++j)
+          for (int i = 0; i < end[0]; ++i) {
+            Vec3 x{block.lower.x + (i + 0.5) * h, block.lower.y + (j + 0.5) * h,
+                   block.lower.z + (k + 0.5) * h};
+            x[d] -= 0.5 * h;
+            uf[static_cast<std::size_t>(d)](blk, i, j, k) = f(x)[d];
+          }
+    }
+  }
+}
+
+/// Largest |face - f_d(face centre)| over the faces 0..b of every block (all ranks).
+template <typename F>
+double face_error(const Forest& forest, const FaceField& uf, F&& f) {
+  FaceField expected = make_vector_field(forest.local_blocks(), uf[0].cells());
+  fill_faces(forest, expected, f);
+  const int b = uf[0].cells();
+  double error = 0.0;
+  for (int blk = 0; blk < forest.local_blocks(); ++blk)
+    for (std::size_t d = 0; d < 3; ++d) {
+      std::array<int, 3> end{b, b, b};
+      end[d] = b + 1;
+      for (int k = 0; k < end[2]; ++k)
+        for (int j = 0; j < end[1]; ++j)
+          for (int i = 0; i < end[0]; ++i)
+            error = std::max(error, std::abs(uf[d](blk, i, j, k) - expected[d](blk, i, j, k)));
+    }
+  return forest.max(error);
+}
+
 /// Largest |ghost - f(ghost centre)| over the ghost cells, `width` deep, of
 /// the neighbour regions whose level relation is `jump` (all ranks).
 template <typename F>

@@ -159,10 +159,24 @@ int check_adaptive_ghosts() {
   BlockField carried(forest.local_blocks(), 4);
   testing::fill_cells(forest, carried, linear);
   BlockField* fields[] = {&carried};
+  auto normal_linear = [](const sanguis::Vec3& x) {
+    return sanguis::Vec3{1.0 + x.x, 2.0 * x.y, -3.0 * x.z};
+  };
+  FaceField faces = make_vector_field(forest.local_blocks(), 4);
+  testing::fill_faces(forest, faces, normal_linear);
+  FaceField* face_fields[] = {&faces};
   // The refined octant lies on rank 0 (the first 4 blocks in p8est order):
   // 11 blocks there and 4 on rank 1 until the repartition moves some over.
   const int before = forest.local_blocks();
-  testing::refine_where(forest, testing::in_refined_octant, fields);
+  forest.adapt(
+      [](const Block& block) {
+        return testing::in_refined_octant(testing::block_centre(block)) ? AdaptFlag::Refine
+                                                                        : AdaptFlag::Keep;
+      },
+      fields, face_fields);
+  // Face components linear along their own direction come through exactly,
+  // slot b (the upper faces, in the ghost layer) included.
+  const double moved_faces = testing::face_error(forest, faces, normal_linear);
   const double ranks_receiving = forest.sum(forest.local_blocks() > before + 3 ? 1.0 : 0.0);
   BlockField expected(forest.local_blocks(), 4);
   testing::fill_cells(forest, expected, linear);
@@ -191,14 +205,14 @@ int check_adaptive_ghosts() {
   if (session.rank() == 0) {
     std::printf(
         "adaptive forest (%lld blocks, %g remote coarse-fine links, %g rank(s) received blocks "
-        "from another): linear field after adapt %.3e, in the ghosts %.3e; quadratic in fine "
-        "ghosts %.3e\n",
-        static_cast<long long>(forest.global_blocks()), remote, ranks_receiving, moved, ghosts,
-        quadratic_ghosts);
+        "from another): linear field after adapt %.3e, face field %.3e, in the ghosts %.3e; "
+        "quadratic in fine ghosts %.3e\n",
+        static_cast<long long>(forest.global_blocks()), remote, ranks_receiving, moved, moved_faces,
+        ghosts, quadratic_ghosts);
   }
   // Values of order 1-5: round-off only; on 2 ranks coarse-fine links must
   // cross ranks and the repartition must have moved field data.
-  return moved <= 1e-13 && ghosts <= 1e-13 && quadratic_ghosts <= 1e-13 &&
+  return moved <= 1e-13 && moved_faces <= 1e-13 && ghosts <= 1e-13 && quadratic_ghosts <= 1e-13 &&
                  (session.size() == 1 || (remote > 0.0 && ranks_receiving > 0.0))
              ? 0
              : 1;
