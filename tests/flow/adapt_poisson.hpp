@@ -51,12 +51,13 @@ double interface_error(const Forest& forest, const BlockField& field, F&& f) {
 inline RefinedPoissonResult solve_refined_manufactured(bool periodic, int level,
                                                        MPI_Comm comm = MPI_COMM_WORLD,
                                                        double tolerance = 1e-10,
-                                                       int max_cycles = 50) {
+                                                       int max_cycles = 50, int threads = 1) {
   ForestSpec spec;
   spec.periodic = {periodic, periodic, periodic};
   spec.block_cells = 8;
   spec.level = level;
   spec.comm = comm;
+  spec.threads = threads;
   Forest forest(spec);
   refine_where(forest, in_refined_octant);
   ScalarBoundary bc;

@@ -58,5 +58,15 @@ TEST(AdaptPoisson, DirichletSecondOrderAcrossCoarseFineFaces) {
   expect_second_order_and_fast(coarse, fine);
 }
 
+TEST(AdaptPoisson, TwoThreadsGiveTheOneThreadAnswerBitForBit) {
+  // Blocks relax independently within a colour (ghosts are filled before),
+  // so the thread count must not change a single bit.
+  const auto one = solve_refined_manufactured(true, 1, MPI_COMM_WORLD, 1e-10, 50, 1);
+  const auto two = solve_refined_manufactured(true, 1, MPI_COMM_WORLD, 1e-10, 50, 2);
+  ASSERT_EQ(one.solution.raw().size(), two.solution.raw().size());
+  EXPECT_EQ(one.solution.raw(), two.solution.raw());
+  EXPECT_EQ(one.report.cycles, two.report.cycles);
+}
+
 }  // namespace
 }  // namespace sanguis::flow
