@@ -59,6 +59,11 @@ Forest::~Forest() = default;
 
 void Forest::partition(std::span<BlockField* const> fields) {
   p8est_t* forest = p4est_->forest.get();
+  for (const BlockField* f : fields) {
+    if (f->blocks() != forest->local_num_quadrants) {
+      throw std::invalid_argument("forest: partition: a field does not match the block list");
+    }
+  }
   const std::vector<p4est_gloidx_t> before(forest->global_first_quadrant,
                                            forest->global_first_quadrant + ranks_ + 1);
   // Families kept on one rank, so that a later adapt() may coarsen them.
