@@ -1,6 +1,7 @@
 #include "flow/forest.hpp"
 
 #include <p8est.h>
+#include <p8est_communication.h>
 #include <p8est_extended.h>
 #include <p8est_ghost.h>
 
@@ -9,25 +10,11 @@
 #include <string>
 #include <unordered_map>
 
+#include "flow/coarse_fine.hpp"
+#include "flow/forest_p4est.hpp"
 #include "flow/mpi_session.hpp"
 
 namespace sanguis::flow {
-
-struct Forest::P4estObjects {
-  struct ConnectivityDeleter {
-    void operator()(p8est_connectivity_t* c) const { p8est_connectivity_destroy(c); }
-  };
-  struct ForestDeleter {
-    void operator()(p8est_t* p) const { p8est_destroy(p); }
-  };
-  struct GhostDeleter {
-    void operator()(p8est_ghost_t* g) const { p8est_ghost_destroy(g); }
-  };
-  // Declared in creation order: destroyed ghost first, connectivity last.
-  std::unique_ptr<p8est_connectivity_t, ConnectivityDeleter> connectivity;
-  std::unique_ptr<p8est_t, ForestDeleter> forest;
-  std::unique_ptr<p8est_ghost_t, GhostDeleter> ghost;
-};
 
 namespace {
 
@@ -50,23 +37,6 @@ void check_spec(const ForestSpec& s) {
   }
 }
 
-/// Integer position of tree t in the brick (its lowest vertex).
-std::array<std::int64_t, 3> tree_position(const p8est_connectivity_t& conn, p4est_topidx_t t) {
-  const p4est_topidx_t v = conn.tree_to_vertex[P8EST_CHILDREN * t];
-  std::array<std::int64_t, 3> pos{};
-  for (int d = 0; d < 3; ++d) {
-    pos[static_cast<std::size_t>(d)] = static_cast<std::int64_t>(conn.vertices[3 * v + d] + 0.5);
-  }
-  return pos;
-}
-
-std::array<std::int64_t, 3> block_coord(const std::array<std::int64_t, 3>& tree_pos,
-                                        const p8est_quadrant_t& q) {
-  const int shift = P8EST_MAXLEVEL - q.level;
-  return {(tree_pos[0] << q.level) + (q.x >> shift), (tree_pos[1] << q.level) + (q.y >> shift),
-          (tree_pos[2] << q.level) + (q.z >> shift)};
-}
-
 }  // namespace
 
 Forest::Forest(const ForestSpec& spec) : spec_(spec), p4est_(std::make_unique<P4estObjects>()) {
@@ -81,16 +51,66 @@ Forest::Forest(const ForestSpec& spec) : spec_(spec), p4est_(std::make_unique<P4
   // Uniform refinement to `level`, already partitioned evenly.
   p4est_->forest.reset(
       p8est_new_ext(comm_, p4est_->connectivity.get(), 0, spec_.level, 1, 0, nullptr, nullptr));
-  partition();
+  p8est_partition(p4est_->forest.get(), 0, nullptr);
+  rebuild_tables();
 }
 
 Forest::~Forest() = default;
 
-void Forest::partition() {
-  p8est_partition(p4est_->forest.get(), 0, nullptr);
+void Forest::partition(std::span<BlockField* const> fields) {
+  p8est_t* forest = p4est_->forest.get();
+  for (const BlockField* f : fields) {
+    if (f->blocks() != forest->local_num_quadrants) {
+      throw std::invalid_argument("forest: partition: a field does not match the block list");
+    }
+  }
+  const std::vector<p4est_gloidx_t> before(forest->global_first_quadrant,
+                                           forest->global_first_quadrant + ranks_ + 1);
+  // Families kept on one rank, so that a later adapt() may coarsen them.
+  p8est_partition(forest, 1, nullptr);
+  const bool moved = !std::equal(before.begin(), before.end(), forest->global_first_quadrant);
+  if (moved && !fields.empty()) migrate_fields(before, fields);
+  rebuild_tables();
+}
+
+void Forest::rebuild_tables() {
   p4est_->ghost.reset(p8est_ghost_new(p4est_->forest.get(), P8EST_CONNECT_FULL));
   build_blocks();
+  build_ghost_tables();
   build_neighbours();
+}
+
+void Forest::migrate_fields(const std::vector<std::int64_t>& before,
+                            std::span<BlockField* const> fields) {
+  // One fixed-size record per block: the whole storage of all fields in turn.
+  std::size_t per_block = 0;
+  for (const BlockField* f : fields) per_block += static_cast<std::size_t>(f->layout().size());
+  const auto old_blocks = static_cast<std::size_t>(before[static_cast<std::size_t>(rank_) + 1] -
+                                                   before[static_cast<std::size_t>(rank_)]);
+  const p8est_t* forest = p4est_->forest.get();
+  const auto new_blocks = static_cast<std::size_t>(forest->local_num_quadrants);
+  std::vector<double> send(old_blocks * per_block), receive(new_blocks * per_block);
+  for (std::size_t blk = 0; blk < old_blocks; ++blk) {
+    double* out = send.data() + blk * per_block;
+    for (const BlockField* f : fields) {
+      const double* in = f->block(static_cast<int>(blk));
+      out = std::copy(in, in + f->layout().size(), out);
+    }
+  }
+  constexpr int kTransferTag = 0x5a17;
+  p8est_transfer_fixed(forest->global_first_quadrant, before.data(), comm_, kTransferTag,
+                       receive.data(), send.data(), per_block * sizeof(double));
+  for (BlockField* f : fields) {
+    *f = BlockField(static_cast<int>(new_blocks), f->cells(), f->layout().ghost);
+  }
+  for (std::size_t blk = 0; blk < new_blocks; ++blk) {
+    const double* in = receive.data() + blk * per_block;
+    for (BlockField* f : fields) {
+      const std::ptrdiff_t size = f->layout().size();
+      std::copy(in, in + size, f->block(static_cast<int>(blk)));
+      in += size;
+    }
+  }
 }
 
 std::array<std::int64_t, 3> Forest::blocks_per_direction(int level) const {
@@ -128,6 +148,21 @@ void Forest::build_blocks() {
     }
   }
   global_blocks_ = forest.global_num_quadrants;
+  first_global_block_ = forest.global_first_quadrant[rank_];
+  int lo = P8EST_QMAXLEVEL, hi = 0;
+  for (const Block& block : blocks_) {
+    lo = std::min(lo, block.level);
+    hi = std::max(hi, block.level);
+  }
+  MPI_Allreduce(&lo, &min_level_, 1, MPI_INT, MPI_MIN, comm_);
+  MPI_Allreduce(&hi, &max_level_, 1, MPI_INT, MPI_MAX, comm_);
+}
+
+std::uint64_t Forest::block_key(int level, const std::array<std::int64_t, 3>& c) const {
+  return flow::block_key(spec_.trees, level, c);
+}
+
+void Forest::build_ghost_tables() {
   const p8est_ghost_t& ghost = *p4est_->ghost;
   remote_blocks_ = static_cast<std::int64_t>(ghost.ghosts.elem_count);
   mirror_blocks_.resize(ghost.mirrors.elem_count);
@@ -140,23 +175,23 @@ void Forest::build_blocks() {
 
 void Forest::build_neighbours() {
   // Blocks of this rank and of the ghost layer by (level, coordinates).
-  auto key = [this](int level, const std::array<std::int64_t, 3>& c) {
-    const auto n = blocks_per_direction(level);
-    return (static_cast<std::uint64_t>(level) << 58) |
-           static_cast<std::uint64_t>((c[2] * n[1] + c[1]) * n[0] + c[0]);
-  };
-  std::unordered_map<std::uint64_t, Neighbour> known;
+  std::unordered_map<std::uint64_t, BlockRef> known;
   known.reserve(blocks_.size() + static_cast<std::size_t>(remote_blocks_));
   for (std::size_t b = 0; b < blocks_.size(); ++b) {
-    known[key(blocks_[b].level, blocks_[b].coord)] = {Link::Local, static_cast<std::int32_t>(b)};
+    known[block_key(blocks_[b].level, blocks_[b].coord)] = {Link::Local,
+                                                            static_cast<std::int32_t>(b)};
   }
   const p8est_ghost_t& ghost = *p4est_->ghost;
   for (std::size_t g = 0; g < ghost.ghosts.elem_count; ++g) {
     const auto* q = static_cast<const p8est_quadrant_t*>(
         sc_array_index(const_cast<sc_array_t*>(&ghost.ghosts), g));
     const auto pos = tree_position(*p4est_->connectivity, q->p.piggy3.which_tree);
-    known[key(q->level, block_coord(pos, *q))] = {Link::Remote, static_cast<std::int32_t>(g)};
+    known[block_key(q->level, block_coord(pos, *q))] = {Link::Remote, static_cast<std::int32_t>(g)};
   }
+  auto find = [&](int level, const std::array<std::int64_t, 3>& c) -> const BlockRef* {
+    const auto found = known.find(block_key(level, c));
+    return found == known.end() ? nullptr : &found->second;
+  };
   for (Block& block : blocks_) {
     const auto n = blocks_per_direction(block.level);
     for (int oz = -1; oz <= 1; ++oz) {
@@ -177,16 +212,43 @@ void Forest::build_neighbours() {
             }
           }
           Neighbour& nb = block.neighbours[static_cast<std::size_t>(neighbour_slot(ox, oy, oz))];
-          if (outside) {
-            nb = {Link::Boundary, -1};
+          nb = Neighbour{};
+          if (outside) continue;
+          if (const BlockRef* same = find(block.level, c)) {
+            nb.link = same->link;
+            nb.index = same->index;
             continue;
           }
-          const auto found = known.find(key(block.level, c));
-          if (found == known.end()) {
-            // Neighbours at another level come with adaptivity (issue #7).
-            throw std::logic_error("forest: a neighbour block is not at the same level");
+          if (block.level > 0) {
+            if (const BlockRef* parent = find(block.level - 1, {c[0] >> 1, c[1] >> 1, c[2] >> 1})) {
+              nb.link = parent->link;
+              nb.index = parent->index;
+              nb.jump = LevelJump::Coarser;
+              continue;
+            }
           }
-          nb = found->second;
+          // Finer: the children touching this block (child bit 1 on the low
+          // side of an offset -1, 0 on the high side of +1, both along 0).
+          nb.jump = LevelJump::Finer;
+          for (int child = 0; child < 8; ++child) {
+            std::array<std::int64_t, 3> cc{};
+            bool touching = true;
+            for (std::size_t d = 0; d < 3; ++d) {
+              const int bit = (child >> d) & 1;
+              touching = touching && (o[d] == 0 || bit == (o[d] < 0 ? 1 : 0));
+              cc[d] = 2 * c[d] + bit;
+            }
+            if (!touching) continue;
+            const BlockRef* fine = find(block.level + 1, cc);
+            if (fine == nullptr) {
+              throw std::logic_error("forest: neighbours differ by more than one level (2:1)");
+            }
+            nb.children[static_cast<std::size_t>(child)] = *fine;
+            if (nb.index < 0) {
+              nb.link = fine->link;
+              nb.index = fine->index;
+            }
+          }
         }
       }
     }
@@ -204,6 +266,67 @@ Range ghost_range(int o, int b, int width) {
   if (o < 0) return {-width, 0, b};
   if (o > 0) return {b, b + width, -b};
   return {0, b, 0};
+}
+
+/// Ghosts of a fine block in the region towards offset o from the coarser
+/// neighbour there: quadratic interpolation of its interior. The region's
+/// cells, shifted by r.shift, count from the lower corner of the same-level
+/// block at coord + o, which is child ((coord + o) & 1) of the coarse block.
+void fill_from_coarser(const Block& block, const std::array<int, 3>& o,
+                       const std::array<Range, 3>& r, const CellReader& coarse, BlockField& field,
+                       int blk) {
+  const int b = field.cells();
+  std::array<int, 3> child_offset{};
+  for (std::size_t d = 0; d < 3; ++d) {
+    child_offset[d] = static_cast<int>((block.coord[d] + o[d]) & 1) * b;
+  }
+  double* dst = field.block(blk);
+  const BlockLayout& L = field.layout();
+  for (int k = r[2].begin; k < r[2].end; ++k)
+    for (int j = r[1].begin; j < r[1].end; ++j)
+      for (int i = r[0].begin; i < r[0].end; ++i) {
+        const std::array<int, 3> fine{child_offset[0] + i + r[0].shift,
+                                      child_offset[1] + j + r[1].shift,
+                                      child_offset[2] + k + r[2].shift};
+        dst[L.index(i, j, k)] = interpolate_from_coarse(coarse, b, fine);
+      }
+}
+
+/// Ghosts of a coarse block in the region towards offset o from the finer
+/// children there: the mean of the 8 fine cells of each ghost cell. Fine
+/// cells that would lie in a child not touching the block (ghosts deeper
+/// than b/2 cells, i.e. blocks of 1 cell on the coarsest multigrid level)
+/// are clamped to the touching child's last layer.
+void fill_from_finer(const std::array<int, 3>& o, const std::array<Range, 3>& r,
+                     const std::array<CellReader, 8>& children, BlockField& field, int blk) {
+  const int b = field.cells();
+  double* dst = field.block(blk);
+  const BlockLayout& L = field.layout();
+  auto clamp_fine = [b](int fine, int offset) {
+    if (offset > 0) return std::min(fine, b - 1);  // touching children: bit 0
+    if (offset < 0) return std::max(fine, b);      // touching children: bit 1
+    return fine;
+  };
+  for (int k = r[2].begin; k < r[2].end; ++k)
+    for (int j = r[1].begin; j < r[1].end; ++j)
+      for (int i = r[0].begin; i < r[0].end; ++i) {
+        const std::array<int, 3> cell{i + r[0].shift, j + r[1].shift, k + r[2].shift};
+        double sum = 0.0;
+        for (int dk = 0; dk < 2; ++dk)
+          for (int dj = 0; dj < 2; ++dj)
+            for (int di = 0; di < 2; ++di) {
+              const std::array<int, 3> delta{di, dj, dk};
+              std::array<int, 3> fine{};
+              int child = 0;
+              for (std::size_t d = 0; d < 3; ++d) {
+                fine[d] = clamp_fine(2 * cell[d] + delta[d], o[d]);
+                child |= (fine[d] >= b ? 1 : 0) << d;
+                fine[d] -= fine[d] >= b ? b : 0;
+              }
+              sum += children[static_cast<std::size_t>(child)](fine[0], fine[1], fine[2]);
+            }
+        dst[L.index(i, j, k)] = sum / 8.0;
+      }
 }
 
 }  // namespace
@@ -250,6 +373,31 @@ void Forest::exchange(std::span<BlockField* const> fields, int width, bool faces
           if (nb.link == Link::Boundary) continue;
           const Range rx = ghost_range(ox, b, width), ry = ghost_range(oy, b, width),
                       rz = ghost_range(oz, b, width);
+          if (nb.jump != LevelJump::Same) {
+            const std::array<Range, 3> r{rx, ry, rz};
+            const std::array<int, 3> o{ox, oy, oz};
+            for (std::size_t f = 0; f < nf; ++f) {
+              auto reader = [&](const BlockRef& ref) {
+                if (ref.link == Link::Local) {
+                  return CellReader{fields[f]->block(ref.index) + layout.index(0, 0, 0),
+                                    {1, layout.stride(1), layout.stride(2)}};
+                }
+                return CellReader{
+                    remote.data() + static_cast<std::size_t>(ref.index) * per_block + f * packed,
+                    {1, b, std::ptrdiff_t{b} * b}};
+              };
+              if (nb.jump == LevelJump::Coarser) {
+                fill_from_coarser(block, o, r, reader({nb.link, nb.index}), *fields[f], blk);
+              } else {
+                std::array<CellReader, 8> children{};
+                for (std::size_t c = 0; c < 8; ++c) {
+                  if (nb.children[c].link != Link::Boundary) children[c] = reader(nb.children[c]);
+                }
+                fill_from_finer(o, r, children, *fields[f], blk);
+              }
+            }
+            continue;
+          }
           for (std::size_t f = 0; f < nf; ++f) {
             double* dst = fields[f]->block(blk);
             if (nb.link == Link::Local) {

@@ -10,12 +10,19 @@
 // copies neighbour interiors into the ghost layers, within one rank and
 // across ranks (p8est_ghost_exchange_custom over the mirror blocks).
 //
-// Adaptivity (issue #7) will add neighbours one level coarser or finer: the
-// neighbour table and the exchange are written per block pair so that
-// coarse-fine interpolation slots in at `Link`, not in the callers.
+// Adaptivity (issue #7, first milestone): blocks may differ by one level
+// across faces, edges and corners (p8est 2:1 balance, P8EST_CONNECT_FULL).
+// A neighbour is then one level coarser (its parent region is a leaf) or
+// finer (the children of the same-level region that touch the block are
+// leaves); `Neighbour::jump` says which. The exchange fills ghosts of a fine
+// block from a coarser neighbour by quadratic interpolation of the coarse
+// interior and ghosts of a coarse block by averaging the 8 fine cells that
+// make up each ghost cell (coarse_fine.hpp). `adapt()` refines and coarsens
+// blocks and carries field data along; `partition()` moves field data.
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <span>
 #include <vector>
@@ -46,9 +53,35 @@ enum class Link : std::uint8_t {
   Boundary,  ///< outside a non-periodic domain face
 };
 
+/// Level of a neighbour relative to the block (2:1 balance: at most one apart).
+enum class LevelJump : std::int8_t {
+  Coarser = -1,  ///< the neighbour is the parent of the same-level region
+  Same = 0,      ///< the neighbour is the same-level region itself
+  Finer = 1,     ///< the same-level region is split; its children touching the block are leaves
+};
+
+/// Where one block lives: this rank's block list or the ghost layer.
+struct BlockRef {
+  Link link = Link::Boundary;
+  std::int32_t index = -1;
+};
+
 struct Neighbour {
   Link link = Link::Boundary;  ///< where the neighbour lives
   std::int32_t index = -1;     ///< local or ghost-layer number, -1 for Boundary
+  LevelJump jump = LevelJump::Same;
+  /// Finer neighbours: the 8 children of the same-level region at this
+  /// offset, by child number cx + 2 cy + 4 cz; only the children that touch
+  /// the block are set (4 across a face, 2 across an edge, 1 across a
+  /// corner), the others stay Boundary. link/index above name the first set one.
+  std::array<BlockRef, 8> children{};
+};
+
+/// Per-block request to `Forest::adapt`.
+enum class AdaptFlag : std::int8_t {
+  Coarsen = -1,  ///< merge with its 7 siblings (only when all 8 ask and sit on one rank)
+  Keep = 0,
+  Refine = 1,  ///< split into 8 children
 };
 
 /// Offset number of neighbour (ox,oy,oz), each in {-1,0,1}.
@@ -106,13 +139,50 @@ class Forest {
   [[nodiscard]] double sum(double local) const;
   [[nodiscard]] double max(double local) const;
 
+  /// Coarsest and finest level of any block (over all ranks).
+  [[nodiscard]] int min_level() const { return min_level_; }
+  [[nodiscard]] int max_level() const { return max_level_; }
+  [[nodiscard]] bool uniform() const { return min_level_ == max_level_; }
+  /// Global number (p8est order over all ranks) of this rank's first block.
+  [[nodiscard]] std::int64_t first_global_block() const { return first_global_block_; }
+
   /// Repartitions the blocks evenly over the ranks (a no-op on uniform
-  /// forests built here; fields are not migrated yet - issue #7).
-  void partition();
+  /// forests built here) and moves `fields` (BlockFields of any layout, one
+  /// entry per local block, e.g. also FaceField components) with them by
+  /// p8est_transfer_fixed: each block's whole storage, ghosts included (so a
+  /// face field keeps its slot b; cell ghosts are stale until the next exchange).
+  void partition(std::span<BlockField* const> fields = {});
+
+  /// Refines and coarsens blocks by `flags` (one per local block), restores
+  /// the 2:1 balance across faces, edges and corners (which may refine more
+  /// blocks, and undoes coarsenings that would break it), repartitions, and
+  /// carries the cell-centred `fields` along (see adapt.cpp): a new parent
+  /// gets the volume average of its children's cells, a new child the
+  /// parent's cell plus minmod-limited slopes (second order, exact for linear
+  /// fields). The fields' ghosts are filled by an exchange (and, for cells on
+  /// the domain boundary, one-sided slopes are used) before refining, and are
+  /// left unfilled after. `face_fields` (faces 0..b of every block valid,
+  /// slot b included) are carried so that fluxes and divergence are kept: a
+  /// parent face is the mean of its 4 child faces, a child face on a parent
+  /// face takes that face's value and a child face inside a parent cell the
+  /// mean of the parent's two faces along its normal (exact for components
+  /// linear along their own direction; constant across). Refinement beyond
+  /// `max_level` is ignored. Returns whether any block changed (on any rank).
+  bool adapt(std::span<const AdaptFlag> flags, std::span<BlockField* const> fields,
+             std::span<FaceField* const> face_fields = {}, int max_level = 18);
+  /// The same with the flag of every block given by a callback.
+  bool adapt(const std::function<AdaptFlag(const Block&)>& decide,
+             std::span<BlockField* const> fields, std::span<FaceField* const> face_fields = {},
+             int max_level = 18);
 
  private:
   void build_blocks();
+  void build_ghost_tables();
   void build_neighbours();
+  void rebuild_tables();  ///< ghost layer, block list, mirrors, neighbours
+  void migrate_fields(const std::vector<std::int64_t>& before, std::span<BlockField* const> fields);
+  /// Key of the block at (level, coord) for the neighbour and matching maps.
+  [[nodiscard]] std::uint64_t block_key(int level, const std::array<std::int64_t, 3>& c) const;
 
   struct P4estObjects;  ///< connectivity, forest and ghost layer (forest.cpp)
 
@@ -125,6 +195,9 @@ class Forest {
   std::vector<std::int32_t> mirror_blocks_;  ///< local block number of each mirror
   std::int64_t global_blocks_ = 0;
   std::int64_t remote_blocks_ = 0;  ///< blocks in the ghost layer
+  std::int64_t first_global_block_ = 0;
+  int min_level_ = 0;
+  int max_level_ = 0;
 };
 
 template <typename Body>

@@ -19,6 +19,21 @@
 // inactive: they keep their value, and the prolongation interpolates from
 // active coarse cells only (renormalised weights), so that masked walls act
 // as Neumann boundaries on every level.
+//
+// Composite grids (blocks at several levels, issue #7): every in-block level
+// is itself a composite grid with the same 2:1 structure, so the V-cycle is
+// unchanged: Forest::exchange fills fine ghosts from coarser blocks by
+// quadratic interpolation and coarse ghosts from finer blocks by averaging.
+// The operator is made conservative (flux matching): at a coarse-fine face
+// the coarse cell's flux is the mean of the 4 fine fluxes computed on the
+// fine side. match_fluxes() writes it into the coarse ghost (the value that
+// gives that flux through the coarse stencil), so the residual needs no
+// special case, and the smoother holds the matched flux fixed while it
+// relaxes the coarse cell (lagged, like the fine ghosts interpolated from the
+// coarse cells). The bottom level (one cell per block) is the graph of leaves,
+// gathered on every rank and solved by CG with a two-point flux between
+// blocks of different size (distance 1.5 h_fine). A forest that adapts needs
+// a new Multigrid.
 
 #include <array>
 #include <vector>
@@ -80,9 +95,13 @@ class Multigrid {
     BlockField x, rhs, res, alpha;
     FaceField beta;
     BlockField active;  ///< 1 where the cell takes part (some open face or alpha > 0), else 0
+    std::array<BlockField, 6> face_flux;  ///< composite grids: fine-side fluxes by face
   };
-  void fill_ghosts(int level, BlockField& x, const ScalarBoundary* bc,
-                   bool faces_only = false) const;
+  /// Ghosts from the neighbours (Forest::exchange) and the boundary; on
+  /// composite grids, coarse ghosts at coarse-fine faces then carry the
+  /// matched fluxes (unless `match` is false: plain restricted values).
+  void fill_ghosts(int level, BlockField& x, const ScalarBoundary* bc, bool faces_only = false,
+                   bool match = true);
   void smooth(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc,
               int sweeps);
   void compute_residual(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc,
@@ -90,6 +109,11 @@ class Multigrid {
   void vcycle(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc);
   void coarse_solve();
   void build_coarse_operator();
+  void build_composite_operator();  ///< the bottom level of a non-uniform forest
+  void composite_solve();
+  /// Coarse ghosts at coarse-fine faces such that the coarse flux equals the
+  /// mean of the fine fluxes across that face.
+  void match_fluxes(int level, BlockField& x);
   double rms(const BlockField& f) const;
   double mean(const BlockField& f) const;  ///< over the active cells of the finest level
   void compute_activity();
@@ -99,6 +123,15 @@ class Multigrid {
   bool has_alpha_ = false;
   bool singular_ = false;
   std::vector<Level> levels_;  ///< 0 finest (b = B), last one cell per block
+  bool composite_ = false;     ///< blocks at more than one level
+
+  /// The bottom level of a composite grid: one cell per leaf in global p8est
+  /// order, the volume-weighted (symmetric) operator in compressed rows.
+  struct CompositeOperator {
+    std::vector<double> volume, active, diagonal;
+    std::vector<std::int64_t> row_start, column;
+    std::vector<double> value;  ///< off-diagonal entries
+  } composite_op_;
 
   // The grid of blocks, one cell each, gathered on every rank.
   std::array<std::int64_t, 3> coarse_n_{};

@@ -1,10 +1,13 @@
 // Run under `mpirun -np 2`: the multigrid Poisson solution on the forest
 // shared by both ranks must equal the one-rank solution (MPI_COMM_SELF) to
-// round-off. Exit status 0 when it does.
+// round-off, on uniform and on statically refined forests; coarse-fine
+// ghosts across ranks and the data moved by adapt/partition must be exact
+// for linear fields. Exit status 0 when all hold.
 #include <cmath>
 #include <cstdio>
 #include <vector>
 
+#include "adapt_poisson.hpp"
 #include "flow/mpi_session.hpp"
 #include "flow/navier_stokes.hpp"
 #include "poisson_problems.hpp"
@@ -101,10 +104,125 @@ int check_navier_stokes() {
   return diff <= 1e-11 ? 0 : 1;
 }
 
+/// Every cell of every block in global block order (any levels), summed over ranks.
+std::vector<double> gathered_by_block(const Forest& forest, const BlockField& field) {
+  const int b = forest.block_cells();
+  const auto per_block = static_cast<std::size_t>(b) * b * b;
+  std::vector<double> all(static_cast<std::size_t>(forest.global_blocks()) * per_block, 0.0);
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    double* out =
+        all.data() + static_cast<std::size_t>(forest.first_global_block() + blk) * per_block;
+    for (int k = 0; k < b; ++k)
+      for (int j = 0; j < b; ++j)
+        for (int i = 0; i < b; ++i) *out++ = field(blk, i, j, k);
+  }
+  MPI_Allreduce(MPI_IN_PLACE, all.data(), static_cast<int>(all.size()), MPI_DOUBLE, MPI_SUM,
+                forest.comm());
+  return all;
+}
+
+/// Poisson on the forest with a refined octant: 2 ranks against 1.
+int check_refined(bool periodic) {
+  auto run = [&](MPI_Comm comm, std::vector<double>& values) {
+    ForestSpec spec;
+    spec.periodic = {periodic, periodic, periodic};
+    spec.level = 1;
+    spec.comm = comm;
+    Forest forest(spec);
+    testing::refine_where(forest, testing::in_refined_octant);
+    // A fixed number of cycles (tolerance 0) so both runs do the same work.
+    auto result = testing::solve_refined_manufactured(periodic, 1, comm, 0.0, 8);
+    values = gathered_by_block(forest, result.solution);
+    return result;
+  };
+  std::vector<double> shared, alone;
+  const auto r2 = run(MPI_COMM_WORLD, shared);
+  const auto r1 = run(MPI_COMM_SELF, alone);
+  double diff = 0.0;
+  for (std::size_t i = 0; i < shared.size(); ++i)
+    diff = std::max(diff, std::abs(shared[i] - alone[i]));
+  const auto& session = MpiSession::ensure();
+  if (session.rank() == 0) {
+    std::printf("refined octant, %s: %d ranks vs 1: max difference %.3e, errors %.6e / %.6e\n",
+                periodic ? "periodic" : "Dirichlet", session.size(), diff, r2.error, r1.error);
+  }
+  return diff <= 1e-11 ? 0 : 1;
+}
+
+/// Coarse-fine ghosts across ranks, and fields carried by adapt + partition.
+int check_adaptive_ghosts() {
+  auto linear = [](const sanguis::Vec3& x) { return 1.0 + 2.0 * x.x - 3.0 * x.y + 0.5 * x.z; };
+  ForestSpec spec;
+  spec.level = 1;
+  spec.block_cells = 4;
+  Forest forest(spec);
+  BlockField carried(forest.local_blocks(), 4);
+  testing::fill_cells(forest, carried, linear);
+  BlockField* fields[] = {&carried};
+  auto normal_linear = [](const sanguis::Vec3& x) {
+    return sanguis::Vec3{1.0 + x.x, 2.0 * x.y, -3.0 * x.z};
+  };
+  FaceField faces = make_vector_field(forest.local_blocks(), 4);
+  testing::fill_faces(forest, faces, normal_linear);
+  FaceField* face_fields[] = {&faces};
+  // The refined octant lies on rank 0 (the first 4 blocks in p8est order):
+  // 11 blocks there and 4 on rank 1 until the repartition moves some over.
+  const int before = forest.local_blocks();
+  forest.adapt(
+      [](const Block& block) {
+        return testing::in_refined_octant(testing::block_centre(block)) ? AdaptFlag::Refine
+                                                                        : AdaptFlag::Keep;
+      },
+      fields, face_fields);
+  // Face components linear along their own direction come through exactly,
+  // slot b (the upper faces, in the ghost layer) included.
+  const double moved_faces = testing::face_error(forest, faces, normal_linear);
+  const double ranks_receiving = forest.sum(forest.local_blocks() > before + 3 ? 1.0 : 0.0);
+  BlockField expected(forest.local_blocks(), 4);
+  testing::fill_cells(forest, expected, linear);
+  double moved = 0.0;
+  for (std::size_t n = 0; n < expected.raw().size(); ++n) {
+    moved = std::max(moved, std::abs(carried.raw()[n] - expected.raw()[n]));
+  }
+  moved = forest.max(moved);
+  forest.exchange(expected, kGhost);
+  double ghosts = 0.0;
+  for (const LevelJump jump : {LevelJump::Same, LevelJump::Coarser, LevelJump::Finer}) {
+    ghosts = std::max(ghosts, testing::ghost_error(forest, expected, linear, jump, kGhost));
+  }
+  // Fine ghosts from coarser blocks (local or remote) reproduce quadratics.
+  auto quadratic = [&](const sanguis::Vec3& x) { return linear(x) + x.x * x.x - 2.0 * x.y * x.z; };
+  testing::fill_cells(forest, expected, quadratic);
+  forest.exchange(expected, kGhost);
+  const double quadratic_ghosts =
+      testing::ghost_error(forest, expected, quadratic, LevelJump::Coarser, kGhost);
+  double remote = 0.0;
+  for (int blk = 0; blk < forest.local_blocks(); ++blk)
+    for (const Neighbour& nb : forest.block(blk).neighbours)
+      remote += nb.link == Link::Remote && nb.jump != LevelJump::Same ? 1.0 : 0.0;
+  remote = forest.sum(remote);
+  const auto& session = MpiSession::ensure();
+  if (session.rank() == 0) {
+    std::printf(
+        "adaptive forest (%lld blocks, %g remote coarse-fine links, %g rank(s) received blocks "
+        "from another): linear field after adapt %.3e, face field %.3e, in the ghosts %.3e; "
+        "quadratic in fine ghosts %.3e\n",
+        static_cast<long long>(forest.global_blocks()), remote, ranks_receiving, moved, moved_faces,
+        ghosts, quadratic_ghosts);
+  }
+  // Values of order 1-5: round-off only; on 2 ranks coarse-fine links must
+  // cross ranks and the repartition must have moved field data.
+  return moved <= 1e-13 && moved_faces <= 1e-13 && ghosts <= 1e-13 && quadratic_ghosts <= 1e-13 &&
+                 (session.size() == 1 || (remote > 0.0 && ranks_receiving > 0.0))
+             ? 0
+             : 1;
+}
+
 }  // namespace
 
 int main() {
   MpiSession::ensure();
-  const int failures = check(true) + check(false) + check_navier_stokes();
+  const int failures = check(true) + check(false) + check_navier_stokes() +
+                       check_adaptive_ghosts() + check_refined(true) + check_refined(false);
   return failures == 0 ? 0 : 1;
 }

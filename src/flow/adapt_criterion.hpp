@@ -1,0 +1,45 @@
+#pragma once
+// The wavelet refinement criterion (thesis eq. 4.11; Popinet 2015, Basilisk's
+// adapt_wavelet): the local error estimate of a field is the difference
+// between the field and its restriction-then-prolongation,
+//
+//     e = | u - P(R(u)) |,                                          (4.11)
+//
+// R the 8-cell volume average onto cells twice as large, P the second-order
+// (linear, central slopes) prolongation back. It vanishes for linear fields,
+// is O(h^3) for smooth ones (a measure of how well the next coarser grid
+// would represent u), and O(1) at fronts. A block is refined where some field
+// exceeds its threshold zeta and coarsened where every field stays below
+// 2 zeta / 3 (the hysteresis of adapt_wavelet, so that a block just coarsened
+// is not refined again at once), within [min_level, max_level]; cells tagged
+// in the "forced finest" field keep their block at max_level.
+
+#include <span>
+#include <vector>
+
+#include "flow/block_field.hpp"
+#include "flow/forest.hpp"
+
+namespace sanguis::flow {
+
+struct WaveletCriterion {
+  std::vector<double> thresholds;       ///< zeta per field (same units as the field)
+  int min_level = 0;                    ///< blocks are refined up to at least this level
+  int max_level = 18;                   ///< and never beyond this one
+  double coarsen_fraction = 2.0 / 3.0;  ///< coarsen below this fraction of zeta
+};
+
+/// The estimate (4.11) of every local block: the largest e over its cells.
+/// Fills the field's ghosts from the neighbours first (the coarse cells
+/// beside the block, for the central slopes); at domain faces the slopes
+/// are one-sided. Needs blocks of b >= 4 cells.
+std::vector<double> wavelet_estimate(const Forest& forest, BlockField& field);
+
+/// Refine/keep/coarsen flags for Forest::adapt from the estimates of
+/// `fields` (one threshold each) and an optional tag field: a block with a
+/// tag cell > 0 is refined up to max_level and never coarsened.
+std::vector<AdaptFlag> wavelet_flags(const Forest& forest, std::span<BlockField* const> fields,
+                                     const WaveletCriterion& criterion,
+                                     const BlockField* finest_tag = nullptr);
+
+}  // namespace sanguis::flow

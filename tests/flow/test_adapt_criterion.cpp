@@ -1,0 +1,126 @@
+// The wavelet refinement criterion (thesis eq. 4.11) on analytic fields:
+// zero for linear fields, the exact O(h^3) value for a cubic, flags that
+// follow a front within the level limits, and the forced-finest tag.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "adapt_problems.hpp"
+#include "flow/adapt_criterion.hpp"
+
+namespace sanguis::flow {
+namespace {
+
+using testing::block_centre;
+using testing::fill_cells;
+
+ForestSpec spec_at(int level) {
+  ForestSpec spec;
+  spec.level = level;
+  spec.block_cells = 8;
+  return spec;
+}
+
+TEST(FlowAdaptCriterion, LinearFieldsHaveNoWaveletAndCoarsenToTheMinimumLevel) {
+  const Forest forest(spec_at(2));
+  BlockField u(forest.local_blocks(), 8);
+  fill_cells(forest, u, [](const Vec3& x) { return 3.0 - x.x + 2.0 * x.y + 0.5 * x.z; });
+  for (const double e : wavelet_estimate(forest, u))
+    EXPECT_LT(e, 1e-14);  // round-off of O(1) values
+  WaveletCriterion criterion{{1e-6}, 1, 3};
+  BlockField* fields[] = {&u};
+  for (const AdaptFlag flag : wavelet_flags(forest, fields, criterion)) {
+    EXPECT_EQ(flag, AdaptFlag::Coarsen);
+  }
+  criterion.min_level = 2;
+  for (const AdaptFlag flag : wavelet_flags(forest, fields, criterion)) {
+    EXPECT_EQ(flag, AdaptFlag::Keep);
+  }
+}
+
+TEST(FlowAdaptCriterion, CubicGivesTheThirdOrderWaveletExactly) {
+  // u = x^3: R(u) = X^3 + 3 X h^2 / 4 per coarse cell (h the fine cell), the
+  // central slope over one coarse cell 6 X^2 h + 9.5 h^3, so P(R(u)) differs
+  // from u at the fine centres X +- h/2 by +-(2.375 - 0.125) h^3 = +-2.25 h^3
+  // in every cell of a block whose x-faces are not domain faces.
+  for (const int level : {2, 3}) {
+    const Forest forest(spec_at(level));
+    BlockField u(forest.local_blocks(), 8);
+    fill_cells(forest, u, [](const Vec3& x) { return x.x * x.x * x.x; });
+    const auto e = wavelet_estimate(forest, u);
+    const double h = forest.spec().tree_length / (8 << level);
+    const auto n = forest.blocks_per_direction(level);
+    for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+      const auto x = forest.block(blk).coord[0];
+      if (x == 0 || x == n[0] - 1) continue;
+      // Round-off of sums of values |u| <= 1 (about 1e-16 each) against a
+      // wavelet of 6.9e-5 (level 2) and 8.6e-6 (level 3).
+      EXPECT_NEAR(e[static_cast<std::size_t>(blk)], 2.25 * h * h * h, 1e-15);
+    }
+  }
+}
+
+double front(const Vec3& x) {
+  return std::tanh((x.x - 0.53) / 0.02);
+}
+
+TEST(FlowAdaptCriterion, FlagsFollowAFrontWithinTheLevelLimits) {
+  const Forest forest(spec_at(2));
+  BlockField u(forest.local_blocks(), 8), tag(forest.local_blocks(), 8);
+  fill_cells(forest, u, front);
+  // Tag one cell of the block at the origin: it must go to the finest level.
+  fill_cells(forest, tag, [](const Vec3& x) { return x.x < 0.03 && x.y < 0.03 && x.z < 0.03; });
+  BlockField* fields[] = {&u};
+  const WaveletCriterion criterion{{1e-3}, 1, 3};
+  const auto flags = wavelet_flags(forest, fields, criterion, &tag);
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    const Vec3 c = block_centre(forest.block(blk));
+    const AdaptFlag flag = flags[static_cast<std::size_t>(blk)];
+    if (c.x < 0.25 && c.y < 0.25 && c.z < 0.25) {
+      EXPECT_EQ(flag, AdaptFlag::Refine);  // tagged
+    } else if (std::abs(c.x - 0.625) < 0.01) {
+      EXPECT_EQ(flag, AdaptFlag::Refine);  // holds the front (x in [0.5, 0.75])
+    } else if (c.x < 0.25 || c.x > 0.75) {
+      // tanh is within 1e-5 of +-1 (e ~ 0) more than 0.2 away from the front.
+      EXPECT_EQ(flag, AdaptFlag::Coarsen);
+    }
+  }
+  // At the maximum level nothing is refined; above it, blocks coarsen.
+  const WaveletCriterion capped{{1e-3}, 0, 2};
+  for (const AdaptFlag flag : wavelet_flags(forest, fields, capped, &tag)) {
+    EXPECT_NE(flag, AdaptFlag::Refine);
+  }
+  const WaveletCriterion below{{1e-3}, 0, 1};
+  for (const AdaptFlag flag : wavelet_flags(forest, fields, below, &tag)) {
+    EXPECT_EQ(flag, AdaptFlag::Coarsen);
+  }
+}
+
+TEST(FlowAdaptCriterion, RepeatedAdaptationResolvesTheFrontAtTheFinestLevel) {
+  Forest forest(spec_at(1));
+  BlockField u(forest.local_blocks(), 8);
+  fill_cells(forest, u, front);
+  const WaveletCriterion criterion{{1e-3}, 1, 4};
+  for (int pass = 0; pass < 4; ++pass) {
+    BlockField* fields[] = {&u};
+    const auto flags = wavelet_flags(forest, fields, criterion);
+    if (!forest.adapt(flags, {})) break;
+    u = BlockField(forest.local_blocks(), 8);
+    fill_cells(forest, u, front);  // the analytic field on the new blocks
+  }
+  EXPECT_EQ(forest.max_level(), 4);
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    const Block& block = forest.block(blk);
+    const bool holds_front = block.lower.x <= 0.53 && 0.53 <= block.lower.x + block.length;
+    if (holds_front) {
+      EXPECT_EQ(block.level, 4);
+    }
+    // Far from the front (tanh flat to 1e-5), only the 2:1 grading keeps blocks fine.
+    if (block.lower.x > 0.8 || block.lower.x + block.length < 0.25) {
+      EXPECT_LE(block.level, 2);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace sanguis::flow
