@@ -104,6 +104,12 @@ std::array<BcKind, 6> pressure_kinds(const std::array<FlowBoundary, 6>& bcs) {
 
 const std::array<FlowBoundary, 6>& checked(const Forest& forest,
                                            const std::array<FlowBoundary, 6>& bcs) {
+  // The advection and projection here are written for one level: on a refined forest the
+  // coarse-fine faces would be neither conservative nor second order (issue #7).
+  if (!forest.uniform()) {
+    throw std::invalid_argument(
+        "Navier-Stokes on a forest with several refinement levels is not available yet");
+  }
   for (int d = 0; d < 3; ++d) {
     for (int side = 0; side < 2; ++side) {
       const FlowBoundary& bc = bcs[D(face_index(d, side))];
