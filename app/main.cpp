@@ -251,7 +251,9 @@ int main(int argc, char** argv) {
       const bool particles_given = particles_opt->count() > 0;
       const bool steps_given = steps_opt->count() > 0;
       if (bench_name == "dem-spheres") {
-        std::cout << bench::run_dem_spheres(bo) << std::endl;
+        if (several_mpi_processes()) bo.comm = flow::MpiSession::ensure().world();
+        const std::string line = bench::run_dem_spheres(bo);
+        if (!line.empty()) std::cout << line << std::endl;
       } else if (bench_name == "dem-crosses") {
         if (!particles_given) bo.particles = 3000;
         if (!steps_given) bo.steps = 500;

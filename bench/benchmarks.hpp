@@ -18,10 +18,15 @@ struct BenchOptions {
   std::int64_t triangles = 5120;     // membrane: triangles per capsule (20 * 4^k)
   std::int64_t capsules = 100;       // membrane: number of capsules
   std::int64_t cells_per_side = 64;  // flow-cavity: cells along each edge (multiple of 8)
+  // dem-spheres under mpirun: the processes share the system (domain decomposition).
+  MPI_Comm comm = MPI_COMM_NULL;
 };
 
 // dem-spheres: 32,000 spheres on a tilted chute, Table 2.1 contact parameters,
-// matched to LAMMPS gran/hooke/history (bench/lammps/in.dem-spheres).
+// matched to LAMMPS gran/hooke/history (bench/lammps/in.dem-spheres). On several MPI
+// processes (options.comm) it also reports the communication: bytes sent and time in
+// the exchanges per step, ghosts per process (docs/performance.md, weak-scaling model).
+// Returns an empty string on every process but the first.
 std::string run_dem_spheres(const BenchOptions& options);
 
 // dem-crosses: a column of crosses (thesis §3.2.2, Table 3.1) behind the gate of the

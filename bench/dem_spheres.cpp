@@ -2,14 +2,16 @@
 // (see bench/README.md for the definition and the parameter mapping).
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <numbers>
 #include <random>
 #include <sstream>
 #include <stdexcept>
 
 #include "benchmarks.hpp"
-#include "memory_usage.hpp"
+#include "dem/domain_decomposition.hpp"
 #include "dem/simulation.hpp"
+#include "memory_usage.hpp"
 
 namespace sanguis::bench {
 
@@ -79,24 +81,50 @@ dem::DemSetup dem_spheres_setup(const BenchOptions& o) {
 std::string run_dem_spheres(const BenchOptions& o) {
   if (o.particles <= 0 || o.steps <= 0)
     throw std::invalid_argument("particles and steps must be > 0");
+  int rank = 0, ranks = 1;
+  if (o.comm != MPI_COMM_NULL) {
+    MPI_Comm_rank(o.comm, &rank);
+    MPI_Comm_size(o.comm, &ranks);
+  }
   const std::int64_t rss_before = resident_bytes();
-  dem::DemSimulation sim(dem_spheres_setup(o));
+  std::unique_ptr<dem::SlabDecomposition> decomposition;
+  if (ranks > 1) decomposition = std::make_unique<dem::SlabDecomposition>(o.comm);
+  dem::DemSimulation sim(decomposition ? decomposition->local_setup(dem_spheres_setup(o))
+                                       : dem_spheres_setup(o));
+  if (decomposition) decomposition->attach(sim);
+  const std::int64_t bytes_before = decomposition ? decomposition->bytes_sent() : 0;
+  const double exchange_before = decomposition ? decomposition->exchange_seconds() : 0.0;
+  if (decomposition) MPI_Barrier(o.comm);
   const auto start = std::chrono::steady_clock::now();
   for (std::int64_t s = 0; s < o.steps; ++s) sim.step();
+  if (decomposition) MPI_Barrier(o.comm);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::ostringstream json;
   json.precision(6);
   json << "{\"benchmark\":\"dem-spheres\",\"code\":\"sanguis\",\"particles\":" << o.particles
-       << ",\"steps\":" << o.steps << ",\"threads\":" << o.threads << ",\"seconds\":" << seconds
-       << ",\"particle_steps_per_s\":"
+       << ",\"steps\":" << o.steps << ",\"threads\":" << o.threads << ",\"processes\":" << ranks
+       << ",\"seconds\":" << seconds << ",\"particle_steps_per_s\":"
        << static_cast<double>(o.particles) * static_cast<double>(o.steps) / seconds
-       << ",\"neighbor_rebuilds\":" << sim.neighbor_search().rebuild_count() - 1
-       << ",\"peak_rss_mb\":" << static_cast<double>(peak_resident_bytes()) / 1048576.0
+       << ",\"neighbor_rebuilds\":" << sim.neighbor_search().rebuild_count() - 1;
+  if (decomposition) {
+    // Per process per step: the largest over the processes (the slowest sets the pace).
+    double figures[3] = {
+        static_cast<double>(decomposition->bytes_sent() - bytes_before) /
+            static_cast<double>(o.steps),
+        (decomposition->exchange_seconds() - exchange_before) / static_cast<double>(o.steps),
+        static_cast<double>(decomposition->ghosts())};
+    MPI_Allreduce(MPI_IN_PLACE, figures, 3, MPI_DOUBLE, MPI_MAX, o.comm);
+    json << ",\"bytes_sent_per_step_per_process\":" << figures[0]
+         << ",\"exchange_s_per_step\":" << figures[1]
+         << ",\"exchange_fraction\":" << figures[1] * static_cast<double>(o.steps) / seconds
+         << ",\"ghosts_per_process\":" << figures[2];
+  }
+  json << ",\"peak_rss_mb\":" << static_cast<double>(peak_resident_bytes()) / 1048576.0
        << ",\"bytes_per_particle\":"
        << static_cast<double>(peak_resident_bytes() - rss_before) / static_cast<double>(o.particles)
        << "}";
-  return json.str();
+  return rank == 0 ? json.str() : std::string();
 }
 
 }  // namespace sanguis::bench

@@ -1,6 +1,7 @@
 #include "dem/domain_decomposition.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <numeric>
@@ -73,6 +74,21 @@ std::vector<std::vector<T>> all_to_all(MPI_Comm comm, const std::vector<std::vec
   }
   return out;
 }
+
+// Adds the lifetime of the timer to a total.
+class ScopedTimer {
+ public:
+  explicit ScopedTimer(double& total) : total_(total), start_(std::chrono::steady_clock::now()) {}
+  ~ScopedTimer() {
+    total_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  }
+  ScopedTimer(const ScopedTimer&) = delete;
+  ScopedTimer& operator=(const ScopedTimer&) = delete;
+
+ private:
+  double& total_;
+  std::chrono::steady_clock::time_point start_;
+};
 
 std::size_t index_of_id(const std::vector<std::int64_t>& ids, std::int64_t id) {
   const auto it = std::lower_bound(ids.begin(), ids.end(), id);
@@ -200,6 +216,7 @@ void SlabDecomposition::attach(DemSimulation& simulation) {
 }
 
 bool SlabDecomposition::any(bool local) {
+  const ScopedTimer timer(exchange_seconds_);
   int flag = local ? 1 : 0;
   MPI_Allreduce(MPI_IN_PLACE, &flag, 1, MPI_INT, MPI_LOR, comm_);
   return flag != 0;
@@ -207,6 +224,7 @@ bool SlabDecomposition::any(bool local) {
 
 void SlabDecomposition::refresh_ghosts(DemSimulation& simulation) {
   if (ranks_ == 1) return;
+  const ScopedTimer timer(exchange_seconds_);
   ParticleStore& p = simulation.particles();
   std::vector<std::vector<GhostState>> buckets(static_cast<std::size_t>(ranks_));
   for (std::size_t d = 0; d < buckets.size(); ++d) {
@@ -228,6 +246,7 @@ void SlabDecomposition::refresh_ghosts(DemSimulation& simulation) {
 }
 
 void SlabDecomposition::redistribute(DemSimulation& simulation) {
+  const ScopedTimer timer(exchange_seconds_);
   ParticleStore& p = simulation.particles();
   const std::vector<std::uint8_t>& ghost = simulation.ghost_flags();
   auto& half_v = simulation.integrator().half_velocity();

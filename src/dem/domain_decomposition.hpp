@@ -64,6 +64,9 @@ class SlabDecomposition final : public ParticleExchange {
   // Bytes sent by this process since construction (particles, contacts and ghost
   // updates), for the communication model of docs/performance.md.
   std::int64_t bytes_sent() const { return bytes_sent_; }
+  // Wall time spent in the exchanges (ghost refreshes, agreements, redistributions,
+  // waits for slower processes included) [s].
+  double exchange_seconds() const { return exchange_seconds_; }
 
   // Mid-step state of one particle in transit (trivially copyable).
   struct ParticleRecord;
@@ -89,6 +92,7 @@ class SlabDecomposition final : public ParticleExchange {
   std::vector<std::vector<std::uint32_t>> send_lists_, receive_lists_;
   std::int64_t ghost_count_ = 0;
   std::int64_t bytes_sent_ = 0;
+  double exchange_seconds_ = 0.0;
 };
 
 }  // namespace sanguis::dem
