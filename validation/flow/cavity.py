@@ -30,15 +30,13 @@ flow_cavity_re100_slice.png (the 3D mid-plane). Exits 1 if a check fails.
 Usage: /usr/bin/python3 validation/flow/cavity.py [--build build] [--fine] [--replot]
 """
 import argparse
-import base64
 import json
-import re
-import subprocess
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
+
+from _cavity_common import centre_lines, last_frame, read_vtu, run, with_walls
 
 ROOT = Path(__file__).resolve().parents[2]
 RESULTS = ROOT / "validation" / "flow" / "results"
@@ -75,66 +73,12 @@ def variant(case_text, n, two_d):
     return text
 
 
-def read_vtu(path):
-    """Cell centres and cell arrays of one of our .vtu files."""
-    xml = path.read_text()
-    arrays = {}
-    for m in re.finditer(r'<DataArray type="(\w+)" Name="(\w+)" NumberOfComponents="(\d)" format="binary">\s*(\S+)\s*</DataArray>', xml):
-        kind, name, comps, data = m.group(1), m.group(2), int(m.group(3)), m.group(4)
-        raw = base64.b64decode(data)[8:]
-        values = np.frombuffer(raw, dtype={"Float64": "<f8", "Int64": "<i8", "UInt8": "u1"}[kind])
-        arrays[name] = values.reshape(-1, comps) if comps > 1 else values
-    points = arrays["Points"]
-    cells = arrays["connectivity"].reshape(-1, 8)
-    centres = points[cells].mean(axis=1)
-    return centres, arrays
-
-
-def centre_lines(centres, velocity, two_d):
-    """u(y) on x = z = 0.5 and v(x) on y = z = 0.5, averaged over the adjacent cells."""
-    h = np.min(np.diff(np.unique(np.round(centres[:, 0], 12))))
-    zmid = 0.5 * (centres[:, 2].min() + centres[:, 2].max())
-    near_z = np.ones(len(centres), bool) if two_d else np.abs(centres[:, 2] - zmid) < 0.6 * h
-
-    def profile(along, across, component):
-        mask = near_z & (np.abs(centres[:, across] - 0.5) < 0.6 * h)
-        coords = np.round(centres[mask, along], 12)
-        keys = np.unique(coords)
-        values = np.array([velocity[mask][coords == k, component].mean() for k in keys])
-        return keys, values
-
-    y, u = profile(1, 0, 0)
-    x, v = profile(0, 1, 1)
-    return (y, u), (x, v)
-
-
-def with_walls(coord, value, lid):
-    """Adds the wall values (0 at the walls, the lid velocity at y = 1 for u)."""
-    return np.concatenate(([0.0], coord, [1.0])), np.concatenate(([0.0], value, [lid]))
-
-
-def run(sanguis, name, text):
-    case = RUNS / f"{name}.toml"
-    out = RUNS / name
-    RUNS.mkdir(parents=True, exist_ok=True)
-    case.write_text(text)
-    start = time.time()
-    subprocess.run([str(sanguis), "run", str(case), "-o", str(out), "--quiet"], check=True,
-                   stdout=subprocess.DEVNULL)
-    return time.time() - start
-
-
-def last_frame(name):
-    frames = sorted((RUNS / name / "flow").glob("flow_*.vtu"))
-    return frames[-1]
-
-
 def draw_slice(name):
     """The mid-plane z = 0.5 of a 3D run: speed and in-plane streamlines (PNG)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    centres, arrays = read_vtu(last_frame(name))
+    centres, arrays = read_vtu(last_frame(RUNS, name))
     h = np.min(np.diff(np.unique(np.round(centres[:, 0], 12))))
     n = int(round(1.0 / h))
     mask = np.abs(centres[:, 2] - 0.5) < 0.6 * h  # the two cell layers beside z = 0.5
@@ -180,11 +124,11 @@ def main():
             name = f"cavity-{'2d' if two_d else '3d'}-{n}"
             seconds = None
             if not args.replot:
-                seconds = run(sanguis, name, variant(case_text, n, two_d))
+                seconds = run(sanguis, RUNS, name, variant(case_text, n, two_d))
                 print(f"{name}: {seconds:.1f} s", flush=True)
             if seconds is None:
                 seconds = previous.get("2d" if two_d else "3d", {}).get(str(n), {}).get("wall_seconds")
-            centres, arrays = read_vtu(last_frame(name))
+            centres, arrays = read_vtu(last_frame(RUNS, name))
             (y, u), (x, v) = centre_lines(centres, arrays["velocity"], two_d)
             entry = {"y": y.tolist(), "u": u.tolist(), "x": x.tolist(), "v": v.tolist(),
                      "u_min": float(u.min()), "y_at_u_min": float(y[np.argmin(u)]),

@@ -1,0 +1,63 @@
+"""Shared by the cavity validation scripts: reading our .vtu frames, centre-line
+profiles, running variants of a case file."""
+import base64
+import re
+import subprocess
+import time
+
+import numpy as np
+
+
+def read_vtu(path):
+    """Cell centres and cell arrays of one of our .vtu files."""
+    xml = path.read_text()
+    arrays = {}
+    for m in re.finditer(r'<DataArray type="(\w+)" Name="(\w+)" NumberOfComponents="(\d)" format="binary">\s*(\S+)\s*</DataArray>', xml):
+        kind, name, comps, data = m.group(1), m.group(2), int(m.group(3)), m.group(4)
+        raw = base64.b64decode(data)[8:]
+        values = np.frombuffer(raw, dtype={"Float64": "<f8", "Int64": "<i8", "UInt8": "u1"}[kind])
+        arrays[name] = values.reshape(-1, comps) if comps > 1 else values
+    points = arrays["Points"]
+    cells = arrays["connectivity"].reshape(-1, 8)
+    centres = points[cells].mean(axis=1)
+    return centres, arrays
+
+
+def centre_lines(centres, velocity, two_d):
+    """u(y) on x = z = 0.5 and v(x) on y = z = 0.5, averaged over the adjacent cells."""
+    h = np.min(np.diff(np.unique(np.round(centres[:, 0], 12))))
+    zmid = 0.5 * (centres[:, 2].min() + centres[:, 2].max())
+    near_z = np.ones(len(centres), bool) if two_d else np.abs(centres[:, 2] - zmid) < 0.6 * h
+
+    def profile(along, across, component):
+        mask = near_z & (np.abs(centres[:, across] - 0.5) < 0.6 * h)
+        coords = np.round(centres[mask, along], 12)
+        keys = np.unique(coords)
+        values = np.array([velocity[mask][coords == k, component].mean() for k in keys])
+        return keys, values
+
+    y, u = profile(1, 0, 0)
+    x, v = profile(0, 1, 1)
+    return (y, u), (x, v)
+
+
+def with_walls(coord, value, lid):
+    """Adds the wall values (0 at the walls, the lid velocity at y = 1 for u)."""
+    return np.concatenate(([0.0], coord, [1.0])), np.concatenate(([0.0], value, [lid]))
+
+
+def run(sanguis, runs, name, text):
+    """Writes the case text under runs/ and runs it (quiet); returns the wall seconds."""
+    case = runs / f"{name}.toml"
+    out = runs / name
+    runs.mkdir(parents=True, exist_ok=True)
+    case.write_text(text)
+    start = time.time()
+    subprocess.run([str(sanguis), "run", str(case), "-o", str(out), "--quiet"], check=True,
+                   stdout=subprocess.DEVNULL)
+    return time.time() - start
+
+
+def last_frame(runs, name):
+    frames = sorted((runs / name / "flow").glob("flow_*.vtu"))
+    return frames[-1]
