@@ -531,10 +531,6 @@ RunSummary run_dem_case(const DemCase& c, const RunOptions& options, std::ostrea
   if (options.restart && !fs::exists(checkpoint)) {
     throw InputError(checkpoint.string(), "", "no checkpoint to restart from");
   }
-  if (options.restart && ranks > 1) {
-    throw InputError(checkpoint.string(), "",
-                     "restart on several MPI processes is not available yet: restart on one");
-  }
 
   // Several processes: each runs its slab of the domain (domain_decomposition.hpp).
   std::unique_ptr<SlabDecomposition> decomposition;
@@ -545,22 +541,44 @@ RunSummary run_dem_case(const DemCase& c, const RunOptions& options, std::ostrea
       throw InputError(c.source.string(), "", e.what());
     }
   }
+  // The whole system on one process, for a decomposed run's restart (on every process)
+  // and checkpoints (on the first): checkpoints are in the one-process format.
+  std::unique_ptr<DemSimulation> whole;
+  if (decomposition && options.restart) {
+    whole = std::make_unique<DemSimulation>(c.setup);
+    whole->load_checkpoint(checkpoint);
+  }
   const auto local_setup = [&]() {
     try {
-      return decomposition->local_setup(c.setup);
+      DemSetup local = decomposition->local_setup(whole ? whole->setup() : c.setup);
+      if (whole) local.start_step = whole->step_index();
+      return local;
     } catch (const std::invalid_argument& e) {
       throw InputError(c.source.string(), "", e.what());
     }
   };
   DemSimulation sim(decomposition ? local_setup() : c.setup);
-  if (decomposition) decomposition->attach(sim);
+  if (decomposition && whole) {
+    decomposition->attach_restart(sim, *whole);
+  } else if (decomposition) {
+    decomposition->attach(sim);
+  }
+  if (!root) whole.reset();
   const auto diagnostics = [&]() {
     return decomposition ? decomposition->diagnostics(sim) : sim.diagnostics();
   };
+  const auto save_checkpoint = [&]() {
+    if (!decomposition) {
+      sim.save_checkpoint(checkpoint);
+      return;
+    }
+    if (root && !whole) whole = std::make_unique<DemSimulation>(c.setup);
+    decomposition->save_checkpoint(sim, whole.get(), checkpoint);
+  };
   const double dt = sim.time_step();
-  if (options.restart) {
-    sim.load_checkpoint(checkpoint);
-    if (fs::exists(csv_path)) io::CsvWriter::truncate_after(csv_path, sim.time());
+  if (options.restart && !decomposition) sim.load_checkpoint(checkpoint);
+  if (options.restart && root && fs::exists(csv_path)) {
+    io::CsvWriter::truncate_after(csv_path, sim.time());
   }
   fs::create_directories(dir);
 
@@ -574,7 +592,7 @@ RunSummary run_dem_case(const DemCase& c, const RunOptions& options, std::ostrea
         << describe(c);
     if (decomposition) {
       log << "domain decomposition: " << ranks << " MPI processes, slabs along "
-          << "xyz"[decomposition->axis()] << "; no checkpoints on several processes yet\n";
+          << "xyz"[decomposition->axis()] << "\n";
     }
     log << std::flush;
   }
@@ -624,7 +642,7 @@ RunSummary run_dem_case(const DemCase& c, const RunOptions& options, std::ostrea
       const std::int64_t s = sim.step_index();
       const bool output_now = s % output_every == 0;
       if (output_now) record();
-      if (checkpoint_every > 0 && s % checkpoint_every == 0) sim.save_checkpoint(checkpoint);
+      if (checkpoint_every > 0 && s % checkpoint_every == 0) save_checkpoint();
       if (output_now && c.stop.mean_velocity_below && s >= settle_after &&
           diagnostics().mean_velocity < *c.stop.mean_velocity_below) {
         summary.settled = true;
@@ -649,7 +667,7 @@ RunSummary run_dem_case(const DemCase& c, const RunOptions& options, std::ostrea
   // for a later restart, so that a split run writes exactly the rows of a whole one.
   const bool stopped_early = sim.step_index() < total_steps && !summary.settled;
   if (sim.step_index() % output_every != 0 && !stopped_early) record();
-  if (!decomposition) sim.save_checkpoint(checkpoint);
+  save_checkpoint();
 
   summary.steps = sim.step_index() - first_step;
   summary.simulated_time = sim.time();
@@ -670,8 +688,8 @@ RunSummary run_dem_case(const DemCase& c, const RunOptions& options, std::ostrea
           << (has_bodies(c.setup, c.setup.particles) ? ", bodies.pvd" : "") << ")"
           << (decomposition ? ", one block per process" : "") << "\n"
           << "  diagnostics " << csv_path.string() << "\n"
-          << "  log         " << (dir / "run.log").string() << "\n";
-  if (!decomposition) console << "  checkpoint  " << checkpoint.string() << "\n";
+          << "  log         " << (dir / "run.log").string() << "\n"
+          << "  checkpoint  " << checkpoint.string() << "\n";
   return summary;
 }
 

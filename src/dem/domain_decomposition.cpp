@@ -20,6 +20,7 @@ struct SlabDecomposition::ParticleRecord {
   Quaternion orientation;
   Vec3 position, velocity, angular_velocity;
   Vec3 half_velocity, half_angular;  // leapfrog's mid-step values
+  Vec3 force, torque;                // contact force and torque of the last evaluation
 };
 
 struct SlabDecomposition::GhostState {
@@ -30,6 +31,46 @@ struct SlabDecomposition::GhostState {
 namespace {
 
 static_assert(std::is_trivially_copyable_v<ContactMemory>);
+
+SlabDecomposition::ParticleRecord record_of(const ParticleStore& p, std::size_t i,
+                                            const Vec3& half_velocity, const Vec3& half_angular) {
+  return {p.id[i],
+          p.material[i],
+          p.species[i],
+          p.spherical[i],
+          p.radius[i],
+          p.mass[i],
+          p.inverse_mass[i],
+          p.inertia_body[i],
+          p.inverse_inertia_body[i],
+          p.orientation[i],
+          p.position[i],
+          p.velocity[i],
+          p.angular_velocity[i],
+          half_velocity,
+          half_angular,
+          p.force[i],
+          p.torque[i]};
+}
+
+void append_record(ParticleStore& store, const SlabDecomposition::ParticleRecord& r) {
+  store.id.push_back(r.id);
+  store.material.push_back(r.material);
+  store.radius.push_back(r.radius);
+  store.mass.push_back(r.mass);
+  store.inverse_mass.push_back(r.inverse_mass);
+  store.species.push_back(r.species);
+  store.spherical.push_back(r.spherical);
+  store.inertia_body.push_back(r.inertia_body);
+  store.inverse_inertia_body.push_back(r.inverse_inertia_body);
+  store.orientation.push_back(r.orientation);
+  store.position.push_back(r.position);
+  store.velocity.push_back(r.velocity);
+  store.angular_velocity.push_back(r.angular_velocity);
+  store.force.push_back(r.force);
+  store.torque.push_back(r.torque);
+  store.coordination.push_back(0);
+}
 
 // Sends buckets[d] to process d; returns what every process sent here, by source.
 template <typename T>
@@ -156,8 +197,12 @@ DemSetup SlabDecomposition::local_setup(const DemSetup& full) {
   if (full.integrator != IntegratorKind::kLeapfrog) {
     throw std::invalid_argument("several MPI processes need the leapfrog integrator");
   }
-  if (!full.pour.empty()) {
-    throw std::invalid_argument("pouring during the run is not available on several MPI processes");
+  for (const PourSource& src : full.pour) {
+    if (src.inserted < src.count) {
+      throw std::invalid_argument(
+          "pouring during the run is not available on several MPI processes: pour on one, "
+          "then restart from its checkpoint on several");
+    }
   }
   const Vec3 extent = full.domain.length();
   axis_ = requested_axis_;
@@ -173,6 +218,11 @@ DemSetup SlabDecomposition::local_setup(const DemSetup& full) {
 
   DemSetup local = full;
   local.particles = ParticleStore{};
+  local.pour.clear();  // all poured (checked above)
+  // Every process uses the skin and linked cells one process would (ghosts come later).
+  const auto [r_min, r_max] = DemSimulation::radius_bounds(full);
+  if (local.skin <= 0.0) local.skin = 0.2 * r_min;
+  local.largest_radius = r_max;
   std::vector<std::size_t> order(p.size());
   std::iota(order.begin(), order.end(), 0);
   std::sort(order.begin(), order.end(),
@@ -182,33 +232,16 @@ DemSetup SlabDecomposition::local_setup(const DemSetup& full) {
     local.particles.append_from(p, i);
   }
   // The ghost band: every pair that can be a candidate of an owned particle.
-  double r_max = 0.0;
-  for (double r : p.radius) r_max = std::max(r_max, r);
-  band_ = 2.0 * r_max;  // the skin is added in attach(), once the simulation has chosen it
+  band_ = 2.0 * r_max + local.skin;
   return local;
 }
 
 void SlabDecomposition::attach(DemSimulation& simulation) {
-  band_ += simulation.neighbor_search().skin();
   simulation.set_exchange(this);
   ParticleStore& p = simulation.particles();
   std::vector<ParticleRecord> owned(p.size());
   for (std::size_t i = 0; i < p.size(); ++i) {
-    owned[i] = {p.id[i],
-                p.material[i],
-                p.species[i],
-                p.spherical[i],
-                p.radius[i],
-                p.mass[i],
-                p.inverse_mass[i],
-                p.inertia_body[i],
-                p.inverse_inertia_body[i],
-                p.orientation[i],
-                p.position[i],
-                p.velocity[i],
-                p.angular_velocity[i],
-                Vec3{},
-                Vec3{}};
+    owned[i] = record_of(p, i, Vec3{}, Vec3{});
   }
   // No contact memory yet: the initial forces are evaluated once, as in one process.
   exchange_ghosts(simulation, std::move(owned), {});
@@ -258,9 +291,7 @@ void SlabDecomposition::redistribute(DemSimulation& simulation) {
   for (std::size_t i = 0; i < p.size(); ++i) {
     if (simulation.is_ghost(i)) continue;
     particle_buckets[static_cast<std::size_t>(owner_of(p.position[i][axis_]))].push_back(
-        {p.id[i], p.material[i], p.species[i], p.spherical[i], p.radius[i], p.mass[i],
-         p.inverse_mass[i], p.inertia_body[i], p.inverse_inertia_body[i], p.orientation[i],
-         p.position[i], p.velocity[i], p.angular_velocity[i], half_v[i], half_w[i]});
+        record_of(p, i, half_v[i], half_w[i]));
   }
   // Contact memories to the new owners of both particles (walls: of the particle).
   std::vector<std::vector<ContactMemory>> contact_buckets(static_cast<std::size_t>(ranks_));
@@ -318,22 +349,7 @@ void SlabDecomposition::exchange_ghosts(DemSimulation& simulation,
   std::vector<Vec3> half_v, half_w;
   for (std::size_t k : order) {
     const ParticleRecord& r = all[k];
-    store.id.push_back(r.id);
-    store.material.push_back(r.material);
-    store.radius.push_back(r.radius);
-    store.mass.push_back(r.mass);
-    store.inverse_mass.push_back(r.inverse_mass);
-    store.species.push_back(r.species);
-    store.spherical.push_back(r.spherical);
-    store.inertia_body.push_back(r.inertia_body);
-    store.inverse_inertia_body.push_back(r.inverse_inertia_body);
-    store.orientation.push_back(r.orientation);
-    store.position.push_back(r.position);
-    store.velocity.push_back(r.velocity);
-    store.angular_velocity.push_back(r.angular_velocity);
-    store.force.push_back({});
-    store.torque.push_back({});
-    store.coordination.push_back(0);
+    append_record(store, r);
     ghost.push_back(is_ghost_record[k]);
     half_v.push_back(r.half_velocity);
     half_w.push_back(r.half_angular);
@@ -387,34 +403,71 @@ DemDiagnostics SlabDecomposition::diagnostics(const DemSimulation& simulation) c
   return d;
 }
 
-ParticleStore SlabDecomposition::gather(const DemSimulation& simulation, int root) const {
+std::vector<SlabDecomposition::ParticleRecord> SlabDecomposition::gather_records(
+    const DemSimulation& simulation, int root) const {
   const ParticleStore& p = simulation.particles();
   std::vector<std::vector<ParticleRecord>> buckets(static_cast<std::size_t>(ranks_));
   for (std::size_t i = 0; i < p.size(); ++i) {
-    if (simulation.is_ghost(i)) continue;
-    buckets[static_cast<std::size_t>(root)].push_back(
-        {p.id[i], p.material[i], p.species[i], p.spherical[i], p.radius[i], p.mass[i],
-         p.inverse_mass[i], p.inertia_body[i], p.inverse_inertia_body[i], p.orientation[i],
-         p.position[i], p.velocity[i], p.angular_velocity[i], p.force[i], p.torque[i]});
+    if (!simulation.is_ghost(i)) {
+      buckets[static_cast<std::size_t>(root)].push_back(record_of(p, i, Vec3{}, Vec3{}));
+    }
   }
   std::int64_t ignored = 0;
   std::vector<ParticleRecord> all;
-  for (auto& from : all_to_all(comm_, buckets, ignored))
+  for (auto& from : all_to_all(comm_, buckets, ignored)) {
     all.insert(all.end(), from.begin(), from.end());
+  }
   std::sort(all.begin(), all.end(),
             [](const ParticleRecord& a, const ParticleRecord& b) { return a.id < b.id; });
+  return all;
+}
+
+ParticleStore SlabDecomposition::gather(const DemSimulation& simulation, int root) const {
   ParticleStore out;
-  for (const ParticleRecord& r : all) {
-    const std::size_t i =
-        out.add_body(r.id, r.material, r.species, r.radius, r.mass, r.inertia_body, r.orientation,
-                     r.position, r.velocity, r.angular_velocity);
-    out.spherical[i] = r.spherical;
-    out.inverse_mass[i] = r.inverse_mass;
-    out.inverse_inertia_body[i] = r.inverse_inertia_body;
-    out.force[i] = r.half_velocity;  // gather() carries force and torque in these slots
-    out.torque[i] = r.half_angular;
-  }
+  for (const ParticleRecord& r : gather_records(simulation, root)) append_record(out, r);
   return out;
+}
+
+void SlabDecomposition::attach_restart(DemSimulation& simulation, const DemSimulation& whole) {
+  simulation.set_exchange(this);
+  // The owned particles as the checkpoint has them (forces included: the first step's
+  // drift uses them), and every memory of the checkpoint (each process keeps its own).
+  const ParticleStore& all = whole.particles();
+  std::vector<ParticleRecord> owned;
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    if (owner_of(all.position[i][axis_]) == rank_) owned.push_back(record_of(all, i, {}, {}));
+  }
+  exchange_ghosts(simulation, std::move(owned), whole.export_contacts());
+  simulation.set_step_index(whole.step_index());
+}
+
+void SlabDecomposition::save_checkpoint(const DemSimulation& simulation, DemSimulation* whole,
+                                        const std::filesystem::path& file) const {
+  // Memories: each process sends those of the contacts whose first particle it owns (a
+  // pair across a boundary is held by both, identically).
+  std::vector<std::vector<ContactMemory>> buckets(static_cast<std::size_t>(ranks_));
+  const std::vector<std::int64_t>& id = simulation.particles().id;
+  for (const ContactMemory& m : simulation.export_contacts()) {
+    if (!simulation.is_ghost(index_of_id(id, m.first_id))) buckets[0].push_back(m);
+  }
+  std::int64_t ignored = 0;
+  std::vector<ContactMemory> memories;
+  for (auto& from : all_to_all(comm_, buckets, ignored)) {
+    memories.insert(memories.end(), from.begin(), from.end());
+  }
+  const std::vector<ParticleRecord> records = gather_records(simulation, 0);
+  std::int64_t step = simulation.step_index();
+  if (rank_ != 0) return;
+  if (whole == nullptr) throw std::logic_error("save_checkpoint: no whole system on process 0");
+  ParticleStore store;
+  for (const ParticleRecord& r : records) append_record(store, r);
+  std::sort(memories.begin(), memories.end(),
+            [](const ContactMemory& a, const ContactMemory& b) { return a.key() < b.key(); });
+  const std::size_t n = store.size();
+  whole->replace_particles(std::move(store), std::vector<std::uint8_t>(n, 0), std::vector<Vec3>(n),
+                           std::vector<Vec3>(n), memories);
+  whole->set_step_index(step);
+  whole->save_checkpoint(file);
 }
 
 }  // namespace sanguis::dem

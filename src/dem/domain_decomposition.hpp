@@ -19,11 +19,16 @@
 // states are bitwise those of one process (checked by tests/dem/dem_mpi_check).
 // Only the reductions of the diagnostics change with the process count.
 //
+// Checkpoints are gathered into the one-process format, so a run may continue on
+// another number of processes (e.g. pour on one, collapse on several).
+//
 // Limits: leapfrog only, no pouring during the run (the insertion test needs
-// all particles), periodic axes other than the slab axis are handled locally
-// (they never cross processes).
+// all particles; a run may be restarted on several processes once its pouring is
+// over), periodic axes other than the slab axis are handled locally (they never
+// cross processes).
 #include <array>
 #include <cstdint>
+#include <filesystem>
 #include <vector>
 
 #include <mpi.h>
@@ -44,6 +49,15 @@ class SlabDecomposition final : public ParticleExchange {
   // Attaches to a simulation built from local_setup(): adds the ghosts and recomputes
   // the forces of the initial state (contacts start without memory, as in one process).
   void attach(DemSimulation& simulation);
+  // Restart: attaches to a simulation built from local_setup(whole.setup()), where `whole`
+  // holds a checkpoint of the whole system (written by any number of processes); the
+  // state, forces and contact memories continue from it.
+  void attach_restart(DemSimulation& simulation, const DemSimulation& whole);
+  // Writes the checkpoint of the whole system in the one-process format (a run may
+  // restart from it on any number of processes): the state is gathered on process 0 into
+  // `whole`, a simulation of the same case there (unused elsewhere). Collective.
+  void save_checkpoint(const DemSimulation& simulation, DemSimulation* whole,
+                       const std::filesystem::path& file) const;
 
   bool any(bool local) override;
   void refresh_ghosts(DemSimulation& simulation) override;
@@ -76,6 +90,7 @@ class SlabDecomposition final : public ParticleExchange {
   void balance(const ParticleStore& p, const std::vector<std::uint8_t>& ghost);
   int owner_of(double coordinate) const;
   bool near_slab(double coordinate, int slab) const;
+  std::vector<ParticleRecord> gather_records(const DemSimulation& simulation, int root) const;
   void exchange_ghosts(DemSimulation& simulation, std::vector<ParticleRecord> owned,
                        std::vector<ContactMemory> contacts);
 

@@ -15,31 +15,37 @@
 
 namespace sanguis::dem {
 
-DemSimulation::DemSimulation(DemSetup setup)
-    : setup_(std::move(setup)), integrator_(setup_.integrator) {
-  ParticleStore& p = setup_.particles;
-  if (!(setup_.time_step > 0.0)) throw std::invalid_argument("time step must be > 0");
-  // Default skin: 10% of the smallest diameter; for a body, of its volume-equivalent sphere
-  // (its bounding sphere can be far larger: a cross's is 3x, and the lists would swell).
-  double r_max = 0.0, r_min = std::numeric_limits<double>::infinity();
-  for (const PourSource& src : setup_.pour) {  // particles to come count for the grid
+std::pair<double, double> DemSimulation::radius_bounds(const DemSetup& s) {
+  // Smallest volume-equivalent radius (a cross's bounding sphere is 3x larger, and a skin
+  // from it would swell the lists) and largest bounding radius, particles to come included.
+  double r_max = s.largest_radius, r_min = std::numeric_limits<double>::infinity();
+  for (const PourSource& src : s.pour) {
     r_max = std::max(r_max, src.radius);
-    r_min =
-        std::min(r_min, src.species >= 0
-                            ? setup_.shapes[static_cast<std::size_t>(src.species)].equivalent_radius
-                            : src.radius);
-    has_bodies_ |= src.species >= 0;
+    r_min = std::min(r_min, src.species >= 0
+                                ? s.shapes[static_cast<std::size_t>(src.species)].equivalent_radius
+                                : src.radius);
   }
-  pour_rng_.seed(setup_.pour_seed);
+  const ParticleStore& p = s.particles;
   for (std::size_t i = 0; i < p.size(); ++i) {
     r_max = std::max(r_max, p.radius[i]);
-    const bool body =
-        !p.spherical[i] && static_cast<std::size_t>(p.species[i]) < setup_.shapes.size();
-    r_min = std::min(r_min,
-                     body ? setup_.shapes[static_cast<std::size_t>(p.species[i])].equivalent_radius
-                          : p.radius[i]);
+    const bool body = !p.spherical[i] && static_cast<std::size_t>(p.species[i]) < s.shapes.size();
+    r_min =
+        std::min(r_min, body ? s.shapes[static_cast<std::size_t>(p.species[i])].equivalent_radius
+                             : p.radius[i]);
   }
   if (r_max == 0.0) r_max = r_min = 1.0;
+  if (!std::isfinite(r_min)) r_min = r_max;
+  return {r_min, r_max};
+}
+
+DemSimulation::DemSimulation(DemSetup setup)
+    : setup_(std::move(setup)), integrator_(setup_.integrator), step_(setup_.start_step) {
+  ParticleStore& p = setup_.particles;
+  if (!(setup_.time_step > 0.0)) throw std::invalid_argument("time step must be > 0");
+  for (const PourSource& src : setup_.pour) has_bodies_ |= src.species >= 0;
+  pour_rng_.seed(setup_.pour_seed);
+  // Default skin: 10% of the smallest diameter.
+  const auto [r_min, r_max] = radius_bounds(setup_);
   if (setup_.skin <= 0.0) setup_.skin = 0.2 * r_min;
   const std::size_t n_materials = setup_.contacts.materials();
   for (std::size_t i = 0; i < p.size(); ++i) {

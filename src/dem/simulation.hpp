@@ -6,6 +6,7 @@
 #include <random>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "dem/contact_list.hpp"
@@ -85,6 +86,12 @@ struct DemSetup {
   std::vector<ParticleShape> shapes;
   std::vector<PourSource> pour;
   std::uint64_t pour_seed = 0;  // species table (ParticleStore::species); spheres may omit it
+  // Largest bounding radius the linked cells must serve beyond the particles present (a
+  // process of a decomposed run receives ghosts later) [m]; 0: the particles' own.
+  double largest_radius = 0.0;
+  // The step the particles' state is at (time = start_step x time_step): a process of a
+  // decomposed restart starts from a checkpoint's state, obstacles at their pose then.
+  std::int64_t start_step = 0;
   ParticleStore particles;
 };
 
@@ -142,6 +149,11 @@ class DemSimulation {
   const std::vector<std::uint8_t>& ghost_flags() const { return ghost_; }
   bool is_ghost(std::size_t i) const { return !ghost_.empty() && ghost_[i] != 0; }
   std::size_t owned_count() const;
+  // {smallest volume-equivalent radius, largest bounding radius} of a setup, particles
+  // to be poured included: the default skin and the linked-cell size follow from them.
+  static std::pair<double, double> radius_bounds(const DemSetup& setup);
+  // Sets the step counter (a decomposed restart continues the checkpoint's count).
+  void set_step_index(std::int64_t step) { step_ = step; }
   // Every contact with its memory, keyed by particle ids.
   std::vector<ContactMemory> export_contacts() const;
   // Replaces the particles mid-step (between the drift and the forces): the new set must

@@ -12,12 +12,15 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <random>
+#include <sstream>
 #include <string>
 
 #include <mpi.h>
 
 #include "dem/dem_case.hpp"
+#include "dem/dem_run.hpp"
 #include "dem/domain_decomposition.hpp"
 #include "dem/simulation.hpp"
 
@@ -193,6 +196,69 @@ positions_m = [[0.09, 0.03, 0.06]]
   return s;
 }
 
+// Largest difference of position, velocity and angular velocity between two checkpoints
+// of the same case (loaded into simulations of `c`).
+double checkpoint_difference(const DemCase& c, const std::filesystem::path& a,
+                             const std::filesystem::path& b) {
+  DemSimulation x(c.setup), y(c.setup);
+  x.load_checkpoint(a);
+  y.load_checkpoint(b);
+  if (x.step_index() != y.step_index() || x.particles().size() != y.particles().size()) {
+    return INFINITY;
+  }
+  return largest_difference(x, y.particles());
+}
+
+// Checkpoints are in the one-process format whatever the process count: a run split at
+// 0.3 s continues on another count. Split 1 -> N and N -> 1 against an unsplit run.
+bool restart_across_process_counts() {
+  namespace fs = std::filesystem;
+  int rank = 0, ranks = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  const DemCase c = load_dem_case(std::string(SANGUIS_SOURCE_DIR) +
+                                  "/tests/integration/data/dam-break-tiny.toml");
+  const fs::path base =
+      fs::temp_directory_path() / ("sanguis_dem_mpi_check_restart_" + std::to_string(ranks));
+  if (rank == 0) fs::remove_all(base);
+  MPI_Barrier(MPI_COMM_WORLD);
+  std::ostringstream quiet_console;
+  const auto run = [&](const fs::path& dir, bool restart, double stop_at, MPI_Comm comm) {
+    RunOptions o;
+    o.output_dir = dir;
+    o.restart = restart;
+    o.quiet = true;
+    o.stop_at = stop_at;
+    o.comm = comm;
+    run_dem_case(c, o, quiet_console);
+  };
+  if (rank == 0) {
+    run(base / "whole", false, -1.0, MPI_COMM_NULL);
+    run(base / "one_then_all", false, 0.3, MPI_COMM_NULL);
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+  run(base / "one_then_all", true, -1.0, MPI_COMM_WORLD);
+  run(base / "all_then_one", false, 0.3, MPI_COMM_WORLD);
+  MPI_Barrier(MPI_COMM_WORLD);
+  bool ok = true;
+  if (rank == 0) {
+    run(base / "all_then_one", true, -1.0, MPI_COMM_NULL);
+    const double d1 = checkpoint_difference(c, base / "whole" / "checkpoint.bin",
+                                            base / "one_then_all" / "checkpoint.bin");
+    const double d2 = checkpoint_difference(c, base / "whole" / "checkpoint.bin",
+                                            base / "all_then_one" / "checkpoint.bin");
+    ok = d1 == 0.0 && d2 == 0.0;
+    std::printf(
+        "%s restart across process counts: split at 0.3 s of 0.6 s, 1 -> %d processes: largest "
+        "state difference %.3g; %d -> 1: %.3g\n",
+        ok ? "PASS" : "FAIL", ranks, d1, ranks, d2);
+    fs::remove_all(base);
+  }
+  int flag = ok ? 1 : 0;
+  MPI_Bcast(&flag, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  return flag != 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -204,6 +270,7 @@ int main(int argc, char** argv) {
     ok &= compare("sphere dam break", d, static_cast<std::int64_t>(0.35 / d.time_step), 0);
     ok &= compare("periodic spheres", periodic_spheres(), 20000, 0);
     ok &= compare("crosses", crosses(), 10000, 0);
+    ok &= restart_across_process_counts();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "dem_mpi_check: %s\n", e.what());
     ok = false;

@@ -54,22 +54,5 @@ TEST_F(MpiRun, TwoProcessesAnalyseLikeOne) {
   EXPECT_NE(read_text_file(dir_ / "two" / "run.log").find("2 MPI processes"), std::string::npos);
 }
 
-TEST_F(MpiRun, RestartOnSeveralProcessesIsAClearError) {
-  if (std::system("command -v mpirun >/dev/null 2>&1") != 0) GTEST_SKIP() << "no mpirun";
-  const std::string tiny =
-      std::string(SANGUIS_SOURCE_DIR) + "/tests/integration/data/dam-break-tiny.toml";
-  ASSERT_EQ(sanguis("run " + shell_quoted(tiny) + " -o " + shell_quoted((dir_ / "run").string()) +
-                    " --quiet")
-                .code,
-            0);
-  const std::string command = "mpirun -np 2 --allow-run-as-root --oversubscribe " +
-                              shell_quoted(SANGUIS_BINARY) + " run " + shell_quoted(tiny) + " -o " +
-                              shell_quoted((dir_ / "run").string()) + " --restart --quiet >" +
-                              shell_quoted((dir_ / "mpirun.txt").string()) + " 2>&1";
-  EXPECT_NE(std::system(command.c_str()), 0);
-  EXPECT_NE(read_text_file(dir_ / "mpirun.txt").find("restart on several MPI processes"),
-            std::string::npos);
-}
-
 }  // namespace
 }  // namespace sanguis
