@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # Side-by-side benchmark "dem-spheres": LAMMPS (bench/lammps/in.dem-spheres)
-# against `sanguis bench dem-spheres`, same N and number of steps, one MPI rank /
-# one thread each. The case is defined in bench/README.md.
+# against `sanguis bench dem-spheres`, same N and number of steps, one thread per
+# MPI process, P processes each (default 1; P > 1 runs both under mpirun). The case
+# is defined in bench/README.md.
 #
 #   bench/dem_spheres_vs_lammps.sh [--particles N] [--steps S] [--repeat K]
-#                                  [--seed SEED] [--logdir DIR]
+#                                  [--seed SEED] [--processes P] [--logdir DIR]
 #
 # Environment: SANGUIS (default build/app/sanguis under the repository root),
 #              LMP (default lmp).
@@ -27,6 +28,7 @@ particles=32000
 steps=2000
 repeat=1
 seed=4928459
+processes=1
 logdir=""
 keep=""
 
@@ -39,12 +41,13 @@ while [[ $# -gt 0 ]]; do
     --steps) steps="${2:?--steps needs a value}"; shift 2 ;;
     --repeat) repeat="${2:?--repeat needs a value}"; shift 2 ;;
     --seed) seed="${2:?--seed needs a value}"; shift 2 ;;
+    --processes) processes="${2:?--processes needs a value}"; shift 2 ;;
     --logdir) logdir="${2:?--logdir needs a value}"; shift 2 ;;
     -h|--help) usage; exit 0 ;;
     *) usage >&2; die "unknown argument: $1" ;;
   esac
 done
-for v in particles steps repeat seed; do
+for v in particles steps repeat seed processes; do
   [[ ${!v} =~ ^[1-9][0-9]*$ ]] || die "--$v must be a positive integer (got '${!v}')"
 done
 
@@ -54,6 +57,11 @@ if [[ ! -x $sanguis ]]; then
 fi
 command -v "$lmp" >/dev/null 2>&1 ||
   die "LAMMPS executable '$lmp' not found (install it with 'make bench-deps' or 'scripts/install-deps.sh --bench', or set LMP=...)"
+launch=()
+if ((processes > 1)); then
+  command -v mpirun >/dev/null 2>&1 || die "--processes $processes needs mpirun (openmpi-bin)"
+  launch=(mpirun -np "$processes" --allow-run-as-root --oversubscribe)
+fi
 lmp_help="$("$lmp" -h 2>/dev/null || true)"
 grep -qw GRANULAR <<<"$lmp_help" || die "'$lmp' was built without the GRANULAR package"
 [[ -f $input ]] || die "missing LAMMPS input $input"
@@ -74,7 +82,7 @@ results="$workdir/results.jsonl"
 lammps_json() {
   "$python" - "$@" <<'PY'
 import json, re, sys
-log, n, s = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
+log, n, s, p = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4])
 pat = re.compile(r"^Loop time of (\S+) on (\d+) procs for (\d+) steps with (\d+) atoms")
 hits = []
 with open(log) as f:
@@ -87,10 +95,10 @@ if not hits:
 seconds, procs, atoms = hits[0]  # the timed run comes first; the diagnostics run has 0 steps
 if atoms != n:
     sys.exit(f"LAMMPS ran with {atoms} atoms, expected {n} (atoms lost?)")
-if procs != 1:
-    sys.exit(f"LAMMPS ran on {procs} procs, expected 1")
+if procs != p:
+    sys.exit(f"LAMMPS ran on {procs} procs, expected {p}")
 print(json.dumps({"benchmark": "dem-spheres", "code": "lammps", "particles": atoms,
-                  "steps": s, "threads": 1, "seconds": seconds,
+                  "steps": s, "threads": 1, "processes": procs, "seconds": seconds,
                   "particle_steps_per_s": atoms * s / seconds}, separators=(",", ":")))
 PY
 }
@@ -128,7 +136,8 @@ PY
 summary() {
   "$python" - "$@" <<'PY'
 import json, statistics, sys
-path, n, s, k = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4])
+path, n, s, k, p = (sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4]),
+                    int(sys.argv[5]))
 rates, secs = {}, {}
 with open(path) as f:
     for line in f:
@@ -137,7 +146,7 @@ with open(path) as f:
         secs.setdefault(d["code"], []).append(float(d["seconds"]))
 med = {c: statistics.median(v) for c, v in rates.items()}
 out = {"benchmark": "dem-spheres", "summary": True, "particles": n, "steps": s,
-       "threads": 1, "repeat": k}
+       "threads": 1, "processes": p, "repeat": k}
 for c in ("lammps", "sanguis"):
     out[f"{c}_median_seconds"] = statistics.median(secs[c])
     out[f"{c}_median_particle_steps_per_s"] = med[c]
@@ -148,21 +157,21 @@ PY
 
 # ---- runs --------------------------------------------------------------------
 export OMP_NUM_THREADS=1
-echo "dem-spheres: N=$particles steps=$steps repeat=$repeat; lammps: $lmp, sanguis: $sanguis; logs in $workdir" >&2
+echo "dem-spheres: N=$particles steps=$steps repeat=$repeat processes=$processes; lammps: $lmp, sanguis: $sanguis; logs in $workdir" >&2
 for ((r = 1; r <= repeat; r++)); do
   log="$workdir/lammps.$r.log"
   echo "dem-spheres: [$r/$repeat] lammps ..." >&2
-  if ! (cd "$workdir" && "$lmp" -nocite -screen none -log "$log" -in "$input" \
+  if ! (cd "$workdir" && "${launch[@]}" "$lmp" -nocite -screen none -log "$log" -in "$input" \
         -var particles "$particles" -var steps "$steps" -var seed "$seed"); then
     tail -n 20 "$log" >&2 || true
     die "LAMMPS failed (log: $log)$keep"
   fi
-  line="$(lammps_json "$log" "$particles" "$steps")" || die "could not parse the LAMMPS log $log$keep"
+  line="$(lammps_json "$log" "$particles" "$steps" "$processes")" || die "could not parse the LAMMPS log $log$keep"
   echo "$line" | tee -a "$results"
 
   out="$workdir/sanguis.$r.out"
   echo "dem-spheres: [$r/$repeat] sanguis ..." >&2
-  if ! "$sanguis" bench dem-spheres --particles "$particles" --steps "$steps" --threads 1 >"$out"; then
+  if ! "${launch[@]}" "$sanguis" bench dem-spheres --particles "$particles" --steps "$steps" --threads 1 >"$out"; then
     tail -n 20 "$out" >&2 || true
     die "sanguis bench dem-spheres failed (output: $out)$keep"
   fi
@@ -170,4 +179,4 @@ for ((r = 1; r <= repeat; r++)); do
   echo "$line" | tee -a "$results"
 done
 
-summary "$results" "$particles" "$steps" "$repeat"
+summary "$results" "$particles" "$steps" "$repeat" "$processes"
