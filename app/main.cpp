@@ -257,7 +257,9 @@ int main(int argc, char** argv) {
       } else if (bench_name == "dem-crosses") {
         if (!particles_given) bo.particles = 3000;
         if (!steps_given) bo.steps = 500;
-        std::cout << bench::run_dem_crosses(bo) << std::endl;
+        if (several_mpi_processes()) bo.comm = flow::MpiSession::ensure().world();
+        const std::string line = bench::run_dem_crosses(bo);
+        if (!line.empty()) std::cout << line << std::endl;
       } else if (bench_name == "membrane") {
         if (!steps_given) bo.steps = 20;
         std::cout << bench::run_membrane(bo) << std::endl;

@@ -30,7 +30,8 @@ struct BenchOptions {
 std::string run_dem_spheres(const BenchOptions& options);
 
 // dem-crosses: a column of crosses (thesis §3.2.2, Table 3.1) behind the gate of the
-// 64 x 30 cm dam-break box, stacked flat at random angles so that they touch.
+// 64 x 30 cm dam-break box, stacked flat at random angles so that they touch. Also on
+// several MPI processes (options.comm); empty string on all but the first.
 std::string run_dem_crosses(const BenchOptions& options);
 
 // membrane: elastic (Skalak, C = 10) and Helfrich bending nodal forces of

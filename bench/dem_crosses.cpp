@@ -3,15 +3,17 @@
 // number of steps (see bench/README.md).
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <numbers>
 #include <random>
 #include <sstream>
 #include <stdexcept>
 
 #include "benchmarks.hpp"
-#include "memory_usage.hpp"
+#include "dem/domain_decomposition.hpp"
 #include "dem/simulation.hpp"
 #include "geometry/mass_properties.hpp"
+#include "memory_usage.hpp"
 
 namespace sanguis::bench {
 
@@ -93,28 +95,47 @@ dem::DemSetup dem_crosses_setup(const BenchOptions& o) {
 std::string run_dem_crosses(const BenchOptions& o) {
   if (o.particles <= 0 || o.steps <= 0)
     throw std::invalid_argument("particles and steps must be > 0");
+  int rank = 0, ranks = 1;
+  if (o.comm != MPI_COMM_NULL) {
+    MPI_Comm_rank(o.comm, &rank);
+    MPI_Comm_size(o.comm, &ranks);
+  }
   const std::int64_t rss_before = resident_bytes();
-  dem::DemSimulation sim(dem_crosses_setup(o));
+  std::unique_ptr<dem::SlabDecomposition> decomposition;
+  if (ranks > 1) decomposition = std::make_unique<dem::SlabDecomposition>(o.comm);
+  dem::DemSimulation sim(decomposition ? decomposition->local_setup(dem_crosses_setup(o))
+                                       : dem_crosses_setup(o));
+  if (decomposition) decomposition->attach(sim);
+  const double exchange_before = decomposition ? decomposition->exchange_seconds() : 0.0;
+  if (decomposition) MPI_Barrier(o.comm);
   const auto start = std::chrono::steady_clock::now();
   for (std::int64_t s = 0; s < o.steps; ++s) sim.step();
+  if (decomposition) MPI_Barrier(o.comm);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const dem::DemDiagnostics d = sim.diagnostics();
+  const dem::DemDiagnostics d = decomposition ? decomposition->diagnostics(sim) : sim.diagnostics();
+  long long candidates = static_cast<long long>(sim.body_contacts().size());
+  double exchange = decomposition ? decomposition->exchange_seconds() - exchange_before : 0.0;
+  if (decomposition) {
+    MPI_Allreduce(MPI_IN_PLACE, &candidates, 1, MPI_LONG_LONG, MPI_SUM, o.comm);
+    MPI_Allreduce(MPI_IN_PLACE, &exchange, 1, MPI_DOUBLE, MPI_MAX, o.comm);
+  }
   std::ostringstream json;
   json.precision(6);
   json << "{\"benchmark\":\"dem-crosses\",\"code\":\"sanguis\",\"particles\":" << o.particles
-       << ",\"steps\":" << o.steps << ",\"threads\":" << sim.threads() << ",\"seconds\":" << seconds
-       << ",\"particle_steps_per_s\":"
+       << ",\"steps\":" << o.steps << ",\"threads\":" << sim.threads() << ",\"processes\":" << ranks
+       << ",\"seconds\":" << seconds << ",\"particle_steps_per_s\":"
        << static_cast<double>(o.particles) * static_cast<double>(o.steps) / seconds
-       << ",\"element_pair_candidates\":" << sim.body_contacts().size()
+       << ",\"element_pair_candidates\":" << candidates
        << ",\"element_contacts\":" << d.particle_contacts
        << ",\"wall_contacts\":" << d.wall_contacts
-       << ",\"max_overlap_over_radius\":" << d.max_overlap_ratio
-       << ",\"peak_rss_mb\":" << static_cast<double>(peak_resident_bytes()) / 1048576.0
+       << ",\"max_overlap_over_radius\":" << d.max_overlap_ratio;
+  if (decomposition) json << ",\"exchange_fraction\":" << exchange / seconds;
+  json << ",\"peak_rss_mb\":" << static_cast<double>(peak_resident_bytes()) / 1048576.0
        << ",\"bytes_per_particle\":"
        << static_cast<double>(peak_resident_bytes() - rss_before) / static_cast<double>(o.particles)
        << "}";
-  return json.str();
+  return rank == 0 ? json.str() : std::string();
 }
 
 }  // namespace sanguis::bench
