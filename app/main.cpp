@@ -1,5 +1,6 @@
 // The sanguis executable: parse the command line, run, report. Errors map to
 // exit codes: 0 success, 1 simulation failure (blow-up), 2 bad input.
+#include <mpi.h>
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
@@ -130,6 +131,18 @@ bool several_mpi_processes() {
     if (value != nullptr && std::atoi(value) > 1) return true;
   }
   return false;
+}
+
+// After an error on one of several MPI processes: the others may wait in a collective
+// for ever, so the whole job stops (mpirun reports the exit code).
+void stop_other_processes(int code) {
+  int initialised = 0, finalised = 0;
+  MPI_Initialized(&initialised);
+  MPI_Finalized(&finalised);
+  if (!initialised || finalised) return;
+  int size = 1;
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  if (size > 1) MPI_Abort(MPI_COMM_WORLD, code);
 }
 
 int run_command(const RunArgs& args) {
@@ -275,15 +288,19 @@ int main(int argc, char** argv) {
     }
   } catch (const InputError& e) {
     std::cerr << "sanguis: error: " << e.what() << "\n";
+    stop_other_processes(2);
     return 2;
   } catch (const SimulationError& e) {
     std::cerr << "sanguis: simulation stopped: " << e.what() << "\n";
+    stop_other_processes(1);
     return 1;
   } catch (const std::invalid_argument& e) {
     std::cerr << "sanguis: error: " << e.what() << "\n";
+    stop_other_processes(2);
     return 2;
   } catch (const std::exception& e) {
     std::cerr << "sanguis: error: " << e.what() << "\n";
+    stop_other_processes(1);
     return 1;
   }
   return 0;

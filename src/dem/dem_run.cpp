@@ -449,7 +449,12 @@ class SnapshotWriter {
       series_.emplace_back(dir / (name + ".pvd"));
       if (restart) series_.back().load_existing(t);
     }
-    if (restart) next_frame_ = static_cast<std::int64_t>(series_[0].entries().size());
+    if (restart) {
+      // One entry per frame, or one per process and frame (part 0 starts each frame).
+      const auto& entries = series_[0].entries();
+      next_frame_ = std::count_if(entries.begin(), entries.end(),
+                                  [](const io::PvdIndex::Entry& e) { return e.part == 0; });
+    }
   }
 
   // Frames are numbered in the order they are written (not by time), so an extra
@@ -601,9 +606,8 @@ RunSummary run_dem_case(const DemCase& c, const RunOptions& options, std::ostrea
   const std::int64_t stop_step =
       options.stop_at >= 0 ? std::min(total_steps, steps_for(options.stop_at, dt)) : total_steps;
   const std::int64_t output_every = steps_for(c.output.interval, dt);
-  const std::int64_t checkpoint_every = c.output.checkpoint_interval > 0 && !decomposition
-                                            ? steps_for(c.output.checkpoint_interval, dt)
-                                            : 0;
+  const std::int64_t checkpoint_every =
+      c.output.checkpoint_interval > 0 ? steps_for(c.output.checkpoint_interval, dt) : 0;
   const std::int64_t settle_after = std::llround(c.stop.settle_check_after / dt);
 
   if (root) write_obstacle_table(dir / "obstacles.csv", c.setup.obstacles);
@@ -621,8 +625,14 @@ RunSummary run_dem_case(const DemCase& c, const RunOptions& options, std::ostrea
   };
   if (!options.restart) record();
 
+  // A decomposed run pours nothing: its count is fixed (summed once over the processes).
+  long long decomposed_count = 0;
+  if (decomposition) {
+    decomposed_count = static_cast<long long>(sim.owned_count());
+    MPI_Allreduce(MPI_IN_PLACE, &decomposed_count, 1, MPI_LONG_LONG, MPI_SUM, options.comm);
+  }
   const auto particle_count = [&]() {
-    return decomposition ? c.setup.particles.size() : sim.particles().size();
+    return decomposition ? static_cast<std::size_t>(decomposed_count) : sim.particles().size();
   };
   if (root) {
     console << "sanguis run: " << c.name << ": " << particle_count() << " particles, "

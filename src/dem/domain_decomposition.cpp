@@ -87,10 +87,21 @@ std::vector<std::vector<T>> all_to_all(MPI_Comm comm, const std::vector<std::vec
   MPI_Alltoall(send_count.data(), 1, MPI_LONG_LONG, receive_count.data(), 1, MPI_LONG_LONG, comm);
   std::vector<int> sc(static_cast<std::size_t>(ranks)), rc(static_cast<std::size_t>(ranks)),
       sd(static_cast<std::size_t>(ranks), 0), rd(static_cast<std::size_t>(ranks), 0);
+  // MPI counts and displacements are ints: every process stops together when one of them
+  // would send or receive 2 GB or more in one exchange.
+  long long send_total = 0, receive_total = 0;
   for (std::size_t d = 0; d < sc.size(); ++d) {
-    if (send_count[d] > INT32_MAX || receive_count[d] > INT32_MAX) {
-      throw std::runtime_error("domain decomposition: a transfer exceeds 2 GB");
-    }
+    send_total += send_count[d];
+    receive_total += receive_count[d];
+  }
+  int too_big = send_total > INT32_MAX || receive_total > INT32_MAX ? 1 : 0;
+  MPI_Allreduce(MPI_IN_PLACE, &too_big, 1, MPI_INT, MPI_LOR, comm);
+  if (too_big) {
+    throw std::runtime_error(
+        "domain decomposition: one exchange exceeds 2 GB on a process (a gathered checkpoint "
+        "holds at most about 7 million particles)");
+  }
+  for (std::size_t d = 0; d < sc.size(); ++d) {
     sc[d] = static_cast<int>(send_count[d]);
     rc[d] = static_cast<int>(receive_count[d]);
     if (d > 0) {
@@ -228,8 +239,11 @@ DemSetup SlabDecomposition::local_setup(const DemSetup& full) {
   std::sort(order.begin(), order.end(),
             [&](std::size_t a, std::size_t b) { return p.id[a] < p.id[b]; });
   for (std::size_t i : order) {
-    if (owner_of(p.position[i][axis_]) != rank_) continue;
+    Vec3 x = p.position[i];
+    full.domain.wrap(x);  // as the first list build will
+    if (owner_of(x[axis_]) != rank_) continue;
     local.particles.append_from(p, i);
+    local.particles.position.back() = x;
   }
   // The ghost band: every pair that can be a candidate of an owned particle.
   band_ = 2.0 * r_max + local.skin;
@@ -284,6 +298,9 @@ void SlabDecomposition::redistribute(DemSimulation& simulation) {
   const std::vector<std::uint8_t>& ghost = simulation.ghost_flags();
   auto& half_v = simulation.integrator().half_velocity();
   auto& half_w = simulation.integrator().half_angular_velocity();
+  // Wrap first, as the rebuild will (bitwise the same): a particle just past the periodic
+  // seam belongs to the slab it wraps into, and its ghosts are chosen from there.
+  for (std::size_t i = 0; i < p.size(); ++i) simulation.setup().domain.wrap(p.position[i]);
   balance(p, ghost);
 
   // Owned particles to their new owners.
@@ -435,7 +452,9 @@ void SlabDecomposition::attach_restart(DemSimulation& simulation, const DemSimul
   const ParticleStore& all = whole.particles();
   std::vector<ParticleRecord> owned;
   for (std::size_t i = 0; i < all.size(); ++i) {
-    if (owner_of(all.position[i][axis_]) == rank_) owned.push_back(record_of(all, i, {}, {}));
+    ParticleRecord r = record_of(all, i, {}, {});
+    whole.setup().domain.wrap(r.position);  // as local_setup() did
+    if (owner_of(r.position[axis_]) == rank_) owned.push_back(r);
   }
   exchange_ghosts(simulation, std::move(owned), whole.export_contacts());
   simulation.set_step_index(whole.step_index());

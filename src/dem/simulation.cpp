@@ -824,6 +824,8 @@ void DemSimulation::replace_particles(ParticleStore particles, std::vector<std::
   }
   setup_.particles = std::move(particles);
   ghost_ = std::move(ghost);
+  // Bodies may arrive on a process that started with spheres only.
+  for (std::uint8_t spherical : setup_.particles.spherical) has_bodies_ |= spherical == 0;
   integrator_.half_velocity() = std::move(half_velocity);
   integrator_.half_angular_velocity() = std::move(half_angular);
   pairs_.clear();

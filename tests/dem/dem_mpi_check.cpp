@@ -121,6 +121,14 @@ DemSetup periodic_spheres() {
   return s;
 }
 
+// The same spheres drifting along x at 0.5 m/s: particles cross the periodic seam between
+// the last and the first process all the time, and are owned by the slab they wrap into.
+DemSetup periodic_drift() {
+  DemSetup s = periodic_spheres();
+  for (Vec3& v : s.particles.velocity) v.x += 0.5;
+  return s;
+}
+
 // Crosses (Table 3.1 shape and contacts) on a lattice, random orientations and velocities.
 DemSetup crosses() {
   const std::string text = R"(
@@ -269,6 +277,7 @@ int main(int argc, char** argv) {
     const DemSetup d = dam_break();
     ok &= compare("sphere dam break", d, static_cast<std::int64_t>(0.35 / d.time_step), 0);
     ok &= compare("periodic spheres", periodic_spheres(), 20000, 0);
+    ok &= compare("spheres drifting across the periodic seam", periodic_drift(), 20000, 0);
     ok &= compare("crosses", crosses(), 10000, 0);
     ok &= restart_across_process_counts();
   } catch (const std::exception& e) {
