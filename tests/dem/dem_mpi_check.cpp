@@ -130,7 +130,9 @@ DemSetup periodic_drift() {
 }
 
 // Crosses (Table 3.1 shape and contacts) on a lattice, random orientations and velocities.
-DemSetup crosses() {
+// `with_spheres`: the lower half in x are spheres (6 mm) instead of crosses, so the first
+// process starts with spheres only and receives crosses as they converge.
+DemSetup crosses(bool with_spheres = false) {
   const std::string text = R"(
 [simulation]
 name = "crosses"
@@ -195,9 +197,13 @@ positions_m = [[0.09, 0.03, 0.06]]
         const Quaternion q = normalized({g(rng), g(rng), g(rng), g(rng)});
         // Converging on the lattice's centre: the crosses collide and entangle.
         const Vec3 v = 60.0 * (centre - x) + Vec3{0.3 * u(rng), 0.3 * u(rng), 0.3 * u(rng)};
-        s.particles.add_body(id++, 0, 0, cross.bounding_radius, 770.0 * cross.volume,
-                             770.0 * cross.inertia_per_density, q, x, v,
-                             {20.0 * u(rng), 20.0 * u(rng), 20.0 * u(rng)});
+        const Vec3 w{20.0 * u(rng), 20.0 * u(rng), 20.0 * u(rng)};
+        if (with_spheres && i < 3) {
+          s.particles.add_sphere(id++, 0, 0.006, 770.0, x, v, w);
+        } else {
+          s.particles.add_body(id++, 0, 0, cross.bounding_radius, 770.0 * cross.volume,
+                               770.0 * cross.inertia_per_density, q, x, v, w);
+        }
       }
     }
   }
@@ -279,6 +285,7 @@ int main(int argc, char** argv) {
     ok &= compare("periodic spheres", periodic_spheres(), 20000, 0);
     ok &= compare("spheres drifting across the periodic seam", periodic_drift(), 20000, 0);
     ok &= compare("crosses", crosses(), 10000, 0);
+    ok &= compare("spheres meeting crosses", crosses(true), 10000, 0);
     ok &= restart_across_process_counts();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "dem_mpi_check: %s\n", e.what());
