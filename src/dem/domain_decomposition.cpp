@@ -23,11 +23,6 @@ struct SlabDecomposition::ParticleRecord {
   Vec3 force, torque;                // contact force and torque of the last evaluation
 };
 
-struct SlabDecomposition::GhostState {
-  Quaternion orientation;
-  Vec3 position, velocity, angular_velocity;
-};
-
 namespace {
 
 static_assert(std::is_trivially_copyable_v<ContactMemory>);
@@ -273,21 +268,43 @@ void SlabDecomposition::refresh_ghosts(DemSimulation& simulation) {
   if (ranks_ == 1) return;
   const ScopedTimer timer(exchange_seconds_);
   ParticleStore& p = simulation.particles();
-  std::vector<std::vector<GhostState>> buckets(static_cast<std::size_t>(ranks_));
-  for (std::size_t d = 0; d < buckets.size(); ++d) {
-    for (std::uint32_t i : send_lists_[d]) {
-      buckets[d].push_back({p.orientation[i], p.position[i], p.velocity[i], p.angular_velocity[i]});
-    }
+  // The lists are fixed between rebuilds and both sides know their lengths: point-to-point
+  // messages with the processes that share ghosts only (the slab neighbours), no collective.
+  if (send_states_.size() != send_lists_.size()) {
+    send_states_.resize(send_lists_.size());
+    receive_states_.resize(receive_lists_.size());
   }
-  const auto received = all_to_all(comm_, buckets, bytes_sent_);
-  for (std::size_t s = 0; s < received.size(); ++s) {
-    const auto& states = received[s];
-    for (std::size_t k = 0; k < states.size(); ++k) {
+  std::vector<MPI_Request> requests;
+  requests.reserve(2 * static_cast<std::size_t>(ranks_));
+  for (std::size_t s = 0; s < receive_lists_.size(); ++s) {
+    if (receive_lists_[s].empty()) continue;
+    receive_states_[s].resize(receive_lists_[s].size());
+    requests.emplace_back();
+    MPI_Irecv(receive_states_[s].data(),
+              static_cast<int>(receive_states_[s].size() * sizeof(GhostState)), MPI_BYTE,
+              static_cast<int>(s), kGhostTag, comm_, &requests.back());
+  }
+  for (std::size_t d = 0; d < send_lists_.size(); ++d) {
+    if (send_lists_[d].empty()) continue;
+    std::vector<GhostState>& out = send_states_[d];
+    out.clear();
+    for (std::uint32_t i : send_lists_[d]) {
+      out.push_back({p.orientation[i], p.position[i], p.velocity[i], p.angular_velocity[i]});
+    }
+    requests.emplace_back();
+    MPI_Isend(out.data(), static_cast<int>(out.size() * sizeof(GhostState)), MPI_BYTE,
+              static_cast<int>(d), kGhostTag, comm_, &requests.back());
+    bytes_sent_ += static_cast<std::int64_t>(out.size() * sizeof(GhostState));
+  }
+  MPI_Waitall(static_cast<int>(requests.size()), requests.data(), MPI_STATUSES_IGNORE);
+  for (std::size_t s = 0; s < receive_lists_.size(); ++s) {
+    for (std::size_t k = 0; k < receive_lists_[s].size(); ++k) {
       const std::uint32_t i = receive_lists_[s][k];
-      p.orientation[i] = states[k].orientation;
-      p.position[i] = states[k].position;
-      p.velocity[i] = states[k].velocity;
-      p.angular_velocity[i] = states[k].angular_velocity;
+      const GhostState& state = receive_states_[s][k];
+      p.orientation[i] = state.orientation;
+      p.position[i] = state.position;
+      p.velocity[i] = state.velocity;
+      p.angular_velocity[i] = state.angular_velocity;
     }
   }
 }

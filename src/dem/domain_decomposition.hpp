@@ -84,7 +84,11 @@ class SlabDecomposition final : public ParticleExchange {
 
   // Mid-step state of one particle in transit (trivially copyable).
   struct ParticleRecord;
-  struct GhostState;
+  // What a ghost refresh sends per ghost (104 B).
+  struct GhostState {
+    Quaternion orientation;
+    Vec3 position, velocity, angular_velocity;
+  };
 
  private:
   void balance(const ParticleStore& p, const std::vector<std::uint8_t>& ghost);
@@ -105,6 +109,8 @@ class SlabDecomposition final : public ParticleExchange {
   // Ghost bookkeeping between rebuilds: local indices sent to each process, and local
   // indices of the ghosts received from each process, in transfer order.
   std::vector<std::vector<std::uint32_t>> send_lists_, receive_lists_;
+  std::vector<std::vector<GhostState>> send_states_, receive_states_;  // message buffers
+  static constexpr int kGhostTag = 7301;
   std::int64_t ghost_count_ = 0;
   std::int64_t bytes_sent_ = 0;
   double exchange_seconds_ = 0.0;
