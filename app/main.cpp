@@ -197,7 +197,8 @@ int main(int argc, char** argv) {
   run->add_option("case", ra.case_file, "case file (TOML)")->required();
   run->add_option("--output,-o", ra.output, "output directory (default: output/<case name>)");
   run->add_flag("--restart", ra.restart, "continue from OUTPUT/checkpoint.bin");
-  run->add_flag("--quiet,-q", ra.quiet, "no progress line");
+  run->add_flag("--quiet,-q", ra.quiet,
+                "no progress line (the one-line summary at the end is still printed)");
   run->add_option("--threads,-t", ra.threads,
                   "OpenMP threads (default: the case's simulation.threads, else all cores)")
       ->check(CLI::Range(1, 1024));
