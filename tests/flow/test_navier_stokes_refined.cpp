@@ -138,18 +138,20 @@ TEST(FlowRefinedNavierStokes, TimeStepFollowsTheCflConditionOnTheFinestCells) {
 }
 
 /// Max and RMS (volume-weighted) velocity error of the Taylor-Green vortex
-/// (unit square, periodic; 32^2 blocks cells of 8^3 cells at `level` 0 or 1,
-/// the central quarter [1/4, 3/4]^2 refined once if `refine_centre`), at
-/// t_end with dt = h_fine/4 for every grid so that only space differs.
+/// (unit square, periodic, one tree thick in z; `trees`^2 trees of 8^3-cell
+/// blocks at `level`, the central quarter [1/4, 3/4]^2 refined once if
+/// `refine_centre`) at t = 1/32 with dt = 1/512 on every grid, so that only
+/// the space discretisation differs.
 struct TaylorGreenError {
-  double max = 0.0, rms = 0.0, max_centre = 0.0;
+  double max = 0.0, rms = 0.0;
 };
 
-TaylorGreenError taylor_green_error(int level, bool refine_centre) {
-  const double nu = 0.01, t_end = 0.25;
+TaylorGreenError taylor_green_error(int trees, int level, bool refine_centre) {
+  const double nu = 0.01, t_end = 1.0 / 32.0;
+  const int steps = 16;
   ForestSpec spec;
-  spec.trees = {4, 4, 1};
-  spec.tree_length = 0.25;
+  spec.trees = {trees, trees, 1};
+  spec.tree_length = 1.0 / trees;
   spec.level = level;
   spec.periodic = {true, true, true};
   Forest forest(spec);
@@ -169,7 +171,6 @@ TaylorGreenError taylor_green_error(int level, bool refine_centre) {
                 -std::cos(2 * kPi * x.x) * std::sin(2 * kPi * x.y) * decay, 0.0};
   };
   ns.set_velocity([&](const Vec3& x) { return exact(x, 0.0); });
-  const int steps = static_cast<int>(std::lround(t_end / (0.25 / 64.0)));
   for (int s = 0; s < steps; ++s) ns.step(t_end / steps);
   EXPECT_LT(ns.max_divergence(), 1e-7);
   TaylorGreenError e;
@@ -180,36 +181,47 @@ TaylorGreenError taylor_green_error(int level, bool refine_centre) {
     for (int k = 0; k < b; ++k)
       for (int j = 0; j < b; ++j)
         for (int i = 0; i < b; ++i) {
-          const Vec3 x = cell_centre(forest, blk, i, j, k);
-          const Vec3 u = exact(x, ns.time());
+          const Vec3 u = exact(cell_centre(forest, blk, i, j, k), ns.time());
           for (int c = 0; c < 3; ++c) {
             const double err = std::abs(ns.velocity()[c](blk, i, j, k) - u[c]);
             e.max = std::max(e.max, err);
-            if (std::abs(x.x - 0.5) < 0.25 && std::abs(x.y - 0.5) < 0.25) {
-              e.max_centre = std::max(e.max_centre, err);
-            }
             sum += err * err * h * h * h;
           }
           volume += h * h * h;
         }
   }
   e.max = forest.max(e.max);
-  e.max_centre = forest.max(e.max_centre);
   e.rms = std::sqrt(forest.sum(sum) / forest.sum(volume));
   return e;
 }
 
-TEST(FlowRefinedNavierStokes, TaylorGreenWithARefinedCentreLiesBetweenTheCoarseAndFineGrids) {
-  const TaylorGreenError coarse = taylor_green_error(0, false);
-  const TaylorGreenError fine = taylor_green_error(1, false);
-  const TaylorGreenError refined = taylor_green_error(0, true);
+TEST(FlowRefinedNavierStokes, TaylorGreenWithARefinedCentreConvergesAtSecondOrder) {
+  const TaylorGreenError coarse = taylor_green_error(4, 0, false);   // 32^2
+  const TaylorGreenError fine = taylor_green_error(4, 1, false);     // 64^2
+  const TaylorGreenError refined = taylor_green_error(4, 0, true);   // 32^2, 64^2 centre
+  const TaylorGreenError refined2 = taylor_green_error(8, 0, true);  // 64^2, 128^2 centre
   std::printf(
-      "Taylor-Green (nu 0.01, t 0.25, dt = 1/256): max / RMS / max in the centre error: "
-      "32^2 %.3e / %.3e / %.3e, 64^2 %.3e / %.3e / %.3e, 32^2 with 64^2 centre %.3e / %.3e / "
-      "%.3e\n",
-      coarse.max, coarse.rms, coarse.max_centre, fine.max, fine.rms, fine.max_centre, refined.max,
-      refined.rms, refined.max_centre);
-  EXPECT_GT(coarse.rms, 0.0);
+      "Taylor-Green (nu 0.01, t 1/32, dt 1/512), max / RMS error: 32^2 %.3e / %.3e, 64^2 %.3e / "
+      "%.3e, 32^2 + 64^2 centre %.3e / %.3e, 64^2 + 128^2 centre %.3e / %.3e (orders %.2f / "
+      "%.2f)\n",
+      coarse.max, coarse.rms, fine.max, fine.rms, refined.max, refined.rms, refined2.max,
+      refined2.rms, std::log2(refined.max / refined2.max), std::log2(refined.rms / refined2.rms));
+  // Second order on the refined forest, interface included (measured 1.96
+  // for the max, 2.04 for the RMS error).
+  EXPECT_GT(std::log2(refined.max / refined2.max), 1.8);
+  EXPECT_GT(std::log2(refined.rms / refined2.rms), 1.8);
+  // Not better than the uniform coarse grid (issue #7, open): the
+  // approximate projection of the cell-centred velocity is not exact at
+  // coarse-fine faces (the face average of a coarse cell and the mean of the
+  // fine faces across differ by O(h^2) u'', a layer of O(h) divergence whose
+  // O(h^2) pressure correction exceeds the coarse grid's own error; the
+  // exact Taylor-Green field, divergence-free to the last bit on a uniform
+  // grid, is already changed by 1.4e-3 by the first projection). Measured
+  // 7.6x the coarse max error and 3.5x its RMS error; these bounds hold the
+  // measurement so that a regression shows, they are not a target.
+  EXPECT_LT(refined.max, 9.0 * coarse.max);
+  EXPECT_LT(refined.rms, 4.0 * coarse.rms);
+  EXPECT_GT(refined.max, fine.max);
 }
 
 /// The channel of test_navier_stokes.cpp (H = 1, 16 cells across, periodic
@@ -294,10 +306,11 @@ TEST(FlowRefinedNavierStokes, PoiseuilleFlowRateAcrossARefinedBand) {
   // interpolation are exact for it; measured 8e-12 after 3 diffusion times,
   // the decay of the start-up transient and the 1e-10 viscous tolerance).
   EXPECT_LT(forest.max(worst), 1e-10);
-  // The flow rate from cell-centre values is then the midpoint rule, short
-  // by h^2/(2 H^2): 1/512 on the coarse half, 1/2048 on the fine half,
-  // 1.22e-3 in all (measured 1.22e-3).
-  EXPECT_NEAR(flow_rate / exact - 1.0, -0.5 * (1.0 / 512 + 1.0 / 2048), 1e-8);
+  // The flow rate from cell-centre values is then the midpoint rule, high
+  // (the parabola is concave) by h^2/(2 H^2) relative: 1/512 on the coarse
+  // half, 1/2048 on the fine half, 1.2207e-3 in all (measured 1.2207e-3;
+  // the 1e-8 covers the 8e-12 profile error).
+  EXPECT_NEAR(flow_rate / exact - 1.0, 0.5 * (1.0 / 512 + 1.0 / 2048), 1e-8);
   EXPECT_LT(ns.max_divergence(), 1e-8);
 }
 
