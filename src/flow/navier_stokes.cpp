@@ -18,17 +18,15 @@ using Strides = std::array<std::ptrdiff_t, 3>;
 /// Bell-Colella-Glaz upwind value at the lower d-face of cell c (between
 /// c - s_d and c) at t + dt/2 (Bell, Colella & Glaz 1989, as in Basilisk's
 /// bcg.h): the upwind cell value extrapolated by its central slope, a source
-/// term, and transverse upwind corrections with the transverse velocities
-/// `vt` of the upwind cell.
-inline double bcg_face_value(const double* f, const double* src, double un, double dt, double h,
-                             int d, std::ptrdiff_t c, const Strides& s,
-                             const std::array<double, 3>& vt) {
+/// term (`source` = dt/4 (src_c + src_{c-s_d}), src the cell source), and transverse upwind
+/// corrections with the transverse velocities `vt` of the upwind cell.
+inline double bcg_face_value(const double* f, double source, double un, double dt, double h, int d,
+                             std::ptrdiff_t c, const Strides& s, const std::array<double, 3>& vt) {
   const double sign = un > 0.0 ? 1.0 : -1.0;
   const double courant = dt * un / h;
   const std::ptrdiff_t up = un > 0.0 ? c - s[D(d)] : c;
   const double slope = 0.5 * (f[up + s[D(d)]] - f[up - s[D(d)]]);  // h df/dx
-  double value =
-      f[up] + 0.25 * dt * (src[c] + src[c - s[D(d)]]) + 0.5 * sign * (1.0 - sign * courant) * slope;
+  double value = f[up] + source + 0.5 * sign * (1.0 - sign * courant) * slope;
   for (int e = 0; e < 3; ++e) {
     if (e == d) continue;
     const double vn = vt[D(e)];
@@ -68,6 +66,77 @@ inline void for_each_cell(int b, Body&& body) {
       for (int i = 0; i < b; ++i) body(i, j, k);
 }
 
+/// Offset number of the face neighbour across face (d, side).
+std::size_t face_slot(int d, int side) {
+  std::array<int, 3> o{0, 0, 0};
+  o[D(d)] = side == 0 ? -1 : 1;
+  return D(neighbour_slot(o[0], o[1], o[2]));
+}
+
+/// Calls body(c, f) for every cell c of the block's layer beside face (d, side)
+/// and the index f of that face in a face field (c on the lower face, c + s_d
+/// on the upper one).
+template <typename Body>
+void for_face_layer(const BlockLayout& L, int d, int side, Body&& body) {
+  const int b = L.cells;
+  const int e1 = (d + 1) % 3, e2 = (d + 2) % 3;
+  for (int t2 = 0; t2 < b; ++t2)
+    for (int t1 = 0; t1 < b; ++t1) {
+      std::array<int, 3> n{};
+      n[D(d)] = side == 0 ? 0 : b - 1;
+      n[D(e1)] = t1;
+      n[D(e2)] = t2;
+      const std::ptrdiff_t c = L.index(n[0], n[1], n[2]);
+      body(c, side == 0 ? c : c + L.stride(d));
+    }
+}
+
+/// Composite grids, first half of "the fine faces win": every block beside a
+/// coarser face neighbour writes fine_value(blk, d, f) of its faces f on that
+/// block face into its face layer of layers[face], and the exchange carries
+/// them to the coarse block, whose ghost cell there is the mean of the 8 fine
+/// cells behind it: the 4 of the face layer and 4 zeros (the layers are only
+/// ever written in their face layer), so twice the ghost is the mean of the 4
+/// fine faces (the trick of Multigrid::match_fluxes).
+template <typename FineValue>
+void fine_faces_to_coarse(const Forest& forest, std::array<BlockField, 6>& layers,
+                          FineValue&& fine_value) {
+  const BlockLayout L = layers[0].layout();
+  forest.for_each_block([&](int blk) {
+    const Block& block = forest.block(blk);
+    for (int d = 0; d < 3; ++d)
+      for (int side = 0; side < 2; ++side) {
+        if (block.neighbours[face_slot(d, side)].jump != LevelJump::Coarser) continue;
+        double* layer = layers[D(face_index(d, side))].block(blk);
+        for_face_layer(L, d, side, [&](std::ptrdiff_t c, std::ptrdiff_t f) {
+          layer[c] = fine_value(blk, d, f);
+        });
+      }
+  });
+  std::array<BlockField*, 6> fields{};
+  for (std::size_t f = 0; f < 6; ++f) fields[f] = &layers[f];
+  forest.exchange(fields, 1, true);
+}
+
+/// Second half: for a block, calls use(d, f, mean) for every face f of it on a
+/// block face whose neighbour is finer, with the mean of the 4 fine faces.
+template <typename Use>
+void for_coarse_faces(const Forest& forest, const std::array<BlockField, 6>& layers, int blk,
+                      Use&& use) {
+  const BlockLayout L = layers[0].layout();
+  const Block& block = forest.block(blk);
+  for (int d = 0; d < 3; ++d)
+    for (int side = 0; side < 2; ++side) {
+      if (block.neighbours[face_slot(d, side)].jump != LevelJump::Finer) continue;
+      // The fine blocks wrote under their own face: the opposite one.
+      const double* fine = layers[D(face_index(d, 1 - side))].block(blk);
+      const std::ptrdiff_t beyond = side == 0 ? -L.stride(d) : L.stride(d);
+      for_face_layer(L, d, side, [&](std::ptrdiff_t c, std::ptrdiff_t f) {
+        use(d, f, 2.0 * fine[c + beyond]);
+      });
+    }
+}
+
 std::array<BcKind, 6> velocity_kinds(const std::array<FlowBoundary, 6>& bcs) {
   std::array<BcKind, 6> kinds{};
   for (std::size_t f = 0; f < 6; ++f) {
@@ -104,12 +173,6 @@ std::array<BcKind, 6> pressure_kinds(const std::array<FlowBoundary, 6>& bcs) {
 
 const std::array<FlowBoundary, 6>& checked(const Forest& forest,
                                            const std::array<FlowBoundary, 6>& bcs) {
-  // The advection and projection here are written for one level: on a refined forest the
-  // coarse-fine faces would be neither conservative nor second order (issue #7).
-  if (!forest.uniform()) {
-    throw std::invalid_argument(
-        "Navier-Stokes on a forest with several refinement levels is not available yet");
-  }
   for (int d = 0; d < 3; ++d) {
     for (int side = 0; side < 2; ++side) {
       const FlowBoundary& bc = bcs[D(face_index(d, side))];
@@ -172,6 +235,11 @@ NavierStokes::NavierStokes(const Forest& forest, const std::array<FlowBoundary, 
     }
   }
   pressure_bc_.kind = pressure_kinds(boundaries_);
+  composite_ = !forest.uniform();
+  if (composite_) {
+    for (auto& layer : interface_) layer = BlockField(n, b);  // zero, see fine_faces_to_coarse
+    face_flux_ = make_vector_field(n, b);
+  }
 }
 
 void NavierStokes::set_velocity(const std::function<Vec3(const Vec3&)>& u0, double time) {
@@ -252,6 +320,12 @@ void NavierStokes::set_viscosity(const std::function<double(const Vec3&)>& mu) {
 }
 
 void NavierStokes::set_solid(const std::function<bool(const Vec3&)>& solid) {
+  // Closed faces (beta = 0) at a coarse-fine face have no matched flux in the
+  // multigrid, and the no-slip closure there is not written for two levels.
+  if (composite_) {
+    throw std::invalid_argument(
+        "navier-stokes: solid cells on a forest with several levels are not available yet");
+  }
   const int b = forest_.block_cells();
   bool any = false;
   for (int blk = 0; blk < forest_.local_blocks(); ++blk) {
@@ -355,8 +429,37 @@ void NavierStokes::set_boundary_faces(FaceField& uf) const {
 
 void NavierStokes::fill_face_ghosts(FaceField& uf) {
   BlockField* fields[] = {&uf[0], &uf[1], &uf[2]};
+  // The upper faces (slot b, in the ghost layer) are the block's own: the
+  // exchange copies the same face from a neighbour of the same level, but
+  // across a level jump it would interpolate face values as if they were
+  // cells. Composite grids keep them.
+  std::vector<double> upper;
+  const int b = forest_.block_cells();
+  const BlockLayout L = uf[0].layout();
+  auto for_upper_faces = [&](auto&& body) {
+    std::size_t at = 0;
+    for (int blk = 0; blk < forest_.local_blocks(); ++blk)
+      for (int d = 0; d < 3; ++d)
+        for_face_layer(
+            L, d, 1, [&](std::ptrdiff_t, std::ptrdiff_t f) { body(uf[D(d)].block(blk)[f], at++); });
+  };
+  if (composite_) {
+    upper.resize(static_cast<std::size_t>(forest_.local_blocks()) * 3 * D(b) * D(b));
+    for_upper_faces([&](double& face, std::size_t at) { upper[at] = face; });
+  }
   forest_.exchange(fields, kGhost);
   fill_face_field_ghosts(forest_, uf, kGhost);
+  if (composite_) for_upper_faces([&](double& face, std::size_t at) { face = upper[at]; });
+}
+
+void NavierStokes::synchronise_coarse_faces(FaceField& uf) {
+  if (!composite_) return;
+  fine_faces_to_coarse(forest_, interface_,
+                       [&](int blk, int d, std::ptrdiff_t f) { return uf[D(d)].block(blk)[f]; });
+  forest_.for_each_block([&](int blk) {
+    for_coarse_faces(forest_, interface_, blk,
+                     [&](int d, std::ptrdiff_t f, double mean) { uf[D(d)].block(blk)[f] = mean; });
+  });
 }
 
 double NavierStokes::stable_dt() const {
@@ -394,7 +497,7 @@ void NavierStokes::predict_face_velocity(double dt) {
         const double un = 0.5 * (f[c] + f[c - s[D(d)]]);
         const std::ptrdiff_t up = un > 0.0 ? c - s[D(d)] : c;
         const std::array<double, 3> vt{u[0][up], u[1][up], u[2][up]};
-        out[c] = bcg_face_value(f, src, un, dt, h, d, c, s, vt);
+        out[c] = bcg_face_value(f, 0.25 * dt * (src[c] + src[c - s[D(d)]]), un, dt, h, d, c, s, vt);
       });
     }
   });
@@ -403,56 +506,125 @@ void NavierStokes::predict_face_velocity(double dt) {
 }
 
 void NavierStokes::advect(double dt) {
+  for (int comp = 0; comp < 3; ++comp) {
+    advect_field(u_[D(comp)], &g_[D(comp)], velocity_bc_[D(comp)].kind, scratch_[D(comp)], dt);
+  }
+}
+
+void NavierStokes::advect_scalar(BlockField& c, double dt) {
+  fill_scalar_neumann(c, kGhost);
+  fill_face_ghosts(uf_);
+  set_boundary_faces(uf_);
+  BlockField out(forest_.local_blocks(), forest_.block_cells());
+  advect_field(c, nullptr, uniform_kinds(forest_, BcKind::Neumann), out, dt);
   const int b = forest_.block_cells();
-  const BlockLayout L = u_[0].layout();
+  forest_.for_each_block([&](int blk) {
+    for_each_cell(b, [&](int i, int j, int k) { c(blk, i, j, k) = out(blk, i, j, k); });
+  });
+}
+
+void NavierStokes::advect_field(const BlockField& field, const BlockField* source,
+                                const std::array<BcKind, 6>& kinds, BlockField& out, double dt) {
+  const int b = forest_.block_cells();
+  const BlockLayout L = field.layout();
   const Strides s{L.stride(0), L.stride(1), L.stride(2)};
+  // BCG value times the face velocity on face c (number n along d) of a
+  // block; dirichlet_lo/hi: the block's d-faces 0/b carry a boundary value.
+  auto face_flux = [&](int blk, int d, std::ptrdiff_t c, int n, bool dirichlet_lo,
+                       bool dirichlet_hi) {
+    const double h = forest_.block(blk).length / b;
+    const double* f = field.block(blk);
+    const double un = uf_[D(d)].block(blk)[c];
+    double value;
+    if (n == 0 && dirichlet_lo) {
+      // The boundary value itself, from the quadratic ghost closure.
+      value = (3.0 * f[c - s[D(d)]] + 6.0 * f[c] - f[c + s[D(d)]]) / 8.0;
+    } else if (n == b && dirichlet_hi) {
+      value = (3.0 * f[c] + 6.0 * f[c - s[D(d)]] - f[c - 2 * s[D(d)]]) / 8.0;
+    } else {
+      const std::ptrdiff_t up = un > 0.0 ? c - s[D(d)] : c;
+      std::array<double, 3> vt{};
+      for (int e = 0; e < 3; ++e) {
+        const double* ufe = uf_[D(e)].block(blk);
+        vt[D(e)] = 0.5 * (ufe[up] + ufe[up + s[D(e)]]);
+      }
+      const double src =
+          source ? 0.25 * dt * (source->block(blk)[c] + source->block(blk)[c - s[D(d)]]) : 0.0;
+      value = bcg_face_value(f, src, un, dt, h, d, c, s, vt);
+    }
+    return value * un;
+  };
+  // Fluxes of all faces 0..b of one block along d into fl.
+  auto block_fluxes = [&](int blk, int d, double* fl) {
+    const Block& block = forest_.block(blk);
+    const bool dirichlet_lo =
+        on_boundary(block, d, 0) && kinds[D(face_index(d, 0))] == BcKind::Dirichlet;
+    const bool dirichlet_hi =
+        on_boundary(block, d, 1) && kinds[D(face_index(d, 1))] == BcKind::Dirichlet;
+    for_each_face(b, d, [&](int i, int j, int k) {
+      const std::ptrdiff_t c = L.index(i, j, k);
+      const int n = d == 0 ? i : (d == 1 ? j : k);
+      fl[c] = face_flux(blk, d, c, n, dirichlet_lo, dirichlet_hi);
+    });
+  };
+  // out = f - dt div(flux) / h on one block.
+  auto update = [&](int blk, const std::array<const double*, 3>& flux) {
+    const double h = forest_.block(blk).length / b;
+    const double* f = field.block(blk);
+    double* o = out.block(blk);
+    for_each_cell(b, [&](int i, int j, int k) {
+      const std::ptrdiff_t c = L.index(i, j, k);
+      double div = 0.0;
+      for (int d = 0; d < 3; ++d) div += flux[D(d)][c + s[D(d)]] - flux[D(d)][c];
+      o[c] = f[c] - dt * div / h;
+    });
+  };
+  if (!composite_) {
+    forest_.for_each_block([&](int blk) {
+      // Face fluxes of one block, per direction: scratch kept per thread.
+      thread_local std::array<std::vector<double>, 3> flux;
+      for (int d = 0; d < 3; ++d) {
+        flux[D(d)].resize(static_cast<std::size_t>(L.size()));
+        block_fluxes(blk, d, flux[D(d)].data());
+      }
+      update(blk, {flux[0].data(), flux[1].data(), flux[2].data()});
+    });
+    return;
+  }
+  // Composite grids: each face's flux is computed once and used by both
+  // cells beside it (conservation to round-off, §4.3.1). Two blocks of one
+  // level would otherwise each evaluate their shared face with their own
+  // ghosts, which differ where a coarser block lies beyond an edge (face
+  // velocities interpolated as if they were cells): the lower block's face 0
+  // wins and reaches the upper block's slot b by the exchange. At coarse-fine
+  // faces the fine faces win: the coarse face takes the mean of the 4.
+  forest_.for_each_block([&](int blk) {
+    for (int d = 0; d < 3; ++d) block_fluxes(blk, d, face_flux_[D(d)].block(blk));
+  });
+  fine_faces_to_coarse(forest_, interface_, [&](int blk, int d, std::ptrdiff_t f) {
+    return face_flux_[D(d)].block(blk)[f];
+  });
+  BlockField* fluxes[] = {&face_flux_[0], &face_flux_[1], &face_flux_[2]};
+  forest_.exchange(fluxes, 1, true);
   forest_.for_each_block([&](int blk) {
     const Block& block = forest_.block(blk);
-    const double h = block.length / b;
-    const std::array<const double*, 3> uf{uf_[0].block(blk), uf_[1].block(blk), uf_[2].block(blk)};
-    // Face fluxes of one block, per direction: scratch kept per thread.
-    thread_local std::array<std::vector<double>, 3> flux;
-    for (auto& fl : flux) fl.resize(static_cast<std::size_t>(L.size()));
-    for (int comp = 0; comp < 3; ++comp) {
-      const double* f = u_[D(comp)].block(blk);
-      const double* src = g_[D(comp)].block(blk);
-      for (int d = 0; d < 3; ++d) {
-        const bool dirichlet_lo =
-            on_boundary(block, d, 0) &&
-            velocity_bc_[D(comp)].kind[D(face_index(d, 0))] == BcKind::Dirichlet;
+    for (int d = 0; d < 3; ++d) {
+      double* fl = face_flux_[D(d)].block(blk);
+      const Neighbour& upper = block.neighbours[face_slot(d, 1)];
+      // The exchange only brings a same-level neighbour's face 0; a domain
+      // boundary or a coarser neighbour leaves slot b to this block.
+      if (upper.link == Link::Boundary || upper.jump == LevelJump::Coarser) {
         const bool dirichlet_hi =
-            on_boundary(block, d, 1) &&
-            velocity_bc_[D(comp)].kind[D(face_index(d, 1))] == BcKind::Dirichlet;
-        double* fl = flux[D(d)].data();
-        for_each_face(b, d, [&](int i, int j, int k) {
-          const std::ptrdiff_t c = L.index(i, j, k);
-          const double un = uf[D(d)][c];
-          const int n = d == 0 ? i : (d == 1 ? j : k);
-          double value;
-          if (n == 0 && dirichlet_lo) {
-            // The boundary value itself, from the quadratic ghost closure.
-            value = (3.0 * f[c - s[D(d)]] + 6.0 * f[c] - f[c + s[D(d)]]) / 8.0;
-          } else if (n == b && dirichlet_hi) {
-            value = (3.0 * f[c] + 6.0 * f[c - s[D(d)]] - f[c - 2 * s[D(d)]]) / 8.0;
-          } else {
-            const std::ptrdiff_t up = un > 0.0 ? c - s[D(d)] : c;
-            std::array<double, 3> vt{};
-            for (int e = 0; e < 3; ++e) vt[D(e)] = 0.5 * (uf[D(e)][up] + uf[D(e)][up + s[D(e)]]);
-            value = bcg_face_value(f, src, un, dt, h, d, c, s, vt);
-          }
-          fl[c] = value * un;
+            upper.link == Link::Boundary && kinds[D(face_index(d, 1))] == BcKind::Dirichlet;
+        for_face_layer(L, d, 1, [&](std::ptrdiff_t, std::ptrdiff_t f) {
+          fl[f] = face_flux(blk, d, f, b, false, dirichlet_hi);
         });
       }
-      double* out = scratch_[D(comp)].block(blk);
-      for_each_cell(b, [&](int i, int j, int k) {
-        const std::ptrdiff_t c = L.index(i, j, k);
-        double div = 0.0;
-        for (int d = 0; d < 3; ++d)
-          div += flux[D(d)][static_cast<std::size_t>(c + s[D(d)])] -
-                 flux[D(d)][static_cast<std::size_t>(c)];
-        out[c] = f[c] - dt * div / h;
-      });
     }
+    for_coarse_faces(forest_, interface_, blk, [&](int d, std::ptrdiff_t face, double mean) {
+      face_flux_[D(d)].block(blk)[face] = mean;
+    });
+    update(blk, {face_flux_[0].block(blk), face_flux_[1].block(blk), face_flux_[2].block(blk)});
   });
 }
 
@@ -467,6 +639,12 @@ void NavierStokes::update_viscous_coefficients(double dt) {
       });
     }
     variable_viscosity_ = forest_.max(hi) > -forest_.max(-lo);
+    // The explicit grad u^T stress is not flux-matched at coarse-fine faces.
+    if (variable_viscosity_ && composite_) {
+      throw std::invalid_argument(
+          "navier-stokes: variable viscosity on a forest with several levels is not available "
+          "yet");
+    }
   }
   const int n = forest_.local_blocks();
   const int b = forest_.block_cells();
@@ -624,6 +802,9 @@ MultigridReport NavierStokes::project(BlockField& phi) {
   const int b = forest_.block_cells();
   const BlockLayout L = phi.layout();
   BlockField& rhs = scratch_[0];
+  // Composite grids: the divergence of a coarse cell beside finer blocks
+  // takes the fine faces' flux (their mean), as the composite operator does.
+  synchronise_coarse_faces(uf_);
   forest_.for_each_block([&](int blk) {
     const double h = forest_.block(blk).length / b;
     for_each_cell(b, [&](int i, int j, int k) {
@@ -654,6 +835,11 @@ MultigridReport NavierStokes::project(BlockField& phi) {
          << report.rhs_norm << ", tolerance " << options_.pressure.tolerance;
     throw SimulationError(what.str());
   }
+  // Composite grids: the ghosts of phi as the composite operator sees them
+  // (quadratic interpolation in fine ghosts, matched fluxes in coarse ones),
+  // so that the correction below subtracts exactly the fluxes whose
+  // divergence the multigrid drove to its residual.
+  if (composite_) pressure_mg_.residual(phi, rhs, pressure_bc_, scratch_[2]);
   forest_.for_each_block([&](int blk) {
     const double h = forest_.block(blk).length / b;
     const double* pb = phi.block(blk);
@@ -667,6 +853,9 @@ MultigridReport NavierStokes::project(BlockField& phi) {
       });
     }
   });
+  // The matched coarse ghosts already give the mean fine correction; this
+  // makes the coarse faces the fine faces' mean to the last bit.
+  synchronise_coarse_faces(uf_);
   return report;
 }
 

@@ -24,6 +24,17 @@
 // The term div(mu grad u^T) vanishes for uniform mu; for variable mu it is
 // added explicitly (with u^n) to the right-hand side of the viscous step.
 // Face viscosities are harmonic means of the two cells.
+//
+// Statically refined forests (issue #7, second milestone): blocks one level
+// apart across faces. At a coarse-fine face the fine faces win: the coarse
+// block's face value (face velocity, advective flux, projection gradient) is
+// the mean of the 4 fine ones across it, so that the coarse cell's flux is
+// the sum of the fine fluxes (conservation) and the projection, which solves
+// the composite Poisson problem of Multigrid (flux matching), leaves every
+// cell, coarse ones beside the interface included, divergence-free to the
+// solver's residual. One dt for all levels (no subcycling), from the CFL
+// condition on the finest cells. Not available there yet: solid masks,
+// variable viscosity (the explicit grad u^T stress is not flux-matched).
 
 #include <array>
 #include <cstdint>
@@ -119,6 +130,10 @@ class NavierStokes {
   [[nodiscard]] double max_divergence() const;
   /// |curl u| at cell centres (1/s), central differences.
   [[nodiscard]] BlockField vorticity_magnitude();
+  /// Advects a passive scalar by dt with the current face velocity uf (the
+  /// BCG fluxes of step 2, no source, zero-gradient ghosts at the domain
+  /// boundary): conservative on every forest, coarse-fine faces included.
+  void advect_scalar(BlockField& c, double dt);
   /// Fills the ghost cells of the velocity (width 2) with the boundary conditions.
   void fill_velocity_ghosts(VectorField& u, int width = kGhost);
   /// The last multigrid report of the final projection.
@@ -127,6 +142,14 @@ class NavierStokes {
  private:
   void predict_face_velocity(double dt);
   void advect(double dt);
+  /// out = f - dt div(uf f_{n+1/2}), BCG face values with the cell source
+  /// `source` (nullptr: none) and the boundary kinds of f (Dirichlet faces take
+  /// the boundary value); f's ghosts must be filled.
+  void advect_field(const BlockField& f, const BlockField* source,
+                    const std::array<BcKind, 6>& kinds, BlockField& out, double dt);
+  /// Composite grids: the coarse block's faces at coarse-fine faces get the
+  /// mean of the 4 fine faces across (the fine faces win).
+  void synchronise_coarse_faces(FaceField& uf);
   void viscous_step(double dt, StepReport& report);
   void face_average_plus_acceleration(double dt);
   MultigridReport project(BlockField& phi);
@@ -166,6 +189,11 @@ class NavierStokes {
   FaceField
       open_;  ///< 1 on faces between two fluid cells (or fluid and the domain boundary), else 0
   MultigridReport pressure_report_;
+  bool composite_ = false;  ///< blocks at more than one level
+  /// Composite grids: per block face, the fine faces' values travelling to
+  /// the coarse block (face layer of the fine block, see fine_faces_to_coarse).
+  std::array<BlockField, 6> interface_;
+  FaceField face_flux_;  ///< composite grids: advective fluxes of all faces
 };
 
 }  // namespace sanguis::flow

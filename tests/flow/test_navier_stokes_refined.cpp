@@ -1,0 +1,345 @@
+// Navier-Stokes on statically refined forests (issue #7, second milestone):
+// exact divergence on every cell after a projection, a passive tracer
+// conserved to round-off across coarse-fine faces, Taylor-Green with a
+// refined centre against the uniform coarse and fine grids, Couette exact
+// and Poiseuille across a refined band, the time step from the finest cells.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "adapt_problems.hpp"
+#include "flow/navier_stokes.hpp"
+#include "poisson_problems.hpp"
+
+namespace sanguis::flow {
+namespace {
+
+using testing::cell_centre;
+using testing::kPi;
+using testing::refine_where;
+
+std::array<FlowBoundary, 6> all_periodic() {
+  std::array<FlowBoundary, 6> bcs{};
+  for (auto& bc : bcs) bc.kind = FlowBoundaryKind::Periodic;
+  return bcs;
+}
+
+/// Channel periodic in x and z, walls at y = 0 and y = H (the upper one moving with `lid`).
+std::array<FlowBoundary, 6> channel(double lid) {
+  auto bcs = all_periodic();
+  bcs[face_index(1, 0)].kind = FlowBoundaryKind::Wall;
+  bcs[face_index(1, 1)].kind = FlowBoundaryKind::Wall;
+  bcs[face_index(1, 1)].wall_velocity = {lid, 0.0, 0.0};
+  return bcs;
+}
+
+/// A deterministic rough field in [-1, 1] (no structure the projection could exploit).
+double rough(const Vec3& x, int seed) {
+  const double v = std::sin(12.9898 * x.x + 78.233 * x.y + 37.719 * x.z + 4.1 * seed) * 43758.5453;
+  return 2.0 * (v - std::floor(v)) - 1.0;
+}
+
+/// Periodic unit cube, 16^3 cells in 8 blocks, the two blocks at x, y < 1/2
+/// refined: coarse-fine faces along x and y, edges and corners included.
+void refine_two_blocks(Forest& forest) {
+  refine_where(forest, [](const Vec3& c) { return c.x < 0.5 && c.y < 0.5; });
+}
+
+ForestSpec periodic_cube() {
+  ForestSpec spec;
+  spec.level = 1;
+  spec.periodic = {true, true, true};
+  return spec;
+}
+
+/// Total amount sum(c V) over all cells (all ranks).
+double total(const Forest& forest, const BlockField& c) {
+  const int b = forest.block_cells();
+  double sum = 0.0;
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    const double h = forest.block(blk).length / b;
+    double block_sum = 0.0;
+    for (int k = 0; k < b; ++k)
+      for (int j = 0; j < b; ++j)
+        for (int i = 0; i < b; ++i) block_sum += c(blk, i, j, k);
+    sum += block_sum * h * h * h;
+  }
+  return forest.sum(sum);
+}
+
+TEST(FlowRefinedNavierStokes, ProjectionLeavesEveryCellDivergenceFree) {
+  Forest forest(periodic_cube());
+  refine_two_blocks(forest);
+  ASSERT_EQ(forest.max_level(), forest.min_level() + 1);
+  NavierStokesOptions options;
+  options.pressure.tolerance = 1e-13;
+  options.pressure.max_cycles = 100;
+  NavierStokes ns(forest, all_periodic(), Fluid{1.0, 0.0}, options);
+  ns.set_velocity([](const Vec3& x) { return Vec3{rough(x, 1), rough(x, 2), rough(x, 3)}; });
+  ASSERT_TRUE(ns.last_pressure_report().converged);
+  // The velocities are O(1) on cells of h = 1/32: an unprojected field has
+  // |div uf| ~ 1/h = 32. The discrete divergence of every cell, coarse cells
+  // beside coarse-fine faces included, equals the composite multigrid's
+  // residual (driven to 1e-13 of the rhs or the 1e-12 max|uf|/h floor of
+  // project()): 1e-9 leaves a factor ~30 for the max against the RMS norm.
+  const double divergence = ns.max_divergence();
+  std::printf("refined projection: max |div uf| %.2e after %d V-cycles\n", divergence,
+              ns.last_pressure_report().cycles);
+  EXPECT_LT(divergence, 1e-9);
+}
+
+TEST(FlowRefinedNavierStokes, TracerAndFluxesAreConservedAcrossCoarseFineFaces) {
+  Forest forest(periodic_cube());
+  refine_two_blocks(forest);
+  NavierStokesOptions options;
+  options.pressure.tolerance = 1e-10;
+  options.viscous.tolerance = 1e-10;
+  NavierStokes ns(forest, all_periodic(), Fluid{1.0, 0.01}, options);
+  // A 3D flow through the coarse-fine faces (ABC flow), a tracer blob on the interface.
+  ns.set_velocity([](const Vec3& x) {
+    const double k = 2 * kPi;
+    return Vec3{std::sin(k * x.z) + std::cos(k * x.y), std::sin(k * x.x) + std::cos(k * x.z),
+                std::sin(k * x.y) + std::cos(k * x.x)};
+  });
+  BlockField tracer(forest.local_blocks(), forest.block_cells());
+  testing::fill_cells(forest, tracer, [](const Vec3& x) {
+    const double r2 =
+        (x.x - 0.5) * (x.x - 0.5) + (x.y - 0.3) * (x.y - 0.3) + (x.z - 0.5) * (x.z - 0.5);
+    return 1.0 + std::exp(-r2 / 0.02);
+  });
+  const double before = total(forest, tracer);
+  double worst_divergence = 0.0;
+  for (int s = 0; s < 40; ++s) {
+    const double dt = ns.stable_dt();
+    ns.step(dt);
+    ns.advect_scalar(tracer, dt);
+    worst_divergence = std::max(worst_divergence, ns.max_divergence());
+  }
+  const double drift = std::abs(total(forest, tracer) / before - 1.0);
+  std::printf("refined tracer: relative change of the total over 40 steps %.2e, max |div| %.2e\n",
+              drift, worst_divergence);
+  // Each step adds and removes the same face fluxes: only round-off of the
+  // sums (~1e-16 per step on O(1) values, 6000 cells) remains.
+  EXPECT_LT(drift, 1e-13);
+  EXPECT_LT(worst_divergence, 1e-6);  // projection tolerance 1e-10 of |div| ~ 1/h
+}
+
+TEST(FlowRefinedNavierStokes, TimeStepFollowsTheCflConditionOnTheFinestCells) {
+  Forest forest(periodic_cube());
+  refine_two_blocks(forest);
+  NavierStokesOptions options;
+  options.cfl = 0.8;
+  NavierStokes ns(forest, all_periodic(), Fluid{1.0, 0.0}, options);
+  ns.set_velocity([](const Vec3&) { return Vec3{1.0, 0.0, 0.0}; });
+  // A uniform flow moves as fast on the coarse cells (h = 1/16) as on the
+  // fine ones (h = 1/32): the fine cells set dt = cfl h_fine / |u| = 0.025.
+  EXPECT_NEAR(ns.stable_dt(), 0.8 / 32.0, 1e-14);
+}
+
+TEST(FlowRefinedNavierStokes, TwoThreadsGiveTheOneThreadAnswerBitForBit) {
+  auto run = [](int threads) {
+    ForestSpec spec = periodic_cube();
+    spec.threads = threads;
+    Forest forest(spec);
+    refine_two_blocks(forest);
+    NavierStokes ns(forest, all_periodic(), Fluid{1.0, 0.01});
+    ns.set_velocity([](const Vec3& x) { return Vec3{rough(x, 1), rough(x, 2), rough(x, 3)}; });
+    BlockField tracer(forest.local_blocks(), forest.block_cells());
+    testing::fill_cells(forest, tracer, [](const Vec3& x) { return rough(x, 4); });
+    for (int s = 0; s < 3; ++s) {
+      ns.step(0.005);
+      ns.advect_scalar(tracer, 0.005);
+    }
+    std::vector<double> values(tracer.raw().begin(), tracer.raw().end());
+    for (const auto& u : ns.velocity()) values.insert(values.end(), u.raw().begin(), u.raw().end());
+    return values;
+  };
+  const auto one = run(1);
+  const auto two = run(2);
+  ASSERT_EQ(one.size(), two.size());
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < one.size(); ++i) differ += one[i] != two[i] ? 1 : 0;
+  EXPECT_EQ(differ, 0u);  // every block's work is independent of the thread doing it
+}
+
+/// Max and RMS (volume-weighted) velocity error of the Taylor-Green vortex
+/// (unit square, periodic, one tree thick in z; `trees`^2 trees of 8^3-cell
+/// blocks at `level`, the central quarter [1/4, 3/4]^2 refined once if
+/// `refine_centre`) at t = 1/32 with dt = 1/512 on every grid, so that only
+/// the space discretisation differs.
+struct TaylorGreenError {
+  double max = 0.0, rms = 0.0;
+};
+
+TaylorGreenError taylor_green_error(int trees, int level, bool refine_centre) {
+  const double nu = 0.01, t_end = 1.0 / 32.0;
+  const int steps = 16;
+  ForestSpec spec;
+  spec.trees = {trees, trees, 1};
+  spec.tree_length = 1.0 / trees;
+  spec.level = level;
+  spec.periodic = {true, true, true};
+  Forest forest(spec);
+  if (refine_centre) {
+    refine_where(forest, [](const Vec3& c) {
+      return std::abs(c.x - 0.5) < 0.25 && std::abs(c.y - 0.5) < 0.25;
+    });
+  }
+  NavierStokesOptions options;
+  options.viscous_theta = 0.5;
+  options.pressure.tolerance = 1e-10;
+  options.viscous.tolerance = 1e-10;
+  NavierStokes ns(forest, all_periodic(), Fluid{1.0, nu}, options);
+  auto exact = [nu](const Vec3& x, double t) {
+    const double decay = std::exp(-8.0 * kPi * kPi * nu * t);
+    return Vec3{std::sin(2 * kPi * x.x) * std::cos(2 * kPi * x.y) * decay,
+                -std::cos(2 * kPi * x.x) * std::sin(2 * kPi * x.y) * decay, 0.0};
+  };
+  ns.set_velocity([&](const Vec3& x) { return exact(x, 0.0); });
+  for (int s = 0; s < steps; ++s) ns.step(t_end / steps);
+  EXPECT_LT(ns.max_divergence(), 1e-7);
+  TaylorGreenError e;
+  double sum = 0.0, volume = 0.0;
+  const int b = forest.block_cells();
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    const double h = forest.block(blk).length / b;
+    for (int k = 0; k < b; ++k)
+      for (int j = 0; j < b; ++j)
+        for (int i = 0; i < b; ++i) {
+          const Vec3 u = exact(cell_centre(forest, blk, i, j, k), ns.time());
+          for (int c = 0; c < 3; ++c) {
+            const double err = std::abs(ns.velocity()[c](blk, i, j, k) - u[c]);
+            e.max = std::max(e.max, err);
+            sum += err * err * h * h * h;
+          }
+          volume += h * h * h;
+        }
+  }
+  e.max = forest.max(e.max);
+  e.rms = std::sqrt(forest.sum(sum) / forest.sum(volume));
+  return e;
+}
+
+TEST(FlowRefinedNavierStokes, TaylorGreenWithARefinedCentreConvergesAtSecondOrder) {
+  const TaylorGreenError coarse = taylor_green_error(4, 0, false);   // 32^2
+  const TaylorGreenError fine = taylor_green_error(4, 1, false);     // 64^2
+  const TaylorGreenError refined = taylor_green_error(4, 0, true);   // 32^2, 64^2 centre
+  const TaylorGreenError refined2 = taylor_green_error(8, 0, true);  // 64^2, 128^2 centre
+  std::printf(
+      "Taylor-Green (nu 0.01, t 1/32, dt 1/512), max / RMS error: 32^2 %.3e / %.3e, 64^2 %.3e / "
+      "%.3e, 32^2 + 64^2 centre %.3e / %.3e, 64^2 + 128^2 centre %.3e / %.3e (orders %.2f / "
+      "%.2f)\n",
+      coarse.max, coarse.rms, fine.max, fine.rms, refined.max, refined.rms, refined2.max,
+      refined2.rms, std::log2(refined.max / refined2.max), std::log2(refined.rms / refined2.rms));
+  // Second order on the refined forest, interface included (measured 1.96
+  // for the max, 2.04 for the RMS error).
+  EXPECT_GT(std::log2(refined.max / refined2.max), 1.8);
+  EXPECT_GT(std::log2(refined.rms / refined2.rms), 1.8);
+  // Not better than the uniform coarse grid (issue #7, open): the
+  // approximate projection of the cell-centred velocity is not exact at
+  // coarse-fine faces (the face average of a coarse cell and the mean of the
+  // fine faces across differ by O(h^2) u'', a layer of O(h) divergence whose
+  // O(h^2) pressure correction exceeds the coarse grid's own error; the
+  // exact Taylor-Green field, divergence-free to the last bit on a uniform
+  // grid, is already changed by 1.4e-3 by the first projection). Measured
+  // 7.6x the coarse max error and 3.5x its RMS error; these bounds hold the
+  // measurement so that a regression shows, they are not a target.
+  EXPECT_LT(refined.max, 9.0 * coarse.max);
+  EXPECT_LT(refined.rms, 4.0 * coarse.rms);
+  EXPECT_GT(refined.max, fine.max);
+}
+
+/// The channel of test_navier_stokes.cpp (H = 1, 16 cells across, periodic
+/// in x and z over 1/2) with its lower half refined: a coarse-fine face
+/// across the flow at y = 1/2.
+ForestSpec channel_spec() {
+  ForestSpec spec;
+  spec.trees = {1, 2, 1};
+  spec.tree_length = 0.5;
+  spec.periodic = {true, false, true};
+  return spec;
+}
+
+void refine_lower_half(Forest& forest) {
+  refine_where(forest, [](const Vec3& c) { return c.y < 0.5; });
+}
+
+TEST(FlowRefinedNavierStokes, CouetteAcrossARefinedBandIsExactlyLinear) {
+  Forest forest(channel_spec());
+  refine_lower_half(forest);
+  ASSERT_EQ(forest.max_level(), 1);
+  const double U = 1.0, H = 1.0, rho = 1.0, mu = 100.0, dt = 1e-3;
+  NavierStokesOptions options;
+  options.pressure.tolerance = 1e-10;
+  options.viscous.tolerance = 1e-10;
+  NavierStokes ns(forest, channel(U), Fluid{rho, mu}, options);
+  ns.set_velocity([](const Vec3&) { return Vec3{}; });
+  for (int s = 0; s < 500; ++s) ns.step(dt);  // 50 diffusion times H^2 rho / mu
+  double worst = 0.0, cross = 0.0;
+  const int b = forest.block_cells();
+  for (int blk = 0; blk < forest.local_blocks(); ++blk)
+    for (int k = 0; k < b; ++k)
+      for (int j = 0; j < b; ++j)
+        for (int i = 0; i < b; ++i) {
+          const double y = cell_centre(forest, blk, i, j, k).y;
+          worst = std::max(worst, std::abs(ns.velocity()[0](blk, i, j, k) - U * y / H));
+          cross = std::max({cross, std::abs(ns.velocity()[1](blk, i, j, k)),
+                            std::abs(ns.velocity()[2](blk, i, j, k))});
+        }
+  worst = forest.max(worst);
+  cross = forest.max(cross);
+  std::printf("Couette across a refined band: max deviation %.2e, cross flow %.2e\n", worst, cross);
+  // A linear profile is a discrete steady state on both levels: the
+  // quadratic ghost interpolation and the flux matching are exact for it.
+  // The same bounds as the uniform test (viscous solves to 1e-10).
+  EXPECT_LT(worst, 1e-9);
+  EXPECT_LT(cross, 1e-10);
+}
+
+TEST(FlowRefinedNavierStokes, PoiseuilleFlowRateAcrossARefinedBand) {
+  Forest forest(channel_spec());
+  refine_lower_half(forest);
+  const double G = 2.0, mu = 1.0, H = 1.0;
+  NavierStokesOptions options;
+  options.dt_max = 0.01;
+  options.viscous.tolerance = 1e-10;
+  NavierStokes ns(forest, channel(0.0), Fluid{1.0, mu}, options);
+  ns.set_velocity([](const Vec3&) { return Vec3{}; });
+  ns.set_body_force([G](const Vec3&) { return Vec3{G, 0.0, 0.0}; });
+  for (int s = 0; s < 300; ++s) ns.step(ns.stable_dt());  // 3 diffusion times
+  const int b = forest.block_cells();
+  double flux = 0.0, worst = 0.0;
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    const double h = forest.block(blk).length / b;
+    for (int k = 0; k < b; ++k)
+      for (int j = 0; j < b; ++j)
+        for (int i = 0; i < b; ++i) {
+          const double y = cell_centre(forest, blk, i, j, k).y;
+          const double u = ns.velocity()[0](blk, i, j, k);
+          flux += u * h * h * h;
+          worst = std::max(worst, std::abs(u - G / (2 * mu) * y * (H - y)));
+        }
+  }
+  const double flow_rate = forest.sum(flux) / (0.5 * 0.5);  // per unit width
+  const double exact = G * H * H * H / (12 * mu);
+  std::printf(
+      "Poiseuille across a refined band: flow rate %.6f exact %.6f (rel. error %.2e), max "
+      "profile error %.2e\n",
+      flow_rate, exact, std::abs(flow_rate / exact - 1), forest.max(worst));
+  // The parabola is a discrete steady state on both levels (the 3-point
+  // Laplacian, the quadratic wall closure and the quadratic coarse-fine
+  // interpolation are exact for it; measured 8e-12 after 3 diffusion times,
+  // the decay of the start-up transient and the 1e-10 viscous tolerance).
+  EXPECT_LT(forest.max(worst), 1e-10);
+  // The flow rate from cell-centre values is then the midpoint rule, high
+  // (the parabola is concave) by h^2/(2 H^2) relative: 1/512 on the coarse
+  // half, 1/2048 on the fine half, 1.2207e-3 in all (measured 1.2207e-3;
+  // the 1e-8 covers the 8e-12 profile error).
+  EXPECT_NEAR(flow_rate / exact - 1.0, 0.5 * (1.0 / 512 + 1.0 / 2048), 1e-8);
+  EXPECT_LT(ns.max_divergence(), 1e-8);
+}
+
+}  // namespace
+}  // namespace sanguis::flow
