@@ -145,6 +145,16 @@ void stop_other_processes(int code) {
   if (size > 1) MPI_Abort(MPI_COMM_WORLD, code);
 }
 
+// The run's output folder: --output, or output/NAME; an existing file there is an error.
+std::filesystem::path output_directory(const std::string& output, const std::string& name) {
+  const std::filesystem::path dir =
+      output.empty() ? std::filesystem::path("output") / name : std::filesystem::path(output);
+  if (std::filesystem::exists(dir) && !std::filesystem::is_directory(dir)) {
+    throw InputError(dir.string(), "--output", "exists and is not a directory");
+  }
+  return dir;
+}
+
 int run_command(const RunArgs& args) {
   ConfigTable cfg = ConfigTable::parse_file(args.case_file);
   for (const std::string& o : args.overrides) cfg.set_override(o);
@@ -157,14 +167,9 @@ int run_command(const RunArgs& args) {
     flow::FlowCase fc = flow::load_flow_case(cfg, args.case_file);
     if (threads > 0) fc.forest.threads = threads;
     flow::FlowRunOptions options;
-    options.output_dir =
-        output.empty() ? std::filesystem::path("output") / fc.name : std::filesystem::path(output);
+    options.output_dir = output_directory(output, fc.name);
     options.restart = restart;
     options.quiet = quiet;
-    if (std::filesystem::exists(options.output_dir) &&
-        !std::filesystem::is_directory(options.output_dir)) {
-      throw InputError(options.output_dir.string(), "--output", "exists and is not a directory");
-    }
     flow::run_flow_case(fc, options, std::cout);
     return 0;
   }
@@ -172,15 +177,10 @@ int run_command(const RunArgs& args) {
   dem::DemCase c = dem::load_dem_case(cfg, args.case_file);
   if (threads > 0) c.setup.threads = threads;
   dem::RunOptions options;
-  options.output_dir =
-      output.empty() ? std::filesystem::path("output") / c.name : std::filesystem::path(output);
+  options.output_dir = output_directory(output, c.name);
   options.restart = restart;
   options.quiet = quiet;
   if (several_mpi_processes()) options.comm = flow::MpiSession::ensure().world();
-  if (std::filesystem::exists(options.output_dir) &&
-      !std::filesystem::is_directory(options.output_dir)) {
-    throw InputError(options.output_dir.string(), "--output", "exists and is not a directory");
-  }
   dem::run_dem_case(c, options, std::cout);
   return 0;
 }

@@ -456,12 +456,6 @@ std::vector<SlabDecomposition::ParticleRecord> SlabDecomposition::gather_records
   return all;
 }
 
-ParticleStore SlabDecomposition::gather(const DemSimulation& simulation, int root) const {
-  ParticleStore out;
-  for (const ParticleRecord& r : gather_records(simulation, root)) append_record(out, r);
-  return out;
-}
-
 void SlabDecomposition::attach_restart(DemSimulation& simulation, const DemSimulation& whole) {
   simulation.set_exchange(this);
   // The owned particles as the checkpoint has them (forces included: the first step's

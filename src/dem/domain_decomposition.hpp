@@ -65,9 +65,6 @@ class SlabDecomposition final : public ParticleExchange {
 
   // Diagnostics of the whole system (sums, means and maxima over the processes).
   DemDiagnostics diagnostics(const DemSimulation& simulation) const;
-  // The owned particles of every process, in increasing id order, on `root` (empty
-  // elsewhere).
-  ParticleStore gather(const DemSimulation& simulation, int root = 0) const;
 
   int rank() const { return rank_; }
   int ranks() const { return ranks_; }

@@ -737,75 +737,66 @@ std::size_t DemSimulation::owned_count() const {
   return static_cast<std::size_t>(std::count(ghost_.begin(), ghost_.end(), std::uint8_t{0}));
 }
 
+namespace {
+
+// Contact k of a list as an id-keyed memory slot (history not copied): walls keep the
+// obstacle index, body lists their element numbers.
+template <typename List>
+ContactMemory memory_key(const List& list, std::size_t k, std::uint8_t kind, bool wall,
+                         const std::vector<std::int64_t>& id) {
+  ContactMemory m;
+  m.kind = kind;
+  m.first_id = id[list.first[k]];
+  m.second_id = wall ? std::int64_t{list.second[k]} : id[list.second[k]];
+  if constexpr (std::is_same_v<List, BodyContactList>) {
+    m.element_first = list.element_first[k];
+    m.element_second = list.element_second[k];
+  }
+  return m;
+}
+
+}  // namespace
+
 std::vector<ContactMemory> DemSimulation::export_contacts() const {
   const std::vector<std::int64_t>& id = setup_.particles.id;
   std::vector<ContactMemory> out;
   out.reserve(pairs_.size() + walls_.size() + body_pairs_.size() + body_walls_.size());
-  const auto add_list = [&](const ContactList& list, std::uint8_t kind, bool wall) {
+  const auto add = [&](const auto& list, std::uint8_t kind, bool wall) {
     for (std::size_t k = 0; k < list.size(); ++k) {
-      ContactMemory r;
-      r.kind = kind;
-      r.first_id = id[list.first[k]];
-      r.second_id = wall ? std::int64_t{list.second[k]} : id[list.second[k]];
-      r.history = list.history[k];
-      out.push_back(r);
+      ContactMemory m = memory_key(list, k, kind, wall, id);
+      m.history = list.history[k];
+      if constexpr (std::is_same_v<std::decay_t<decltype(list)>, BodyContactList>) {
+        m.warm = list.warm[k];
+      }
+      out.push_back(m);
     }
   };
-  const auto add_body_list = [&](const BodyContactList& list, std::uint8_t kind, bool wall) {
-    for (std::size_t k = 0; k < list.size(); ++k) {
-      ContactMemory r;
-      r.kind = kind;
-      r.first_id = id[list.first[k]];
-      r.second_id = wall ? std::int64_t{list.second[k]} : id[list.second[k]];
-      r.element_first = list.element_first[k];
-      r.element_second = list.element_second[k];
-      r.history = list.history[k];
-      r.warm = list.warm[k];
-      out.push_back(r);
-    }
-  };
-  add_list(pairs_, ContactMemory::kSpherePair, false);
-  add_list(walls_, ContactMemory::kSphereWall, true);
-  add_body_list(body_pairs_, ContactMemory::kBodyPair, false);
-  add_body_list(body_walls_, ContactMemory::kBodyWall, true);
+  add(pairs_, ContactMemory::kSpherePair, false);
+  add(walls_, ContactMemory::kSphereWall, true);
+  add(body_pairs_, ContactMemory::kBodyPair, false);
+  add(body_walls_, ContactMemory::kBodyWall, true);
   return out;
 }
 
 void DemSimulation::import_contacts(std::span<const ContactMemory> contacts) {
   const std::vector<std::int64_t>& id = setup_.particles.id;
-  const auto find = [&](const ContactMemory& probe) -> const ContactMemory* {
-    const auto it = std::lower_bound(
-        contacts.begin(), contacts.end(), probe,
-        [](const ContactMemory& a, const ContactMemory& b) { return a.key() < b.key(); });
-    return it != contacts.end() && it->key() == probe.key() ? &*it : nullptr;
-  };
-  const auto fill_list = [&](ContactList& list, std::uint8_t kind, bool wall) {
+  const auto fill = [&](auto& list, std::uint8_t kind, bool wall) {
     for (std::size_t k = 0; k < list.size(); ++k) {
-      ContactMemory probe;
-      probe.kind = kind;
-      probe.first_id = id[list.first[k]];
-      probe.second_id = wall ? std::int64_t{list.second[k]} : id[list.second[k]];
-      if (const ContactMemory* r = find(probe)) list.history[k] = r->history;
-    }
-  };
-  const auto fill_body_list = [&](BodyContactList& list, std::uint8_t kind, bool wall) {
-    for (std::size_t k = 0; k < list.size(); ++k) {
-      ContactMemory probe;
-      probe.kind = kind;
-      probe.first_id = id[list.first[k]];
-      probe.second_id = wall ? std::int64_t{list.second[k]} : id[list.second[k]];
-      probe.element_first = list.element_first[k];
-      probe.element_second = list.element_second[k];
-      if (const ContactMemory* r = find(probe)) {
-        list.history[k] = r->history;
-        list.warm[k] = r->warm;
+      const ContactMemory probe = memory_key(list, k, kind, wall, id);
+      const auto it = std::lower_bound(
+          contacts.begin(), contacts.end(), probe,
+          [](const ContactMemory& a, const ContactMemory& b) { return a.key() < b.key(); });
+      if (it == contacts.end() || it->key() != probe.key()) continue;
+      list.history[k] = it->history;
+      if constexpr (std::is_same_v<std::decay_t<decltype(list)>, BodyContactList>) {
+        list.warm[k] = it->warm;
       }
     }
   };
-  fill_list(pairs_, ContactMemory::kSpherePair, false);
-  fill_list(walls_, ContactMemory::kSphereWall, true);
-  fill_body_list(body_pairs_, ContactMemory::kBodyPair, false);
-  fill_body_list(body_walls_, ContactMemory::kBodyWall, true);
+  fill(pairs_, ContactMemory::kSpherePair, false);
+  fill(walls_, ContactMemory::kSphereWall, true);
+  fill(body_pairs_, ContactMemory::kBodyPair, false);
+  fill(body_walls_, ContactMemory::kBodyWall, true);
 }
 
 void DemSimulation::replace_particles(ParticleStore particles, std::vector<std::uint8_t> ghost,

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <unordered_map>
 
+#include "flow/conjugate_gradients.hpp"
 #include "flow/multigrid.hpp"
 
 namespace sanguis::flow {
@@ -252,29 +253,9 @@ void Multigrid::composite_solve() {
       ax[i] = sum;
     }
   };
-  auto dot = [](const std::vector<double>& a, const std::vector<double>& b) {
-    double s = 0.0;
-    for (std::size_t i = 0; i < a.size(); ++i) s += a[i] * b[i];
-    return s;
-  };
-  std::vector<double> x(cells, 0.0), r = rhs, p = rhs, ap(cells, 0.0);
-  const double bb = dot(rhs, rhs);
-  double rr = bb;
-  for (int it = 0; it < 4 * static_cast<int>(cells) + 50 && rr > 1e-26 * bb && bb > 0.0; ++it) {
-    apply(p, ap);
-    const double pap = dot(p, ap);
-    if (!(pap > 0.0)) break;
-    const double a = rr / pap;
-    for (std::size_t i = 0; i < cells; ++i) {
-      x[i] += a * p[i];
-      r[i] -= a * ap[i];
-    }
+  std::vector<double> x = conjugate_gradients(rhs, apply, [&](std::vector<double>& r) {
     if (singular_ && active_volume > 0.0) project_sum(r);
-    const double rr_new = dot(r, r);
-    if (rr_new == 0.0) break;
-    for (std::size_t i = 0; i < cells; ++i) p[i] = r[i] + (rr_new / rr) * p[i];
-    rr = rr_new;
-  }
+  });
   if (singular_ && active_volume > 0.0) {
     double mean = 0.0;
     for (std::size_t i = 0; i < cells; ++i) mean += op.active[i] * op.volume[i] * x[i];

@@ -133,55 +133,14 @@ DemSetup periodic_drift() {
 // `with_spheres`: the lower half in x are spheres (6 mm) instead of crosses, so the first
 // process starts with spheres only and receives crosses as they converge.
 DemSetup crosses(bool with_spheres = false) {
-  const std::string text = R"(
-[simulation]
-name = "crosses"
-end_time_s = 0.01
-time_step_s = 2.5e-6
-[domain]
-min_m = [0.0, 0.0, 0.0]
-max_m = [0.18, 0.06, 0.12]
-[[shape]]
-name = "cross"
-type = "cross"
-length_m = 0.027
-width_m = 0.002
-thickness_m = 0.003
-crust_m = 1.0e-4
-[[material]]
-name = "plastic"
-density_kg_m3 = 770.0
-[[material]]
-name = "acrylic"
-[[interaction]]
-materials = ["plastic", "plastic"]
-mode = "explicit"
-normal_stiffness_N_m = 4.5e5
-normal_restitution = 0.85
-tangential_stiffness_N_m = 3.0e2
-tangential_damping_rate_1_s = 1.0e3
-friction = 0.46
-[[interaction]]
-materials = ["plastic", "acrylic"]
-mode = "explicit"
-normal_stiffness_N_m = 4.5e5
-normal_restitution = 0.85
-tangential_stiffness_N_m = 3.0e2
-tangential_damping_rate_1_s = 1.0e3
-friction = 0.62
-[[obstacle]]
-name = "floor"
-type = "plane"
-material = "acrylic"
-point_m = [0.0, 0.0, 0.0]
-normal = [0.0, 0.0, 1.0]
-[[particles]]
-material = "plastic"
-shape = "cross"
-arrangement = "list"
-positions_m = [[0.09, 0.03, 0.06]]
-)";
-  DemSetup s = load_dem_case(ConfigTable::parse_string(text, "crosses.toml"), "crosses.toml").setup;
+  // The Table 3.1 crosses and contacts of the dam-break case, in a smaller box with its
+  // floor only; the poured column is replaced by the lattice below.
+  DemSetup s =
+      load_dem_case(std::string(SANGUIS_SOURCE_DIR) + "/cases/dem/dam-break-crosses-memory.toml")
+          .setup;
+  s.domain.max = {0.18, 0.06, 0.12};
+  s.obstacles.resize(1);  // the floor
+  s.pour.clear();
   s.particles = ParticleStore{};  // replaced by the lattice below
   const ParticleShape& cross = s.shapes.at(0);
   std::mt19937_64 rng(7);
