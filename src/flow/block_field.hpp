@@ -37,6 +37,23 @@ struct BlockLayout {
   }
 };
 
+/// Calls body(c, g) for every cell c of the block's layer beside face (d, side)
+/// (side 0: the lower face) and the ghost g just beyond that face.
+template <typename Body>
+void for_face_cells(const BlockLayout& L, int d, int side, Body&& body) {
+  const int b = L.cells;
+  const int e1 = (d + 1) % 3, e2 = (d + 2) % 3;
+  for (int t2 = 0; t2 < b; ++t2)
+    for (int t1 = 0; t1 < b; ++t1) {
+      int n[3] = {0, 0, 0};
+      n[d] = side == 0 ? 0 : b - 1;
+      n[e1] = t1;
+      n[e2] = t2;
+      const std::ptrdiff_t c = L.index(n[0], n[1], n[2]);
+      body(c, side == 0 ? c - L.stride(d) : c + L.stride(d));
+    }
+}
+
 /// One scalar per cell (interior and ghosts) of every local block.
 class BlockField {
  public:

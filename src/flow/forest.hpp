@@ -89,6 +89,12 @@ constexpr int neighbour_slot(int ox, int oy, int oz) {
   return (ox + 1) + 3 * (oy + 1) + 9 * (oz + 1);
 }
 
+/// Slot of the neighbour across face (d, side) (side 0: the lower face).
+constexpr std::size_t face_neighbour_slot(int d, int side) {
+  const int o = side == 0 ? -1 : 1;
+  return static_cast<std::size_t>(neighbour_slot(d == 0 ? o : 0, d == 1 ? o : 0, d == 2 ? o : 0));
+}
+
 /// One local leaf of the forest.
 struct Block {
   int level = 0;                           ///< p8est refinement level

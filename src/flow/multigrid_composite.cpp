@@ -16,30 +16,6 @@ constexpr std::size_t D(int d) {
   return static_cast<std::size_t>(d);
 }
 
-/// Offset of the face neighbour across face (d, side).
-std::size_t face_slot(int d, int side) {
-  std::array<int, 3> o{0, 0, 0};
-  o[D(d)] = side == 0 ? -1 : 1;
-  return D(neighbour_slot(o[0], o[1], o[2]));
-}
-
-/// Calls body(c, g) for every cell c of the block's layer beside face
-/// (d, side) and the ghost g beyond it (offsets in the layout L).
-template <typename Body>
-void for_face_cells(const BlockLayout& L, int d, int side, Body&& body) {
-  const int b = L.cells;
-  const int e1 = (d + 1) % 3, e2 = (d + 2) % 3;
-  for (int t2 = 0; t2 < b; ++t2)
-    for (int t1 = 0; t1 < b; ++t1) {
-      std::array<int, 3> n{};
-      n[D(d)] = side == 0 ? 0 : b - 1;
-      n[D(e1)] = t1;
-      n[D(e2)] = t2;
-      const std::ptrdiff_t c = L.index(n[0], n[1], n[2]);
-      body(c, side == 0 ? c - L.stride(d) : c + L.stride(d));
-    }
-}
-
 }  // namespace
 
 // Flux matching at coarse-fine faces. A cell's residual is
@@ -65,7 +41,7 @@ void Multigrid::match_fluxes(int level, BlockField& x) {
       for (int side = 0; side < 2; ++side) {
         double* flux = lv.face_flux[D(face_index(d, side))].block(blk);
         std::fill(flux, flux + L.size(), 0.0);
-        if (block.neighbours[face_slot(d, side)].jump != LevelJump::Coarser) continue;
+        if (block.neighbours[face_neighbour_slot(d, side)].jump != LevelJump::Coarser) continue;
         const double* xb = x.block(blk);
         const double* beta = lv.beta[D(d)].block(blk);
         for_face_cells(L, d, side, [&](std::ptrdiff_t c, std::ptrdiff_t g) {
@@ -83,7 +59,7 @@ void Multigrid::match_fluxes(int level, BlockField& x) {
     double* xb = x.block(blk);
     for (int d = 0; d < 3; ++d)
       for (int side = 0; side < 2; ++side) {
-        if (block.neighbours[face_slot(d, side)].jump != LevelJump::Finer) continue;
+        if (block.neighbours[face_neighbour_slot(d, side)].jump != LevelJump::Finer) continue;
         // The fine blocks stored their fluxes under their own face: the opposite one.
         const double* fine = lv.face_flux[D(face_index(d, 1 - side))].block(blk);
         const double* beta = lv.beta[D(d)].block(blk);

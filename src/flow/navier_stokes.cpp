@@ -66,29 +66,13 @@ inline void for_each_cell(int b, Body&& body) {
       for (int i = 0; i < b; ++i) body(i, j, k);
 }
 
-/// Offset number of the face neighbour across face (d, side).
-std::size_t face_slot(int d, int side) {
-  std::array<int, 3> o{0, 0, 0};
-  o[D(d)] = side == 0 ? -1 : 1;
-  return D(neighbour_slot(o[0], o[1], o[2]));
-}
-
 /// Calls body(c, f) for every cell c of the block's layer beside face (d, side)
 /// and the index f of that face in a face field (c on the lower face, c + s_d
 /// on the upper one).
 template <typename Body>
 void for_face_layer(const BlockLayout& L, int d, int side, Body&& body) {
-  const int b = L.cells;
-  const int e1 = (d + 1) % 3, e2 = (d + 2) % 3;
-  for (int t2 = 0; t2 < b; ++t2)
-    for (int t1 = 0; t1 < b; ++t1) {
-      std::array<int, 3> n{};
-      n[D(d)] = side == 0 ? 0 : b - 1;
-      n[D(e1)] = t1;
-      n[D(e2)] = t2;
-      const std::ptrdiff_t c = L.index(n[0], n[1], n[2]);
-      body(c, side == 0 ? c : c + L.stride(d));
-    }
+  for_face_cells(L, d, side,
+                 [&](std::ptrdiff_t c, std::ptrdiff_t g) { body(c, side == 0 ? c : g); });
 }
 
 /// Composite grids, first half of "the fine faces win": every block beside a
@@ -106,7 +90,7 @@ void fine_faces_to_coarse(const Forest& forest, std::array<BlockField, 6>& layer
     const Block& block = forest.block(blk);
     for (int d = 0; d < 3; ++d)
       for (int side = 0; side < 2; ++side) {
-        if (block.neighbours[face_slot(d, side)].jump != LevelJump::Coarser) continue;
+        if (block.neighbours[face_neighbour_slot(d, side)].jump != LevelJump::Coarser) continue;
         double* layer = layers[D(face_index(d, side))].block(blk);
         for_face_layer(L, d, side, [&](std::ptrdiff_t c, std::ptrdiff_t f) {
           layer[c] = fine_value(blk, d, f);
@@ -127,7 +111,7 @@ void for_coarse_faces(const Forest& forest, const std::array<BlockField, 6>& lay
   const Block& block = forest.block(blk);
   for (int d = 0; d < 3; ++d)
     for (int side = 0; side < 2; ++side) {
-      if (block.neighbours[face_slot(d, side)].jump != LevelJump::Finer) continue;
+      if (block.neighbours[face_neighbour_slot(d, side)].jump != LevelJump::Finer) continue;
       // The fine blocks wrote under their own face: the opposite one.
       const double* fine = layers[D(face_index(d, 1 - side))].block(blk);
       const std::ptrdiff_t beyond = side == 0 ? -L.stride(d) : L.stride(d);
@@ -610,7 +594,7 @@ void NavierStokes::advect_field(const BlockField& field, const BlockField* sourc
     const Block& block = forest_.block(blk);
     for (int d = 0; d < 3; ++d) {
       double* fl = face_flux_[D(d)].block(blk);
-      const Neighbour& upper = block.neighbours[face_slot(d, 1)];
+      const Neighbour& upper = block.neighbours[face_neighbour_slot(d, 1)];
       // The exchange only brings a same-level neighbour's face 0; a domain
       // boundary or a coarser neighbour leaves slot b to this block.
       if (upper.link == Link::Boundary || upper.jump == LevelJump::Coarser) {
