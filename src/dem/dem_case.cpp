@@ -46,6 +46,7 @@ struct ParticleGroup {
   std::vector<Vec3> positions, velocities, angular_velocities;
   Vec3 velocity, angular_velocity;
   double velocity_noise = 0.0;
+  bool fixed = false;  // glued in place (ParticleStore::fix)
 };
 
 double sphere_mass(double r, double density) {
@@ -344,6 +345,14 @@ ParticleGroup parse_group(const ConfigTable& t, std::vector<MaterialSpec>& mater
   g.velocity = t.get_vec3("velocity_m_s", {});
   g.angular_velocity = t.get_vec3("angular_velocity_rad_s", {});
   g.velocity_noise = t.get_non_negative("velocity_noise_m_s", 0.0);
+  g.fixed = t.get_bool("fixed", false);
+  if (g.fixed) {
+    if (g.arrangement == "pour") t.fail("fixed", "a poured group cannot be fixed");
+    for (const char* key : {"velocity_m_s", "angular_velocity_rad_s", "velocity_noise_m_s",
+                            "velocities_m_s", "angular_velocities_rad_s"}) {
+      if (t.has(key)) t.fail(key, "a fixed group does not move: remove this key");
+    }
+  }
   if (g.arrangement == "list") {
     if (g.r_min != g.r_max) t.fail("radius_min_m", "a 'list' arrangement needs one radius_m");
     // (bodies: positions are centres of mass; their bounding spheres must not overlap)
@@ -744,6 +753,7 @@ DemCase load_dem_case(const ConfigTable& cfg, const std::filesystem::path& sourc
                            g.shape, sh.bounding_radius, density * sh.volume,
                            density * sh.inertia_per_density, q, seeds[i].position, v, w);
     }
+    if (g.fixed) s.particles.fix(s.particles.size() - 1);
   }
   // Periodic axes need room for the linked cells.
   double r_max = 0.0, r_min = std::numeric_limits<double>::infinity();

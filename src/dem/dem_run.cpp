@@ -76,6 +76,12 @@ io::DataArray vector_array(const char* name, const std::vector<Vec3>& values) {
   return a;
 }
 
+std::vector<std::int64_t> fixed_flags(const ParticleStore& p) {
+  std::vector<std::int64_t> flags(p.size());
+  for (std::size_t i = 0; i < p.size(); ++i) flags[i] = p.is_fixed(i) ? 1 : 0;
+  return flags;
+}
+
 }  // namespace
 
 io::PointCloud particle_cloud(const ParticleStore& p) {
@@ -98,6 +104,7 @@ io::PointCloud particle_cloud(const ParticleStore& p) {
       {"material", 1, {p.material.begin(), p.material.end()}},
       {"species", 1, {p.species.begin(), p.species.end()}},
       {"spherical", 1, {p.spherical.begin(), p.spherical.end()}},
+      {"fixed", 1, fixed_flags(p)},
   };
   return cloud;
 }

@@ -417,7 +417,7 @@ void SlabDecomposition::exchange_ghosts(DemSimulation& simulation,
 
 DemDiagnostics SlabDecomposition::diagnostics(const DemSimulation& simulation) const {
   DemDiagnostics d = simulation.diagnostics();
-  const auto owned = static_cast<double>(simulation.owned_count());
+  const auto owned = static_cast<double>(d.mobile_particles);
   double sums[5] = {d.kinetic_energy_translational, d.kinetic_energy_rotational,
                     d.mean_velocity * owned, d.mean_angular_velocity * owned, owned};
   MPI_Allreduce(MPI_IN_PLACE, sums, 5, MPI_DOUBLE, MPI_SUM, comm_);
@@ -429,6 +429,7 @@ DemDiagnostics SlabDecomposition::diagnostics(const DemSimulation& simulation) c
   d.kinetic_energy_rotational = sums[1];
   d.mean_velocity = sums[4] > 0 ? sums[2] / sums[4] : 0.0;
   d.mean_angular_velocity = sums[4] > 0 ? sums[3] / sums[4] : 0.0;
+  d.mobile_particles = static_cast<std::int64_t>(sums[4]);
   d.max_velocity = maxima[0];
   d.max_overlap_ratio = maxima[1];
   d.particle_contacts = counts[0];

@@ -38,6 +38,13 @@ std::size_t ParticleStore::add_body(std::int64_t particle_id, std::int32_t mater
   return position.size() - 1;
 }
 
+void ParticleStore::fix(std::size_t i) {
+  inverse_mass[i] = 0.0;
+  inverse_inertia_body[i] = {};
+  velocity[i] = {};
+  angular_velocity[i] = {};
+}
+
 void ParticleStore::append_from(const ParticleStore& o, std::size_t i) {
   id.push_back(o.id[i]);
   material.push_back(o.material[i]);

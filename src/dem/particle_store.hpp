@@ -17,7 +17,7 @@ struct ParticleStore {
   std::vector<std::int32_t> material;      // index into the material table
   std::vector<double> radius;              // bounding radius about the centroid [m]
   std::vector<double> mass;                // [kg]
-  std::vector<double> inverse_mass;        // [1/kg]
+  std::vector<double> inverse_mass;        // [1/kg]; 0 for a fixed particle (see fix())
   std::vector<std::int32_t> species;       // index into the species (shape) table
   std::vector<std::uint8_t> spherical;     // 1: a sphere (isotropic: no orientation dynamics)
   std::vector<Vec3> inertia_body;          // principal moments of inertia [kg m^2]
@@ -31,6 +31,12 @@ struct ParticleStore {
   std::vector<std::int32_t> coordination;  // contacts touching this particle at the last step
 
   std::size_t size() const { return position.size(); }
+
+  // A fixed particle (a bead glued to a wall: a rough floor) takes part in contacts but
+  // never moves: infinite mass and inertia, encoded as zero inverses so that the flag
+  // travels with every copy, sort, migration and checkpoint of the inverse mass.
+  void fix(std::size_t i);
+  bool is_fixed(std::size_t i) const { return inverse_mass[i] == 0.0; }
 
   // Appends particle i of `other`, every field as it is.
   void append_from(const ParticleStore& other, std::size_t i);

@@ -691,7 +691,7 @@ DemDiagnostics DemSimulation::diagnostics() const {
   d.time = time();
   std::size_t owned = 0;
   for (std::size_t i = 0; i < p.size(); ++i) {
-    if (is_ghost(i)) continue;
+    if (is_ghost(i) || p.is_fixed(i)) continue;
     ++owned;
     const double v2 = norm2(p.velocity[i]);
     const double w2 = norm2(p.angular_velocity[i]);
@@ -705,6 +705,7 @@ DemDiagnostics DemSimulation::diagnostics() const {
     d.max_velocity = std::max(d.max_velocity, speed);
     d.mean_angular_velocity += std::sqrt(w2);
   }
+  d.mobile_particles = static_cast<std::int64_t>(owned);
   if (owned > 0) {
     d.mean_velocity /= static_cast<double>(owned);
     d.mean_angular_velocity /= static_cast<double>(owned);

@@ -99,13 +99,14 @@ struct DemDiagnostics {
   double time = 0.0;
   double kinetic_energy_translational = 0.0;  // [J]
   double kinetic_energy_rotational = 0.0;     // [J]
-  double mean_velocity = 0.0;                 // mean |v| [m/s]
+  double mean_velocity = 0.0;                 // mean |v| over the mobile particles [m/s]
   double max_velocity = 0.0;                  // [m/s]
   double mean_angular_velocity = 0.0;         // mean |omega| [rad/s]
   std::int64_t particle_contacts = 0;         // touching particle pairs
   std::int64_t wall_contacts = 0;             // touching particle-obstacle pairs
   double max_overlap_ratio = 0.0;             // max overlap / smaller radius
   std::int64_t deep_contacts = 0;             // body contacts deeper than the crusts
+  std::int64_t mobile_particles = 0;          // the means' population (fixed ones excluded)
 };
 
 class DemSimulation {

@@ -117,6 +117,11 @@ void resize_history(MultistepHistory& h, std::size_t n) {
   }
 }
 
+// A fixed particle (zero inverse mass) feels no gravity either: it stays where it is.
+inline Vec3 gravity_on(double inverse_mass, const Vec3& gravity) {
+  return inverse_mass != 0.0 ? gravity : Vec3{};
+}
+
 }  // namespace
 
 void TimeIntegrator::advance(ParticleStore& p, const Vec3& gravity, double dt) {
@@ -136,7 +141,7 @@ void TimeIntegrator::advance(ParticleStore& p, const Vec3& gravity, double dt) {
     case IntegratorKind::kForwardEuler:  // eq. 2.30
       parallel_for(n, threads_, [&](std::size_t i) {
         x[i] += dt * v[i];
-        v[i] += dt * (inv_m[i] * f[i] + gravity);
+        v[i] += dt * (inv_m[i] * f[i] + gravity_on(inv_m[i], gravity));
         if (sphere[i]) {
           w[i] += (dt * inv_j[i].x) * t[i];
         } else {
@@ -148,7 +153,7 @@ void TimeIntegrator::advance(ParticleStore& p, const Vec3& gravity, double dt) {
       half_velocity_.resize(n);
       half_angular_velocity_.resize(n);
       parallel_for(n, threads_, [&](std::size_t i) {
-        const Vec3 kick = (0.5 * dt) * (inv_m[i] * f[i] + gravity);
+        const Vec3 kick = (0.5 * dt) * (inv_m[i] * f[i] + gravity_on(inv_m[i], gravity));
         half_velocity_[i] = v[i] + kick;
         x[i] += dt * half_velocity_[i];
         // The forces at x_{n+1} see the predicted v_{n+1} = v_n + dt a_n rather than
@@ -182,7 +187,7 @@ void TimeIntegrator::advance(ParticleStore& p, const Vec3& gravity, double dt) {
       const int max_order = kind_ == IntegratorKind::kAdamsBashforth2 ? 2 : 3;
       const int order = std::min(max_order, h.depth + 1);
       parallel_for(n, threads_, [&](std::size_t i) {
-        const Vec3 a = inv_m[i] * f[i] + gravity;
+        const Vec3 a = inv_m[i] * f[i] + gravity_on(inv_m[i], gravity);
         const Vec3 alpha = inv_j[i].x * t[i];  // spheres only; bodies below
         const Vec3 v_now = v[i];
         const Vec3 w_now = w[i];
@@ -228,7 +233,9 @@ void TimeIntegrator::finish(ParticleStore& p, const Vec3& gravity, double dt) {
   if (kind_ != IntegratorKind::kLeapfrog) return;
   const std::size_t n = p.size();
   parallel_for(n, threads_, [&](std::size_t i) {  // final half kick with a_{n+1}
-    p.velocity[i] = half_velocity_[i] + (0.5 * dt) * (p.inverse_mass[i] * p.force[i] + gravity);
+    p.velocity[i] =
+        half_velocity_[i] +
+        (0.5 * dt) * (p.inverse_mass[i] * p.force[i] + gravity_on(p.inverse_mass[i], gravity));
     if (p.spherical[i]) {
       p.angular_velocity[i] =
           half_angular_velocity_[i] + (0.5 * dt * p.inverse_inertia_body[i].x) * p.torque[i];

@@ -259,11 +259,22 @@ const IntDataArray& find_array(const std::vector<IntDataArray>& arrays, const st
   throw std::runtime_error("no array '" + name + "'");
 }
 
-bool has_array(const std::vector<DataArray>& arrays, const std::string& name) {
-  for (const DataArray& a : arrays) {
+namespace {
+template <typename Array>
+bool named_array_exists(const std::vector<Array>& arrays, const std::string& name) {
+  for (const Array& a : arrays) {
     if (a.name == name) return true;
   }
   return false;
+}
+}  // namespace
+
+bool has_array(const std::vector<DataArray>& arrays, const std::string& name) {
+  return named_array_exists(arrays, name);
+}
+
+bool has_array(const std::vector<IntDataArray>& arrays, const std::string& name) {
+  return named_array_exists(arrays, name);
 }
 
 }  // namespace sanguis::io

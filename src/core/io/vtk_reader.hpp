@@ -30,5 +30,6 @@ std::vector<PvdIndex::Entry> read_pvd(const std::filesystem::path& path);
 const DataArray& find_array(const std::vector<DataArray>& arrays, const std::string& name);
 const IntDataArray& find_array(const std::vector<IntDataArray>& arrays, const std::string& name);
 bool has_array(const std::vector<DataArray>& arrays, const std::string& name);
+bool has_array(const std::vector<IntDataArray>& arrays, const std::string& name);
 
 }  // namespace sanguis::io

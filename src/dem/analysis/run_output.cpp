@@ -91,6 +91,28 @@ const std::vector<std::string>& file_of(const std::vector<std::vector<std::strin
   return files[frame];
 }
 
+// Glued particles (a rough floor) are part of the walls, not of the granular mass: the
+// run-out, heights, velocities and coordination are measured on the mobile particles.
+void drop_fixed(ParticleFrame& f, const std::vector<std::int64_t>& fixed) {
+  std::size_t kept = 0;
+  for (std::size_t k = 0; k < f.size(); ++k) {
+    if (fixed[k] != 0) continue;
+    f.id[kept] = f.id[k];
+    f.position[kept] = f.position[k];
+    f.velocity[kept] = f.velocity[k];
+    f.radius[kept] = f.radius[k];
+    if (!f.mass.empty()) f.mass[kept] = f.mass[k];
+    f.spherical[kept] = f.spherical[k];
+    ++kept;
+  }
+  f.id.resize(kept);
+  f.position.resize(kept);
+  f.velocity.resize(kept);
+  f.radius.resize(kept);
+  if (!f.mass.empty()) f.mass.resize(kept);
+  f.spherical.resize(kept);
+}
+
 }  // namespace
 
 RunOutput::RunOutput(std::filesystem::path dir) : dir_(std::move(dir)) {
@@ -139,6 +161,9 @@ ParticleFrame RunOutput::particles(std::size_t frame) const {
     f.mass = io::find_array(cloud.point_data, "mass").values;
   f.id = io::find_array(cloud.int_point_data, "id").values;
   f.spherical = io::find_array(cloud.int_point_data, "spherical").values;
+  if (io::has_array(cloud.int_point_data, "fixed")) {
+    drop_fixed(f, io::find_array(cloud.int_point_data, "fixed").values);
+  }
   return f;
 }
 
