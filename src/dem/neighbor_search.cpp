@@ -117,6 +117,7 @@ void NeighborSearch::rebuild(ParticleStore& particles, const std::vector<Obstacl
   for (std::size_t i = 0; i < n; ++i) {
     const Vec3 xi = particles.position[i];
     const double ri = particles.radius[i];
+    const bool fixed_i = particles.is_fixed(i);  // two glued particles never interact
     std::int64_t ci[3];
     for (int k = 0; k < 3; ++k) {
       const auto ku = static_cast<std::size_t>(k);
@@ -147,6 +148,7 @@ void NeighborSearch::rebuild(ParticleStore& particles, const std::vector<Obstacl
           for (std::uint32_t m = cell_start_[c]; m < cell_start_[c + 1]; ++m) {
             const std::uint32_t j = cell_members_[m];
             if (j <= i || (ghost != nullptr && ghost[i] && ghost[j])) continue;
+            if (fixed_i && particles.is_fixed(j)) continue;
             const double cut = ri + particles.radius[j] + skin_;
             const Vec3 d = domain_.minimum_image(particles.position[j] - xi);
             if (norm2(d) < cut * cut) candidates_.push_back(j);

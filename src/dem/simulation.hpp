@@ -169,6 +169,7 @@ class DemSimulation {
   void compute_forces();
   void rebuild_lists();
   void build_incidence();
+  void build_blocks();
   void split_body_contacts();
   void pour_particles();
   void check_state() const;
@@ -196,6 +197,11 @@ class DemSimulation {
   std::vector<std::uint8_t> pair_touching_, wall_touching_, body_pair_touching_,
       body_wall_touching_;
   std::vector<std::uint32_t> body_incident_offset_, body_incident_, body_wall_offset_;
+  // Threaded spheres (see compute_forces): particles cut into one contiguous block per
+  // thread; `shared_` marks the particles with a contact in another block, summed by the
+  // gather above, while every other particle accumulates directly in its block's loop.
+  std::vector<std::uint32_t> block_particle_, block_pair_, block_wall_, shared_list_;
+  std::vector<std::uint8_t> shared_;
   std::int64_t deep_contacts_ = 0;
   std::mt19937_64 pour_rng_;  // element contacts whose overlap exceeded the crusts
 };

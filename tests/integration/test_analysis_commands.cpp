@@ -55,6 +55,7 @@ TEST_F(AnalysisCommandTest, AnalyzeMeasuresTheCollapseOfASmallColumn) {
   const auto s = first_row(out / "summary.csv");
   // The initial frame is the gate removal (obstacles.csv), at 0.25 s.
   EXPECT_NEAR(number(s, "initial_time_s"), 0.25, 0.025);
+  EXPECT_EQ(number(s, "release_time_s"), 0.25);  // the clock of velocity.csv starts there
   // The column stands 16 mm long behind the gate; one pixel is half a mean radius.
   EXPECT_NEAR(number(s, "L0_m"), 0.016, 0.002);
   // 200 beads of 2 mm in 16 x 16 mm at a packing fraction near 0.6: H0 about 4.4 cm.

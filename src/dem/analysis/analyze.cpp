@@ -122,6 +122,9 @@ RunAnalysis analyze_run(const RunOutput& run, const AnalysisOptions& o) {
                              format(initial.time) + " s) has no particles");
   }
   a.initial_time = initial.time;
+  // The frame before the removal gives L0 and H0; the clock starts at the removal itself
+  // (frames fall on the output grid, up to one interval earlier).
+  a.release_time = gate_time && *gate_time >= initial.time ? *gate_time : initial.time;
   a.final_time = final.time;
   a.particles = final.size();
 
@@ -199,7 +202,7 @@ std::vector<std::pair<std::string, double>> summary_values(const RunAnalysis& a)
   const Vec3 c0 = a.series.empty() ? Vec3{} : a.series.front().centre_of_mass;
   const Vec3 c1 = a.series.empty() ? Vec3{} : a.series.back().centre_of_mass;
   const double l0 = a.initial_length.length, h0 = a.initial_height.mean;
-  double peak_speed = 0.0, peak_time = a.initial_time;
+  double peak_speed = 0.0, peak_time = a.release_time;
   for (const TimeSample& s : a.series) {
     if (s.mean_speed > peak_speed) {
       peak_speed = s.mean_speed;
@@ -209,6 +212,7 @@ std::vector<std::pair<std::string, double>> summary_values(const RunAnalysis& a)
   const Coordination whole = a.coordination.empty() ? Coordination{} : a.coordination[0].second;
   return {
       {"initial_time_s", a.initial_time},
+      {"release_time_s", a.release_time},
       {"final_time_s", a.final_time},
       {"particles", static_cast<double>(a.particles)},
       {"L0_m", l0},
@@ -228,7 +232,7 @@ std::vector<std::pair<std::string, double>> summary_values(const RunAnalysis& a)
       {"com_displacement_x_m", c1.x - c0.x},
       {"com_displacement_x_over_L0", l0 > 0 ? (c1.x - c0.x) / l0 : 0.0},
       {"peak_mean_speed_over_sqrt_gH0", h0 > 0 ? peak_speed / a.velocity_scale() : 0.0},
-      {"peak_time_over_tau_c", h0 > 0 ? (peak_time - a.initial_time) / a.time_scale() : 0.0},
+      {"peak_time_over_tau_c", h0 > 0 ? (peak_time - a.release_time) / a.time_scale() : 0.0},
       {"pair_coordination", whole.pair_coordination},
       {"contact_point_coordination", whole.contact_point_coordination},
       {"fabric_anisotropy", a.fabric.anisotropy},
@@ -265,7 +269,7 @@ void write_analysis(const RunAnalysis& a, const std::filesystem::path& out) {
 
   rows.clear();
   for (const TimeSample& s : a.series) {
-    const double t = s.time - a.initial_time;
+    const double t = s.time - a.release_time;
     rows.push_back({format(s.time), format(t / a.time_scale()), format(s.mean_speed),
                     format(s.mean_speed / a.velocity_scale()), format(s.centre_of_mass.x),
                     format(s.centre_of_mass.y), format(s.centre_of_mass.z)});

@@ -43,7 +43,8 @@ struct TimeSample {
 
 struct RunAnalysis {
   std::string run;  // folder analysed
-  double initial_time = 0.0, final_time = 0.0;
+  double initial_time = 0.0, final_time = 0.0;  // frames measured [s]
+  double release_time = 0.0;  // origin of the time series: the gate's removal, if any [s]
   double wall_x = 0.0, floor_z = 0.0, y_min = 0.0, y_max = 0.0, pixel = 0.0;
   std::size_t particles = 0;
   RunoutMeasure initial_length, final_length;  // from the back wall [m]
