@@ -649,6 +649,20 @@ void DemSimulation::split_body_contacts() {
            a.min.z <= b.max.z && b.min.z <= a.max.z;
   };
 
+  // Two box elements (the arms of crosses) whose axis-aligned boxes meet are often far
+  // apart when tilted: keep the pair only if no separating axis puts their cores more
+  // than both crusts and the skin apart (each point moves < skin / 2 before the next
+  // rebuild, so such a pair cannot touch before then).
+  const auto arms_apart = [&](std::size_t i, std::size_t ea, std::size_t j, std::size_t eb,
+                              const Vec3& shift) {
+    const ElementView a = element_view(p, shapes, i, ea, p.position[i]);
+    const ElementView b = element_view(p, shapes, j, eb, p.position[j] + shift);
+    const auto* box_a = std::get_if<geometry::Box>(a.core);
+    const auto* box_b = std::get_if<geometry::Box>(b.core);
+    return box_a && box_b &&
+           geometry::boxes_apart_beyond(*box_a, {a.position, a.orientation}, *box_b,
+                                        {b.position, b.orientation}, a.crust + b.crust + skin);
+  };
   ContactList spheres_only;
   BodyContactList fresh;
   for (std::size_t k = 0; k < pairs_.size(); ++k) {
@@ -662,9 +676,9 @@ void DemSimulation::split_body_contacts() {
         domain.minimum_image(p.position[j] - p.position[i]) - (p.position[j] - p.position[i]);
     for (std::size_t ea = 0; ea < element_count(p, shapes, i); ++ea) {
       for (std::size_t eb = 0; eb < element_count(p, shapes, j); ++eb) {
-        if (boxes_meet(boxes[first_box[i] + ea], boxes[first_box[j] + eb], shift)) {
-          fresh.push(i, j, static_cast<std::uint16_t>(ea), static_cast<std::uint16_t>(eb));
-        }
+        if (!boxes_meet(boxes[first_box[i] + ea], boxes[first_box[j] + eb], shift)) continue;
+        if (arms_apart(i, ea, j, eb, shift)) continue;
+        fresh.push(i, j, static_cast<std::uint16_t>(ea), static_cast<std::uint16_t>(eb));
       }
     }
   }
