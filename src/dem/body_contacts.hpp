@@ -13,7 +13,6 @@
 #include "dem/obstacles.hpp"
 #include "dem/particle_shape.hpp"
 #include "geometry/gjk.hpp"
-#include "geometry/separating_axes.hpp"
 
 namespace sanguis::dem {
 
@@ -82,13 +81,6 @@ inline ElementContact element_pair_contact(const geometry::ConvexShape& core_a,
                                            geometry::GjkWarmStart* warm) {
   ElementContact c;
   const double reach = crust_a + crust_b;
-  // Two boxes (the arms of crosses) mostly pass the bounding-ball test without touching:
-  // the separating-axis test rejects them at a fraction of GJK's cost.
-  const auto* box_a = std::get_if<geometry::Box>(&core_a);
-  const auto* box_b = std::get_if<geometry::Box>(&core_b);
-  if (box_a && box_b && geometry::boxes_apart_beyond(*box_a, pose_a, *box_b, pose_b, reach)) {
-    return c;
-  }
   geometry::GjkSettings settings;
   settings.stop_beyond = reach;
   settings.relative_tolerance = 1e-10;

@@ -12,6 +12,7 @@
 #include "core/error.hpp"
 #include "core/io/atomic_file.hpp"
 #include "dem/body_contacts.hpp"
+#include "geometry/separating_axes.hpp"
 
 namespace sanguis::dem {
 
