@@ -205,7 +205,6 @@ inline ElementView element_view(const ParticleStore& p, const std::vector<Partic
 
 void DemSimulation::compute_forces() {
   ParticleStore& p = setup_.particles;
-  const std::size_t n = p.size();
   const double dt = setup_.time_step;
   const double now = time();
 
@@ -410,20 +409,51 @@ void DemSimulation::compute_forces() {
     for (std::size_t k = 0; k < n_body_walls; ++k) {
       add_wall(body_wall_outcome(k), body_walls_.first[k]);
     }
-  } else if (!has_bodies_) {
-    // Threads, spheres: each block of particles (build_incidence) owns the contacts whose
-    // first particle it holds. A particle whose contacts all lie in its block sums them
-    // there, directly and in increasing contact index (walls last), as the serial loop
-    // does; only the contacts of shared particles go through the outcome slots and the
-    // gather. Bitwise the serial result for any number of threads, without the memory
-    // traffic of a slot per contact.
+  } else {
+    // Threads: each block of particles (build_blocks) owns the contacts whose first
+    // particle it holds. A particle whose contacts all lie in its block sums them there,
+    // directly, in the order of the serial loop (sphere pairs, body pairs, sphere walls,
+    // body walls, each in increasing contact index); only the contacts of shared
+    // particles go through the outcome slots and the gather below. Bitwise the serial
+    // result for any number of threads, no atomics, no slot per contact.
     const std::uint8_t* shared = shared_.data();
     const auto blocks = static_cast<std::ptrdiff_t>(block_particle_.size()) - 1;
+    // One contact of a list: its outcome, kept for the gather when it touches a shared
+    // particle, and added at once to the particles that are not shared.
+    const auto pair_step = [&](const ContactOutcome& o, std::uint32_t i, std::uint32_t j,
+                               std::uint8_t& touching_flag, ContactOutcome& slot) {
+      if (shared[i] || shared[j]) {
+        touching_flag = o.touching;
+        if (o.touching) slot = o;
+      }
+      if (!o.touching) return;
+      if (!shared[i]) {
+        f[i] += o.force;
+        tq[i] += o.torque_first;
+        ++coord[i];
+      }
+      if (!shared[j]) {
+        f[j] -= o.force;
+        tq[j] += o.torque_second;
+        ++coord[j];
+      }
+    };
+    const auto wall_step = [&](const ContactOutcome& o, std::uint32_t i,
+                               std::uint8_t& touching_flag, ContactOutcome& slot) {
+      if (shared[i]) {
+        touching_flag = o.touching;
+        if (o.touching) slot = o;
+      } else if (o.touching) {
+        f[i] += o.force;
+        tq[i] += o.torque_first;
+        ++coord[i];
+      }
+    };
     const int nt = threads_;
 #pragma omp parallel num_threads(nt)
     {
 #pragma omp for schedule(static, 1) reduction(max : worst) \
-    reduction(+ : touching_pairs, touching_walls)
+    reduction(+ : touching_pairs, touching_walls, deep)
       for (std::ptrdiff_t b = 0; b < blocks; ++b) {
         const auto bu = static_cast<std::size_t>(b);
         for (std::uint32_t i = block_particle_[bu]; i < block_particle_[bu + 1]; ++i) {
@@ -432,126 +462,37 @@ void DemSimulation::compute_forces() {
           tq[i] = Vec3{};
           coord[i] = 0;
         }
+        const auto tally = [&](const ContactOutcome& o, std::int64_t& touching) {
+          if (!o.touching) return;
+          ++touching;
+          deep += o.deep;
+          worst = std::max(worst, o.overlap_ratio);
+        };
         for (std::uint32_t k = block_pair_[bu]; k < block_pair_[bu + 1]; ++k) {
           const ContactOutcome o = pair_outcome(k);
-          const std::uint32_t i = pairs_.first[k], j = pairs_.second[k];
-          if (shared[i] || shared[j]) {
-            pair_touching_[k] = o.touching;
-            if (o.touching) pair_buffer_[k] = o;
-          }
-          if (!o.touching) continue;
-          ++touching_pairs;
-          worst = std::max(worst, o.overlap_ratio);
-          if (!shared[i]) {
-            f[i] += o.force;
-            tq[i] += o.torque_first;
-            ++coord[i];
-          }
-          if (!shared[j]) {
-            f[j] -= o.force;
-            tq[j] += o.torque_second;
-            ++coord[j];
-          }
+          tally(o, touching_pairs);
+          pair_step(o, pairs_.first[k], pairs_.second[k], pair_touching_[k], pair_buffer_[k]);
+        }
+        for (std::uint32_t k = block_body_pair_[bu]; k < block_body_pair_[bu + 1]; ++k) {
+          const ContactOutcome o = body_pair_outcome(k);
+          tally(o, touching_pairs);
+          pair_step(o, body_pairs_.first[k], body_pairs_.second[k], body_pair_touching_[k],
+                    body_pair_buffer_[k]);
         }
         for (std::uint32_t k = block_wall_[bu]; k < block_wall_[bu + 1]; ++k) {
           const ContactOutcome o = wall_outcome(k);
-          const std::uint32_t i = walls_.first[k];
-          if (shared[i]) {
-            wall_touching_[k] = o.touching;
-            if (o.touching) wall_buffer_[k] = o;
-          }
-          if (!o.touching) continue;
-          ++touching_walls;
-          worst = std::max(worst, o.overlap_ratio);
-          if (!shared[i]) {
-            f[i] += o.force;
-            tq[i] += o.torque_first;
-            ++coord[i];
-          }
+          tally(o, touching_walls);
+          wall_step(o, walls_.first[k], wall_touching_[k], wall_buffer_[k]);
+        }
+        for (std::uint32_t k = block_body_wall_[bu]; k < block_body_wall_[bu + 1]; ++k) {
+          const ContactOutcome o = body_wall_outcome(k);
+          tally(o, touching_walls);
+          wall_step(o, body_walls_.first[k], body_wall_touching_[k], body_wall_buffer_[k]);
         }
       }
 #pragma omp for schedule(static)
       for (std::size_t s = 0; s < shared_list_.size(); ++s) {
         const std::uint32_t i = shared_list_[s];
-        Vec3 force{}, torque{};
-        std::int32_t count = 0;
-        for (std::uint32_t e = incident_offset_[i]; e < incident_offset_[i + 1]; ++e) {
-          const std::uint32_t k = incident_[e] >> 1;
-          if (!pair_touching_[k]) continue;
-          const ContactOutcome& o = pair_buffer_[k];
-          if ((incident_[e] & 1u) == 0) {
-            force += o.force;
-            torque += o.torque_first;
-          } else {
-            force -= o.force;
-            torque += o.torque_second;
-          }
-          ++count;
-        }
-        for (std::uint32_t k = wall_offset_[i]; k < wall_offset_[i + 1]; ++k) {
-          if (!wall_touching_[k]) continue;
-          force += wall_buffer_[k].force;
-          torque += wall_buffer_[k].torque_first;
-          ++count;
-        }
-        f[i] = force;
-        tq[i] = torque;
-        coord[i] = count;
-      }
-    }
-  } else {
-    // Threads: every contact writes its own slot, then each particle sums its contacts in
-    // increasing contact index, walls last: exactly the order of the serial loop, so the
-    // result is bitwise the same for any number of threads (no atomics). A contact that
-    // does not touch writes only its one-byte flag: most Verlet candidates are apart, and
-    // the outcome slots are the memory traffic that limits this path.
-    const int nt = threads_;
-#pragma omp parallel num_threads(nt)
-    {
-#pragma omp for schedule(static) reduction(max : worst) reduction(+ : touching_pairs)
-      for (std::size_t k = 0; k < n_pairs; ++k) {
-        const ContactOutcome o = pair_outcome(k);
-        pair_touching_[k] = o.touching;
-        if (o.touching) {
-          pair_buffer_[k] = o;
-          ++touching_pairs;
-          worst = std::max(worst, o.overlap_ratio);
-        }
-      }
-#pragma omp for schedule(static) reduction(max : worst) reduction(+ : touching_walls)
-      for (std::size_t k = 0; k < n_walls; ++k) {
-        const ContactOutcome o = wall_outcome(k);
-        wall_touching_[k] = o.touching;
-        if (o.touching) {
-          wall_buffer_[k] = o;
-          ++touching_walls;
-          worst = std::max(worst, o.overlap_ratio);
-        }
-      }
-#pragma omp for schedule(dynamic, 64) reduction(max : worst) reduction(+ : touching_pairs, deep)
-      for (std::size_t k = 0; k < n_body_pairs; ++k) {
-        const ContactOutcome o = body_pair_outcome(k);
-        body_pair_touching_[k] = o.touching;
-        if (o.touching) {
-          body_pair_buffer_[k] = o;
-          ++touching_pairs;
-          deep += o.deep;
-          worst = std::max(worst, o.overlap_ratio);
-        }
-      }
-#pragma omp for schedule(dynamic, 64) reduction(max : worst) reduction(+ : touching_walls, deep)
-      for (std::size_t k = 0; k < n_body_walls; ++k) {
-        const ContactOutcome o = body_wall_outcome(k);
-        body_wall_touching_[k] = o.touching;
-        if (o.touching) {
-          body_wall_buffer_[k] = o;
-          ++touching_walls;
-          deep += o.deep;
-          worst = std::max(worst, o.overlap_ratio);
-        }
-      }
-#pragma omp for schedule(static)
-      for (std::size_t i = 0; i < n; ++i) {
         Vec3 force{}, torque{};
         std::int32_t count = 0;
         const auto add_pairs = [&](const std::vector<std::uint32_t>& offset,
@@ -581,7 +522,6 @@ void DemSimulation::compute_forces() {
             ++count;
           }
         };
-        // The order of the serial loop: sphere pairs, body pairs, sphere walls, body walls.
         add_pairs(incident_offset_, incident_, pair_buffer_, pair_touching_);
         if (has_bodies_) {
           add_pairs(body_incident_offset_, body_incident_, body_pair_buffer_, body_pair_touching_);
@@ -773,42 +713,54 @@ void DemSimulation::build_incidence() {
   wall_touching_.resize(walls_.size());
   body_pair_touching_.resize(body_pairs_.size());
   body_wall_touching_.resize(body_walls_.size());
-  if (!has_bodies_) build_blocks();
+  build_blocks();
 }
 
-// Cuts the particles into one contiguous block per thread with about equal numbers of
-// contacts (each pair belongs to the block of its first particle, each wall contact to
-// its particle's) and marks the particles with a pair in another block as shared.
+// Cuts the particles into one contiguous block per thread with about equal work (each
+// contact belongs to the block of its first particle; an element pair weighs as
+// kElementPairWeight sphere contacts, for its GJK) and marks the particles with a pair in
+// another block as shared.
 void DemSimulation::build_blocks() {
+  constexpr std::size_t kElementPairWeight = 8;
   const std::size_t n = setup_.particles.size();
   const auto blocks = static_cast<std::size_t>(threads_);
-  const std::size_t total = pairs_.size() + walls_.size();
+  const std::size_t total = pairs_.size() + walls_.size() + body_walls_.size() +
+                            kElementPairWeight * body_pairs_.size();
   block_particle_.assign(blocks + 1, static_cast<std::uint32_t>(n));
   block_particle_[0] = 0;
-  std::size_t k = 0, w = 0, next = 1;
+  std::size_t k = 0, w = 0, bp = 0, bw = 0, next = 1;
   for (std::uint32_t i = 0; i < n && next < blocks; ++i) {
-    // Contacts held by particles before i: start block `next` here once its share is met.
+    // Work held by particles before i: start block `next` here once its share is met.
     while (k < pairs_.size() && pairs_.first[k] < i) ++k;
     while (w < walls_.size() && walls_.first[w] < i) ++w;
-    if ((k + w) * blocks >= next * total) block_particle_[next++] = i;
+    while (bp < body_pairs_.size() && body_pairs_.first[bp] < i) ++bp;
+    while (bw < body_walls_.size() && body_walls_.first[bw] < i) ++bw;
+    const std::size_t done = k + w + bw + kElementPairWeight * bp;
+    if (done * blocks >= next * total) block_particle_[next++] = i;
   }
-  const auto first_contact = [](const std::vector<std::uint32_t>& first, std::uint32_t i) {
-    return static_cast<std::uint32_t>(std::lower_bound(first.begin(), first.end(), i) -
-                                      first.begin());
+  const auto starts = [&](const std::vector<std::uint32_t>& first, std::vector<std::uint32_t>& out) {
+    out.resize(blocks + 1);
+    for (std::size_t b = 0; b <= blocks; ++b) {
+      out[b] = static_cast<std::uint32_t>(
+          std::lower_bound(first.begin(), first.end(), block_particle_[b]) - first.begin());
+    }
   };
-  block_pair_.resize(blocks + 1);
-  block_wall_.resize(blocks + 1);
-  for (std::size_t b = 0; b <= blocks; ++b) {
-    block_pair_[b] = first_contact(pairs_.first, block_particle_[b]);
-    block_wall_[b] = first_contact(walls_.first, block_particle_[b]);
-  }
+  starts(pairs_.first, block_pair_);
+  starts(walls_.first, block_wall_);
+  starts(body_pairs_.first, block_body_pair_);
+  starts(body_walls_.first, block_body_wall_);
   shared_.assign(n, 0);
-  std::size_t b = 0;
-  for (std::size_t c = 0; c < pairs_.size(); ++c) {
-    const std::uint32_t i = pairs_.first[c], j = pairs_.second[c];
-    while (i >= block_particle_[b + 1]) ++b;
-    if (j >= block_particle_[b + 1]) shared_[i] = shared_[j] = 1;  // j > i: a later block
-  }
+  const auto mark = [&](const std::vector<std::uint32_t>& first,
+                        const std::vector<std::uint32_t>& second) {
+    std::size_t b = 0;
+    for (std::size_t c = 0; c < first.size(); ++c) {
+      const std::uint32_t i = first[c], j = second[c];
+      while (i >= block_particle_[b + 1]) ++b;
+      if (j >= block_particle_[b + 1]) shared_[i] = shared_[j] = 1;  // j > i: a later block
+    }
+  };
+  mark(pairs_.first, pairs_.second);
+  mark(body_pairs_.first, body_pairs_.second);
   shared_list_.clear();
   for (std::uint32_t i = 0; i < n; ++i) {
     if (shared_[i]) shared_list_.push_back(i);

@@ -197,10 +197,12 @@ class DemSimulation {
   std::vector<std::uint8_t> pair_touching_, wall_touching_, body_pair_touching_,
       body_wall_touching_;
   std::vector<std::uint32_t> body_incident_offset_, body_incident_, body_wall_offset_;
-  // Threaded spheres (see compute_forces): particles cut into one contiguous block per
-  // thread; `shared_` marks the particles with a contact in another block, summed by the
-  // gather above, while every other particle accumulates directly in its block's loop.
-  std::vector<std::uint32_t> block_particle_, block_pair_, block_wall_, shared_list_;
+  // Threads (see compute_forces): particles cut into one contiguous block per thread,
+  // with the first contact of each list per block; `shared_` marks the particles with a
+  // contact in another block, summed by the gather, while every other particle
+  // accumulates directly in its block's loop.
+  std::vector<std::uint32_t> block_particle_, block_pair_, block_wall_, block_body_pair_,
+      block_body_wall_, shared_list_;
   std::vector<std::uint8_t> shared_;
   std::int64_t deep_contacts_ = 0;
   std::mt19937_64 pour_rng_;  // element contacts whose overlap exceeded the crusts
