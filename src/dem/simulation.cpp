@@ -66,14 +66,6 @@ DemSimulation::DemSimulation(DemSetup setup)
       throw std::invalid_argument("a non-spherical particle has no shape in the species table");
     }
   }
-  // Threads pay off only with enough work per thread between two barriers; below that the
-  // serial path is used (same results, bit for bit), which also keeps small runs from
-  // stalling when the cores are shared.
-  const std::size_t per_thread =
-      setup_.particles_per_thread > 0 ? setup_.particles_per_thread : (has_bodies_ ? 500 : 4000);
-  const auto useful = static_cast<int>(std::max<std::size_t>(1, p.size() / per_thread));
-  threads_ = std::clamp(setup_.threads, 1, useful);
-  integrator_.set_threads(threads_);
   rebuild_lists();
   compute_forces();
 }
@@ -549,7 +541,21 @@ void DemSimulation::compute_forces() {
   }
 }
 
+void DemSimulation::choose_threads() {
+  // Threads pay off only with enough work per thread between two barriers; below that the
+  // serial path is used (same results, bit for bit), which also keeps small runs from
+  // stalling when the cores are shared. Chosen again at every rebuild: a pour that starts
+  // empty takes the threads once it holds enough particles.
+  const std::size_t per_thread =
+      setup_.particles_per_thread > 0 ? setup_.particles_per_thread : (has_bodies_ ? 500 : 4000);
+  const auto useful =
+      static_cast<int>(std::max<std::size_t>(1, setup_.particles.size() / per_thread));
+  threads_ = std::clamp(setup_.threads, 1, useful);
+  integrator_.set_threads(threads_);
+}
+
 void DemSimulation::rebuild_lists() {
+  choose_threads();
   search_.rebuild(setup_.particles, setup_.obstacles, time(), pairs_, walls_,
                   ghost_.empty() ? nullptr : ghost_.data());
   if (has_bodies_) split_body_contacts();
@@ -1101,6 +1107,7 @@ void DemSimulation::load_checkpoint(const std::filesystem::path& file) {
     get(in, max_overlap_ratio_);
     get(in, touching_pairs_);
     get(in, touching_walls_);
+    choose_threads();
     build_incidence();
   } catch (const std::runtime_error& e) {
     throw InputError(file.string(), "", e.what());

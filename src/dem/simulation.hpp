@@ -167,6 +167,7 @@ class DemSimulation {
 
  private:
   void compute_forces();
+  void choose_threads();
   void rebuild_lists();
   void build_incidence();
   void build_blocks();

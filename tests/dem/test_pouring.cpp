@@ -88,6 +88,22 @@ TEST(Pouring, InsertsAtTheRateWithoutOverlap) {
   EXPECT_GT(sim.diagnostics().wall_contacts, 0);         // they reached the floor
 }
 
+TEST(Pouring, APourThatStartsEmptyTakesItsThreadsAndMatchesOneThread) {
+  DemCase c = pour_case();
+  c.setup.particles_per_thread = 20;  // two threads from 40 particles on
+  DemSimulation serial(c.setup);
+  c.setup.threads = 2;
+  DemSimulation threaded(c.setup);
+  EXPECT_EQ(threaded.threads(), 1);  // empty
+  serial.run_until(0.06);  // about 70 particles by then
+  threaded.run_until(0.06);
+  EXPECT_EQ(threaded.threads(), 2);
+  const auto& a = serial.particles().position;
+  const auto& b = threaded.particles().position;
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(Vec3)), 0);
+}
+
 TEST(Pouring, RestartInTheMiddleOfThePourIsBitForBit) {
   const auto file = std::filesystem::temp_directory_path() / "sanguis_test_pour.ckpt";
   DemCase c = pour_case();
