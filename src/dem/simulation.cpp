@@ -409,7 +409,7 @@ void DemSimulation::compute_forces() {
     // particles go through the outcome slots and the gather below. Bitwise the serial
     // result for any number of threads, no atomics, no slot per contact.
     const std::uint8_t* shared = shared_.data();
-    const auto blocks = static_cast<std::ptrdiff_t>(block_particle_.size()) - 1;
+    const auto blocks = static_cast<std::ptrdiff_t>(block_pairs_.offset.size()) - 1;
     // One contact of a list: its outcome, kept for the gather when it touches a shared
     // particle, and added at once to the particles that are not shared.
     const auto pair_step = [&](const ContactOutcome& o, std::uint32_t i, std::uint32_t j,
@@ -444,39 +444,40 @@ void DemSimulation::compute_forces() {
     const int nt = threads_;
 #pragma omp parallel num_threads(nt)
     {
+#pragma omp for schedule(static)
+      for (std::size_t i = 0; i < setup_.particles.size(); ++i) {
+        if (shared[i]) continue;
+        f[i] = Vec3{};
+        tq[i] = Vec3{};
+        coord[i] = 0;
+      }
 #pragma omp for schedule(static, 1) reduction(max : worst) \
     reduction(+ : touching_pairs, touching_walls, deep)
       for (std::ptrdiff_t b = 0; b < blocks; ++b) {
         const auto bu = static_cast<std::size_t>(b);
-        for (std::uint32_t i = block_particle_[bu]; i < block_particle_[bu + 1]; ++i) {
-          if (shared[i]) continue;
-          f[i] = Vec3{};
-          tq[i] = Vec3{};
-          coord[i] = 0;
-        }
         const auto tally = [&](const ContactOutcome& o, std::int64_t& touching) {
           if (!o.touching) return;
           ++touching;
           deep += o.deep;
           worst = std::max(worst, o.overlap_ratio);
         };
-        for (std::uint32_t k = block_pair_[bu]; k < block_pair_[bu + 1]; ++k) {
+        for (const std::uint32_t k : block_pairs_.of(bu)) {
           const ContactOutcome o = pair_outcome(k);
           tally(o, touching_pairs);
           pair_step(o, pairs_.first[k], pairs_.second[k], pair_touching_[k], pair_buffer_[k]);
         }
-        for (std::uint32_t k = block_body_pair_[bu]; k < block_body_pair_[bu + 1]; ++k) {
+        for (const std::uint32_t k : block_body_pairs_.of(bu)) {
           const ContactOutcome o = body_pair_outcome(k);
           tally(o, touching_pairs);
           pair_step(o, body_pairs_.first[k], body_pairs_.second[k], body_pair_touching_[k],
                     body_pair_buffer_[k]);
         }
-        for (std::uint32_t k = block_wall_[bu]; k < block_wall_[bu + 1]; ++k) {
+        for (const std::uint32_t k : block_walls_.of(bu)) {
           const ContactOutcome o = wall_outcome(k);
           tally(o, touching_walls);
           wall_step(o, walls_.first[k], wall_touching_[k], wall_buffer_[k]);
         }
-        for (std::uint32_t k = block_body_wall_[bu]; k < block_body_wall_[bu + 1]; ++k) {
+        for (const std::uint32_t k : block_body_walls_.of(bu)) {
           const ContactOutcome o = body_wall_outcome(k);
           tally(o, touching_walls);
           wall_step(o, body_walls_.first[k], body_wall_touching_[k], body_wall_buffer_[k]);
@@ -722,47 +723,64 @@ void DemSimulation::build_incidence() {
   build_blocks();
 }
 
-// Cuts the particles into one contiguous block per thread with about equal work (each
-// contact belongs to the block of its first particle; an element pair weighs as
-// kElementPairWeight sphere contacts, for its GJK) and marks the particles with a pair in
-// another block as shared.
+// Cuts space into one slab per thread along the longest axis of the particles, with about
+// equal work in each (a contact belongs to the slab of its first particle; an element
+// pair weighs as kElementPairWeight sphere contacts, for its GJK), lists each slab's
+// contacts in increasing index, and marks the particles with a pair in another slab as
+// shared. Slabs, not index ranges: particles are stored in id order, which follows
+// space only for ordered inputs (a random fill scatters ids).
 void DemSimulation::build_blocks() {
-  constexpr std::size_t kElementPairWeight = 8;
-  const std::size_t n = setup_.particles.size();
+  constexpr std::uint32_t kElementPairWeight = 8;
+  constexpr std::size_t kBins = 4096;
+  const ParticleStore& p = setup_.particles;
+  const std::size_t n = p.size();
   const auto blocks = static_cast<std::size_t>(threads_);
-  const std::size_t total = pairs_.size() + walls_.size() + body_walls_.size() +
-                            kElementPairWeight * body_pairs_.size();
-  block_particle_.assign(blocks + 1, static_cast<std::uint32_t>(n));
-  block_particle_[0] = 0;
-  std::size_t k = 0, w = 0, bp = 0, bw = 0, next = 1;
-  for (std::uint32_t i = 0; i < n && next < blocks; ++i) {
-    // Work held by particles before i: start block `next` here once its share is met.
-    while (k < pairs_.size() && pairs_.first[k] < i) ++k;
-    while (w < walls_.size() && walls_.first[w] < i) ++w;
-    while (bp < body_pairs_.size() && body_pairs_.first[bp] < i) ++bp;
-    while (bw < body_walls_.size() && body_walls_.first[bw] < i) ++bw;
-    const std::size_t done = k + w + bw + kElementPairWeight * bp;
-    if (done * blocks >= next * total) block_particle_[next++] = i;
-  }
-  const auto starts = [&](const std::vector<std::uint32_t>& first, std::vector<std::uint32_t>& out) {
-    out.resize(blocks + 1);
-    for (std::size_t b = 0; b <= blocks; ++b) {
-      out[b] = static_cast<std::uint32_t>(
-          std::lower_bound(first.begin(), first.end(), block_particle_[b]) - first.begin());
+  // The longest axis of the particles' extent (a column in a long channel is cut
+  // across its height, not along the empty channel).
+  Vec3 low = setup_.domain.max, high = setup_.domain.min;
+  for (const Vec3& x : p.position) {
+    for (int k = 0; k < 3; ++k) {
+      low[k] = std::min(low[k], x[k]);
+      high[k] = std::max(high[k], x[k]);
     }
-  };
-  starts(pairs_.first, block_pair_);
-  starts(walls_.first, block_wall_);
-  starts(body_pairs_.first, block_body_pair_);
-  starts(body_walls_.first, block_body_wall_);
+  }
+  int axis = 0;
+  for (int k = 1; k < 3; ++k) {
+    if (high[k] - low[k] > high[axis] - low[axis]) axis = k;
+  }
+  const double lo = low[axis], span = std::max(high[axis] - low[axis], 1e-300);
+  std::vector<std::uint32_t> bin(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double u = (p.position[i][axis] - lo) / span;
+    bin[i] = static_cast<std::uint32_t>(
+        std::clamp(u * static_cast<double>(kBins), 0.0, static_cast<double>(kBins - 1)));
+  }
+  std::vector<std::uint64_t> work(kBins, 0);
+  for (std::uint32_t i : pairs_.first) ++work[bin[i]];
+  for (std::uint32_t i : walls_.first) ++work[bin[i]];
+  for (std::uint32_t i : body_pairs_.first) work[bin[i]] += kElementPairWeight;
+  for (std::uint32_t i : body_walls_.first) ++work[bin[i]];
+  std::uint64_t total = 0;
+  for (std::uint64_t w : work) total += w;
+  std::vector<std::uint32_t> block_of_bin(kBins);
+  std::uint64_t done = 0;
+  for (std::size_t b = 0; b < kBins; ++b) {
+    block_of_bin[b] = static_cast<std::uint32_t>(
+        std::min<std::uint64_t>(blocks - 1, total > 0 ? done * blocks / total : 0));
+    done += work[b];
+  }
+  std::vector<std::uint32_t> block(n);
+  for (std::size_t i = 0; i < n; ++i) block[i] = block_of_bin[bin[i]];
+
+  block_pairs_.build(pairs_.first, block, blocks);
+  block_walls_.build(walls_.first, block, blocks);
+  block_body_pairs_.build(body_pairs_.first, block, blocks);
+  block_body_walls_.build(body_walls_.first, block, blocks);
   shared_.assign(n, 0);
   const auto mark = [&](const std::vector<std::uint32_t>& first,
                         const std::vector<std::uint32_t>& second) {
-    std::size_t b = 0;
     for (std::size_t c = 0; c < first.size(); ++c) {
-      const std::uint32_t i = first[c], j = second[c];
-      while (i >= block_particle_[b + 1]) ++b;
-      if (j >= block_particle_[b + 1]) shared_[i] = shared_[j] = 1;  // j > i: a later block
+      if (block[first[c]] != block[second[c]]) shared_[first[c]] = shared_[second[c]] = 1;
     }
   };
   mark(pairs_.first, pairs_.second);
@@ -770,6 +788,18 @@ void DemSimulation::build_blocks() {
   shared_list_.clear();
   for (std::uint32_t i = 0; i < n; ++i) {
     if (shared_[i]) shared_list_.push_back(i);
+  }
+}
+
+void BlockContacts::build(const std::vector<std::uint32_t>& first,
+                          const std::vector<std::uint32_t>& block, std::size_t blocks) {
+  offset.assign(blocks + 1, 0);
+  for (std::uint32_t i : first) ++offset[block[i] + 1];
+  for (std::size_t b = 0; b < blocks; ++b) offset[b + 1] += offset[b];
+  index.resize(first.size());
+  fill.assign(offset.begin(), offset.end() - 1);
+  for (std::size_t k = 0; k < first.size(); ++k) {
+    index[fill[block[first[k]]]++] = static_cast<std::uint32_t>(k);
   }
 }
 

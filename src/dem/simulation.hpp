@@ -109,6 +109,17 @@ struct DemDiagnostics {
   std::int64_t mobile_particles = 0;          // the means' population (fixed ones excluded)
 };
 
+// The contacts of one list grouped by thread block, each group in increasing contact
+// index (CSR layout).
+struct BlockContacts {
+  std::vector<std::uint32_t> offset, index, fill;
+  void build(const std::vector<std::uint32_t>& first, const std::vector<std::uint32_t>& block,
+             std::size_t blocks);
+  std::span<const std::uint32_t> of(std::size_t b) const {
+    return {index.data() + offset[b], index.data() + offset[b + 1]};
+  }
+};
+
 class DemSimulation {
  public:
   explicit DemSimulation(DemSetup setup);
@@ -198,12 +209,12 @@ class DemSimulation {
   std::vector<std::uint8_t> pair_touching_, wall_touching_, body_pair_touching_,
       body_wall_touching_;
   std::vector<std::uint32_t> body_incident_offset_, body_incident_, body_wall_offset_;
-  // Threads (see compute_forces): particles cut into one contiguous block per thread,
-  // with the first contact of each list per block; `shared_` marks the particles with a
-  // contact in another block, summed by the gather, while every other particle
-  // accumulates directly in its block's loop.
-  std::vector<std::uint32_t> block_particle_, block_pair_, block_wall_, block_body_pair_,
-      block_body_wall_, shared_list_;
+  // Threads (see compute_forces): space cut into one slab per thread, each with its
+  // contacts of every list; `shared_` marks the particles with a contact in another
+  // slab, summed by the gather, while every other particle accumulates directly in its
+  // slab's loop.
+  BlockContacts block_pairs_, block_walls_, block_body_pairs_, block_body_walls_;
+  std::vector<std::uint32_t> shared_list_;
   std::vector<std::uint8_t> shared_;
   std::int64_t deep_contacts_ = 0;
   std::mt19937_64 pour_rng_;  // element contacts whose overlap exceeded the crusts
