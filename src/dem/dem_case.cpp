@@ -348,6 +348,7 @@ ParticleGroup parse_group(const ConfigTable& t, std::vector<MaterialSpec>& mater
   g.fixed = t.get_bool("fixed", false);
   if (g.fixed) {
     if (g.arrangement == "pour") t.fail("fixed", "a poured group cannot be fixed");
+    if (g.shape >= 0) t.fail("fixed", "only spheres can be glued (fixed = true)");
     for (const char* key : {"velocity_m_s", "angular_velocity_rad_s", "velocity_noise_m_s",
                             "velocities_m_s", "angular_velocities_rad_s"}) {
       if (t.has(key)) t.fail(key, "a fixed group does not move: remove this key");

@@ -165,7 +165,7 @@ void NeighborSearch::rebuild(ParticleStore& particles, const std::vector<Obstacl
   // Particle-obstacle pairs, sorted by (particle, obstacle).
   scratch_.clear();
   for (std::size_t i = 0; i < n; ++i) {
-    if (ghost != nullptr && ghost[i]) continue;
+    if ((ghost != nullptr && ghost[i]) || particles.is_fixed(i)) continue;  // glued: no force
     for (std::size_t o = 0; o < obstacles.size(); ++o) {
       if (!obstacles[o].active(time)) continue;
       const SphereObstacleGap gap =

@@ -407,7 +407,8 @@ void DemSimulation::compute_forces() {
     // directly, in the order of the serial loop (sphere pairs, body pairs, sphere walls,
     // body walls, each in increasing contact index); only the contacts of shared
     // particles go through the outcome slots and the gather below. Bitwise the serial
-    // result for any number of threads, no atomics, no slot per contact.
+    // result for any number of threads, no atomics, and only the contacts of shared
+    // particles pass through memory twice.
     const std::uint8_t* shared = shared_.data();
     const auto blocks = static_cast<std::ptrdiff_t>(block_pairs_.offset.size()) - 1;
     // One contact of a list: its outcome, kept for the gather when it touches a shared
@@ -445,7 +446,7 @@ void DemSimulation::compute_forces() {
 #pragma omp parallel num_threads(nt)
     {
 #pragma omp for schedule(static)
-      for (std::size_t i = 0; i < setup_.particles.size(); ++i) {
+      for (std::size_t i = 0; i < p.size(); ++i) {
         if (shared[i]) continue;
         f[i] = Vec3{};
         tq[i] = Vec3{};
@@ -751,7 +752,8 @@ void DemSimulation::build_blocks() {
   const double lo = low[axis], span = std::max(high[axis] - low[axis], 1e-300);
   std::vector<std::uint32_t> bin(n);
   for (std::size_t i = 0; i < n; ++i) {
-    const double u = (p.position[i][axis] - lo) / span;
+    double u = (p.position[i][axis] - lo) / span;
+    if (!std::isfinite(u)) u = 0.0;  // a blown-up particle: check_state reports it
     bin[i] = static_cast<std::uint32_t>(
         std::clamp(u * static_cast<double>(kBins), 0.0, static_cast<double>(kBins - 1)));
   }

@@ -205,7 +205,8 @@ class DemSimulation {
   bool has_bodies_ = false;
   BodyContactList body_pairs_, body_walls_;
   std::vector<ContactOutcome> body_pair_buffer_, body_wall_buffer_;
-  // Per slot: whether the outcome was written this step (only touching contacts are).
+  // Per slot: whether the contact touched this step (written for the contacts of shared
+  // particles, the only ones the gather reads; the outcome only when it touched).
   std::vector<std::uint8_t> pair_touching_, wall_touching_, body_pair_touching_,
       body_wall_touching_;
   std::vector<std::uint32_t> body_incident_offset_, body_incident_, body_wall_offset_;

@@ -1,11 +1,12 @@
 #pragma once
-// Separating-axis test for two oriented boxes with a margin: a cheap, exact rejection
-// before GJK for the box elements of composite particles (the crosses of thesis §3.2).
-// Fifteen candidate axes (three face normals of each box and the nine cross products
-// of their edges, Gottschalk et al. 1996); along a unit axis L the boxes' projections
-// are at least |T.L| - rA(L) - rB(L) apart, and so are the boxes. When that gap exceeds
-// `margin` (the sum of the crusts) the cores cannot be within contact range and GJK
-// need not run; otherwise nothing is concluded.
+// Separating-axis test for two oriented boxes with a margin: a cheap, conservative
+// rejection of element pairs for the box elements of composite particles (the crosses
+// of thesis §3.2), used when the element lists are rebuilt. Fifteen candidate axes
+// (three face normals of each box and the nine cross products of their edges,
+// Gottschalk et al. 1996); along a unit axis L the boxes' projections are at least
+// |T.L| - rA(L) - rB(L) apart, and so are the boxes. When that gap exceeds `margin`
+// (crusts plus skin) the pair cannot touch before the next rebuild. A pair it keeps may
+// still be farther apart than the margin: it never drops one that is closer.
 #include <algorithm>
 #include <cmath>
 

@@ -1,5 +1,6 @@
-// The same case gives bitwise identical results on 1, 2 and 3 threads: forces are
-// gathered per particle in a fixed order, never accumulated with atomics.
+// The same case gives bitwise identical results on 1, 2 and 3 threads: every particle
+// sums its contacts in the serial loop's order, in its thread's slab or through the
+// gather of shared particles, never with atomics.
 #include <gtest/gtest.h>
 
 #include <cstring>

@@ -42,6 +42,29 @@ TEST(SeparatingAxes, OnlyAnEdgeAxisSeparatesTwoCubesEdgeToEdge) {
   EXPECT_FALSE(boxes_apart_beyond(cube, a, cube, b, 1.01 * g));
 }
 
+TEST(SeparatingAxes, UnequalBoxesInEitherOrder) {
+  // A flat plate under a long rod, both tilted: the test must not depend on which box
+  // comes first, and must agree with GJK on the margin (the rod's extents enter as b's
+  // when it comes second and as a's when it comes first).
+  std::mt19937_64 rng(7);
+  const Box plate{{0.02, 0.015, 0.001}};
+  const Box rod{{0.0135, 0.001, 0.0015}};
+  int rejected = 0;
+  for (int n = 0; n < 5000; ++n) {
+    const Pose a{{0.0, 0.0, 0.0}, random_rotation(rng)};
+    const Pose b{uniform(rng, 0.0, 0.06) * random_unit(rng), random_rotation(rng)};
+    const double margin = uniform(rng, 0.0, 0.003);  // crusts and a skin
+    const bool ab = boxes_apart_beyond(plate, a, rod, b, margin);
+    EXPECT_EQ(ab, boxes_apart_beyond(rod, b, plate, a, margin)) << n;
+    const DistanceResult d = gjk_distance(ConvexShape{plate}, a, ConvexShape{rod}, b);
+    if (d.intersecting || d.distance <= margin) {
+      EXPECT_FALSE(ab) << n;
+    }
+    rejected += ab ? 1 : 0;
+  }
+  EXPECT_GT(rejected, 1000);
+}
+
 TEST(SeparatingAxes, NeverRejectsAPairWithinTheMarginAndRejectsMostFarOnes) {
   // Arms of the crosses of thesis §3.2.2 (27 x 2 x 3 mm boxes, 0.1 mm crusts) at random
   // poses with their bounding balls overlapping, as the element lists hand them over.

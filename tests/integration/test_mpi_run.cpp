@@ -27,7 +27,13 @@ TEST_F(MpiRun, TwoProcessesAnalyseLikeOne) {
                     " --quiet")
                 .code,
             0);
-  const std::string command = "mpirun -np 2 --allow-run-as-root --oversubscribe " +
+  // A test that ran before in this process may have started MPI as a singleton, whose
+  // environment (OMPI_*, PMIX_*) would make this mpirun believe it runs inside a job.
+  const std::string clean_environment =
+      "for v in $(env | sed -n 's/^\\(OMPI_[^=]*\\|PMIX_[^=]*\\|OPAL_[^=]*\\)=.*/\\1/p'); do "
+      "unset $v; done; ";
+  const std::string command = clean_environment +
+                              "mpirun -np 2 --allow-run-as-root --oversubscribe " +
                               shell_quoted(SANGUIS_BINARY) + " run " + shell_quoted(tiny) + " -o " +
                               shell_quoted((dir_ / "two").string()) + " --quiet >" +
                               shell_quoted((dir_ / "mpirun.txt").string()) + " 2>&1";

@@ -1,5 +1,7 @@
 #include "dem/analysis/run_output.hpp"
 
+#include <unordered_set>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -94,6 +96,7 @@ const std::vector<std::string>& file_of(const std::vector<std::vector<std::strin
 // Glued particles (a rough floor) are part of the walls, not of the granular mass: the
 // run-out, heights, velocities and coordination are measured on the mobile particles.
 void drop_fixed(ParticleFrame& f, const std::vector<std::int64_t>& fixed) {
+  if (fixed.size() != f.size()) throw std::runtime_error("particle frame: 'fixed' has a wrong length");
   std::size_t kept = 0;
   for (std::size_t k = 0; k < f.size(); ++k) {
     if (fixed[k] != 0) continue;
@@ -167,14 +170,39 @@ ParticleFrame RunOutput::particles(std::size_t frame) const {
   return f;
 }
 
+std::unordered_set<std::int64_t> RunOutput::fixed_ids(std::size_t frame) const {
+  std::unordered_set<std::int64_t> ids;
+  const io::PointCloud cloud = read_clouds(file_of(particle_files_, frame, "particle"));
+  if (!io::has_array(cloud.int_point_data, "fixed")) return ids;
+  const auto& fixed = io::find_array(cloud.int_point_data, "fixed").values;
+  const auto& id = io::find_array(cloud.int_point_data, "id").values;
+  for (std::size_t k = 0; k < fixed.size() && k < id.size(); ++k) {
+    if (fixed[k] != 0) ids.insert(id[k]);
+  }
+  return ids;
+}
+
 ContactPointFrame RunOutput::contacts(std::size_t frame) const {
   const io::PointCloud cloud = read_clouds(file_of(contact_files_, frame, "contact"));
+  ContactPointFrame all;
+  all.point = cloud.points;
+  all.force = as_vectors(io::find_array(cloud.point_data, "force").values);
+  all.kind = io::find_array(cloud.int_point_data, "kind").values;
+  all.first = io::find_array(cloud.int_point_data, "first_id").values;
+  all.second = io::find_array(cloud.int_point_data, "second_id").values;
+  // Contacts of glued particles belong to the walls they make: left out with them.
+  const auto fixed = fixed_ids(frame);
+  if (fixed.empty()) return all;
   ContactPointFrame f;
-  f.point = cloud.points;
-  f.force = as_vectors(io::find_array(cloud.point_data, "force").values);
-  f.kind = io::find_array(cloud.int_point_data, "kind").values;
-  f.first = io::find_array(cloud.int_point_data, "first_id").values;
-  f.second = io::find_array(cloud.int_point_data, "second_id").values;
+  for (std::size_t k = 0; k < all.size(); ++k) {
+    const bool pair = !ContactPointFrame::is_wall(all.kind[k]);
+    if (fixed.count(all.first[k]) || (pair && fixed.count(all.second[k]))) continue;
+    f.point.push_back(all.point[k]);
+    f.force.push_back(all.force[k]);
+    f.kind.push_back(all.kind[k]);
+    f.first.push_back(all.first[k]);
+    f.second.push_back(all.second[k]);
+  }
   return f;
 }
 
@@ -188,7 +216,18 @@ BranchFrame RunOutput::branches(std::size_t frame) const {
   f.force_magnitude = io::find_array(mesh.cell_data, "force_magnitude").values;
   f.first = io::find_array(mesh.int_cell_data, "first_id").values;
   f.second = io::find_array(mesh.int_cell_data, "second_id").values;
-  return f;
+  const auto fixed = fixed_ids(frame);
+  if (fixed.empty()) return f;
+  BranchFrame kept;
+  for (std::size_t k = 0; k < f.size(); ++k) {
+    if (fixed.count(f.first[k]) || fixed.count(f.second[k])) continue;
+    kept.from.push_back(f.from[k]);
+    kept.to.push_back(f.to[k]);
+    kept.force_magnitude.push_back(f.force_magnitude[k]);
+    kept.first.push_back(f.first[k]);
+    kept.second.push_back(f.second[k]);
+  }
+  return kept;
 }
 
 BodySurfaceFrame RunOutput::bodies(std::size_t frame) const {

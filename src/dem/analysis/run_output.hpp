@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <unordered_set>
 #include <vector>
 
 #include "core/vec3.hpp"
@@ -75,6 +76,8 @@ class RunOutput {
   std::optional<double> first_removal_time() const { return first_removal_; }
 
  private:
+  // Ids of the glued particles of a frame (empty for runs without any).
+  std::unordered_set<std::int64_t> fixed_ids(std::size_t frame) const;
   std::filesystem::path dir_;
   std::vector<double> times_;
   // Per frame, its files: one, or one piece per process of a decomposed run.
