@@ -26,7 +26,9 @@ wide ones, 3000 crosses, peak at 18-22 % near 2.5 tau_c, below 5 % at 10 tau_c);
 columns (a = 3.2, narrower boxes) differ from the box here, so they are not checked.
 
 Writes validation/dem/results/crosses_dam_break.json and
-docs/validation/figures/crosses_dam_break.png. `--reuse`: analyse the runs on disk.
+docs/validation/figures/crosses_dam_break.png. `--reuse`: analyse the runs on disk. A run
+folder left with a checkpoint by a stopped run is continued from it (hours-long gates
+can span several sessions).
 Usage: /usr/bin/python3 validation/dem/crosses_dam_break.py [--build build]
            [--gates 4 8 ...] [--threads T] [--reuse] [--quick]
 """
@@ -91,22 +93,33 @@ def poured_and_at_rest(run, count):
 def run_gate(exe, gate, out, threads):
     """Pour and settle with the gate in place, extending by 0.5 s until every cross is in
     and at rest (the pour rate is bounded by the free room of the region), then remove
-    the gate and follow the collapse for COLLAPSE_S. Returns the opening time."""
+    the gate and follow the collapse for COLLAPSE_S. A folder with a checkpoint (a run
+    stopped on the way) is continued from it. Returns the opening time."""
     base = [exe, "run", CASE, "--output", out, "--quiet", "--threads", str(threads)]
     for o in overrides(gate):
         base += ["--set", o]
-    rate = pour_rate(gate)
-    t = math.ceil(10 * (CROSSES[gate] / rate + SETTLE_S)) / 10
-    cmd = base + ["--set", f"simulation.end_time_s={t}"]
-    print(" ".join(cmd), flush=True)
-    subprocess.run(cmd, check=True)
+    checkpoint = os.path.join(out, "checkpoint.bin")
+
+    def advance(end, extra=()):
+        cmd = base + (["--restart"] if os.path.exists(checkpoint) else []) + list(extra)
+        cmd += ["--set", f"simulation.end_time_s={end}"]
+        print(" ".join(cmd), flush=True)
+        subprocess.run(cmd, check=True)
+
+    if os.path.exists(checkpoint) and opening_time(out) < 1e5:  # stopped in the collapse
+        t = opening_time(out)
+        advance(t + COLLAPSE_S, ["--set", f"obstacle[{GATE_INDEX}].remove_at_s={t}"])
+        return t
+    t = math.ceil(10 * (CROSSES[gate] / pour_rate(gate) + SETTLE_S)) / 10
+    if os.path.exists(checkpoint):  # stopped in the pour: go on from where it is
+        t = max(t, math.ceil(2 * diagnostics(out)[-1]["time_s"] + 1e-9) / 2)
+    advance(t)
     while not poured_and_at_rest(out, CROSSES[gate]):
         if t > 20.0:
             sys.exit(f"gate {gate} cm: the pour has not come to rest by {t} s")
         t = round(t + 0.5, 1)
-        subprocess.run(base + ["--restart", "--set", f"simulation.end_time_s={t}"], check=True)
-    subprocess.run(base + ["--restart", "--set", f"obstacle[{GATE_INDEX}].remove_at_s={t}",
-                           "--set", f"simulation.end_time_s={t + COLLAPSE_S}"], check=True)
+        advance(t)
+    advance(t + COLLAPSE_S, ["--set", f"obstacle[{GATE_INDEX}].remove_at_s={t}"])
     return t
 
 
@@ -160,7 +173,7 @@ def main():
         out = os.path.join(RUNS, f"L{gate}cm_seed{SEED}")
         runs[gate] = out
         if args.reuse and os.path.exists(os.path.join(out, "diagnostics.csv")):
-            continue
+            continue  # analyse what is there (a stopped run: continue it without --reuse)
         run_gate(exe, gate, out, args.threads)
     for out in runs.values():
         subprocess.run([exe, "analyze", out], check=True, stdout=subprocess.DEVNULL)
