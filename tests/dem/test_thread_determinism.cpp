@@ -3,6 +3,8 @@
 // gather of shared particles, never with atomics.
 #include <gtest/gtest.h>
 
+#include <omp.h>
+
 #include <cstring>
 #include <vector>
 
@@ -105,6 +107,25 @@ TEST(ThreadDeterminism, OneTwoAndThreeThreadsGiveIdenticalBits) {
       EXPECT_TRUE(bitwise_equal(one.f, many.f)) << threads << " threads";
     }
   }
+}
+
+TEST(ThreadDeterminism, FewerThreadsGrantedThanSlabsStillGiveTheSerialBits) {
+  // Inside an active parallel region OpenMP grants the simulation's regions a single
+  // thread: its three slabs then run one after the other on that thread.
+  const Snapshot one = run(1, IntegratorKind::kLeapfrog);
+  const int levels = omp_get_max_active_levels();
+  omp_set_max_active_levels(1);
+  Snapshot starved;
+#pragma omp parallel num_threads(2)
+  {
+#pragma omp single
+    starved = run(3, IntegratorKind::kLeapfrog);
+  }
+  omp_set_max_active_levels(levels);
+  ASSERT_EQ(starved.x.size(), 500u);
+  EXPECT_TRUE(bitwise_equal(one.x, starved.x));
+  EXPECT_TRUE(bitwise_equal(one.v, starved.v));
+  EXPECT_TRUE(bitwise_equal(one.f, starved.f));
 }
 
 }  // namespace
