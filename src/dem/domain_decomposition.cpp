@@ -1,4 +1,5 @@
 #include "dem/domain_decomposition.hpp"
+#include "dem/slab_cuts.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -176,27 +177,21 @@ bool SlabDecomposition::near_slab(double c, int slab) const {
 // Slab bounds at equal particle counts, from a histogram of the owned particles along
 // the axis summed over the processes (cheap: no particle list travels).
 void SlabDecomposition::balance(const ParticleStore& p, const std::vector<std::uint8_t>& ghost) {
-  constexpr int kBins = 4096;
+  constexpr std::size_t kBins = 4096;
   std::vector<long long> histogram(kBins, 0);
   const double length = axis_max_ - axis_min_;
   for (std::size_t i = 0; i < p.size(); ++i) {
     if (!ghost.empty() && ghost[i]) continue;
-    const double u = (p.position[i][axis_] - axis_min_) / length;
-    ++histogram[static_cast<std::size_t>(std::clamp(static_cast<int>(u * kBins), 0, kBins - 1))];
+    ++histogram[axis_bin(p.position[i][axis_], axis_min_, length, kBins)];
   }
   MPI_Allreduce(MPI_IN_PLACE, histogram.data(), kBins, MPI_LONG_LONG, MPI_SUM, comm_);
-  const long long total = std::accumulate(histogram.begin(), histogram.end(), 0LL);
-  bounds_.assign(static_cast<std::size_t>(ranks_) + 1, axis_min_);
-  bounds_.back() = axis_max_;
-  long long seen = 0;
-  int next = 1;
-  for (int b = 0; b < kBins && next < ranks_; ++b) {
-    seen += histogram[static_cast<std::size_t>(b)];
-    while (next < ranks_ && seen * ranks_ >= total * next) {
-      bounds_[static_cast<std::size_t>(next++)] = axis_min_ + length * (b + 1) / kBins;
-    }
+  const std::vector<std::size_t> cut =
+      equal_weight_cuts(histogram, static_cast<std::size_t>(ranks_));
+  bounds_.resize(cut.size());
+  for (std::size_t k = 0; k < cut.size(); ++k) {
+    bounds_[k] = cut[k] == kBins ? axis_max_
+                                 : axis_min_ + length * static_cast<double>(cut[k]) / kBins;
   }
-  for (; next < ranks_; ++next) bounds_[static_cast<std::size_t>(next)] = axis_max_;
 }
 
 DemSetup SlabDecomposition::local_setup(const DemSetup& full) {

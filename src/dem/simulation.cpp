@@ -1,4 +1,5 @@
 #include "dem/simulation.hpp"
+#include "dem/slab_cuts.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -752,24 +753,17 @@ void DemSimulation::build_blocks() {
   const double lo = low[axis], span = std::max(high[axis] - low[axis], 1e-300);
   std::vector<std::uint32_t> bin(n);
   for (std::size_t i = 0; i < n; ++i) {
-    double u = (p.position[i][axis] - lo) / span;
-    if (!std::isfinite(u)) u = 0.0;  // a blown-up particle: check_state reports it
-    bin[i] = static_cast<std::uint32_t>(
-        std::clamp(u * static_cast<double>(kBins), 0.0, static_cast<double>(kBins - 1)));
+    bin[i] = static_cast<std::uint32_t>(axis_bin(p.position[i][axis], lo, span, kBins));
   }
   std::vector<std::uint64_t> work(kBins, 0);
   for (std::uint32_t i : pairs_.first) ++work[bin[i]];
   for (std::uint32_t i : walls_.first) ++work[bin[i]];
   for (std::uint32_t i : body_pairs_.first) work[bin[i]] += kElementPairWeight;
   for (std::uint32_t i : body_walls_.first) ++work[bin[i]];
-  std::uint64_t total = 0;
-  for (std::uint64_t w : work) total += w;
+  const std::vector<std::size_t> cut = equal_weight_cuts(work, blocks);
   std::vector<std::uint32_t> block_of_bin(kBins);
-  std::uint64_t done = 0;
-  for (std::size_t b = 0; b < kBins; ++b) {
-    block_of_bin[b] = static_cast<std::uint32_t>(
-        std::min<std::uint64_t>(blocks - 1, total > 0 ? done * blocks / total : 0));
-    done += work[b];
+  for (std::size_t b = 0; b < blocks; ++b) {
+    for (std::size_t k = cut[b]; k < cut[b + 1]; ++k) block_of_bin[k] = static_cast<std::uint32_t>(b);
   }
   std::vector<std::uint32_t> block(n);
   for (std::size_t i = 0; i < n; ++i) block[i] = block_of_bin[bin[i]];

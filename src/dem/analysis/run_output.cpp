@@ -93,27 +93,27 @@ const std::vector<std::string>& file_of(const std::vector<std::vector<std::strin
   return files[frame];
 }
 
+// Keeps the entries k with keep[k] of each array (all of one frame's length), in order.
+template <typename... Arrays>
+void keep_entries(const std::vector<bool>& keep, Arrays&... arrays) {
+  const auto compact = [&](auto& a) {
+    if (a.empty()) return;  // an optional array the run did not write
+    std::size_t kept = 0;
+    for (std::size_t k = 0; k < keep.size(); ++k) {
+      if (keep[k]) a[kept++] = a[k];
+    }
+    a.resize(kept);
+  };
+  (compact(arrays), ...);
+}
+
 // Glued particles (a rough floor) are part of the walls, not of the granular mass: the
 // run-out, heights, velocities and coordination are measured on the mobile particles.
 void drop_fixed(ParticleFrame& f, const std::vector<std::int64_t>& fixed) {
   if (fixed.size() != f.size()) throw std::runtime_error("particle frame: 'fixed' has a wrong length");
-  std::size_t kept = 0;
-  for (std::size_t k = 0; k < f.size(); ++k) {
-    if (fixed[k] != 0) continue;
-    f.id[kept] = f.id[k];
-    f.position[kept] = f.position[k];
-    f.velocity[kept] = f.velocity[k];
-    f.radius[kept] = f.radius[k];
-    if (!f.mass.empty()) f.mass[kept] = f.mass[k];
-    f.spherical[kept] = f.spherical[k];
-    ++kept;
-  }
-  f.id.resize(kept);
-  f.position.resize(kept);
-  f.velocity.resize(kept);
-  f.radius.resize(kept);
-  if (!f.mass.empty()) f.mass.resize(kept);
-  f.spherical.resize(kept);
+  std::vector<bool> keep(fixed.size());
+  for (std::size_t k = 0; k < fixed.size(); ++k) keep[k] = fixed[k] == 0;
+  keep_entries(keep, f.id, f.position, f.velocity, f.radius, f.mass, f.spherical);
 }
 
 }  // namespace
@@ -184,25 +184,21 @@ std::unordered_set<std::int64_t> RunOutput::fixed_ids(std::size_t frame) const {
 
 ContactPointFrame RunOutput::contacts(std::size_t frame) const {
   const io::PointCloud cloud = read_clouds(file_of(contact_files_, frame, "contact"));
-  ContactPointFrame all;
-  all.point = cloud.points;
-  all.force = as_vectors(io::find_array(cloud.point_data, "force").values);
-  all.kind = io::find_array(cloud.int_point_data, "kind").values;
-  all.first = io::find_array(cloud.int_point_data, "first_id").values;
-  all.second = io::find_array(cloud.int_point_data, "second_id").values;
+  ContactPointFrame f;
+  f.point = cloud.points;
+  f.force = as_vectors(io::find_array(cloud.point_data, "force").values);
+  f.kind = io::find_array(cloud.int_point_data, "kind").values;
+  f.first = io::find_array(cloud.int_point_data, "first_id").values;
+  f.second = io::find_array(cloud.int_point_data, "second_id").values;
   // Contacts of glued particles belong to the walls they make: left out with them.
   const auto fixed = fixed_ids(frame);
-  if (fixed.empty()) return all;
-  ContactPointFrame f;
-  for (std::size_t k = 0; k < all.size(); ++k) {
-    const bool pair = !ContactPointFrame::is_wall(all.kind[k]);
-    if (fixed.count(all.first[k]) || (pair && fixed.count(all.second[k]))) continue;
-    f.point.push_back(all.point[k]);
-    f.force.push_back(all.force[k]);
-    f.kind.push_back(all.kind[k]);
-    f.first.push_back(all.first[k]);
-    f.second.push_back(all.second[k]);
+  if (fixed.empty()) return f;
+  std::vector<bool> keep(f.size());
+  for (std::size_t k = 0; k < f.size(); ++k) {
+    const bool pair = !ContactPointFrame::is_wall(f.kind[k]);
+    keep[k] = !fixed.count(f.first[k]) && !(pair && fixed.count(f.second[k]));
   }
+  keep_entries(keep, f.point, f.force, f.kind, f.first, f.second);
   return f;
 }
 
@@ -218,16 +214,12 @@ BranchFrame RunOutput::branches(std::size_t frame) const {
   f.second = io::find_array(mesh.int_cell_data, "second_id").values;
   const auto fixed = fixed_ids(frame);
   if (fixed.empty()) return f;
-  BranchFrame kept;
+  std::vector<bool> keep(f.size());
   for (std::size_t k = 0; k < f.size(); ++k) {
-    if (fixed.count(f.first[k]) || fixed.count(f.second[k])) continue;
-    kept.from.push_back(f.from[k]);
-    kept.to.push_back(f.to[k]);
-    kept.force_magnitude.push_back(f.force_magnitude[k]);
-    kept.first.push_back(f.first[k]);
-    kept.second.push_back(f.second[k]);
+    keep[k] = !fixed.count(f.first[k]) && !fixed.count(f.second[k]);
   }
-  return kept;
+  keep_entries(keep, f.from, f.to, f.force_magnitude, f.first, f.second);
+  return f;
 }
 
 BodySurfaceFrame RunOutput::bodies(std::size_t frame) const {
