@@ -185,8 +185,8 @@ NavierStokes::NavierStokes(const Forest& forest, const std::array<FlowBoundary, 
       boundaries_(checked(forest, boundaries)),
       fluid_(fluid),
       options_(options),
-      pressure_mg_(forest, pressure_kinds(boundaries)),
-      viscous_mg_(forest, velocity_kinds(boundaries)) {
+      pressure_mg_(std::in_place, forest, pressure_kinds(boundaries)),
+      viscous_mg_(std::in_place, forest, velocity_kinds(boundaries)) {
   if (!(fluid.density > 0.0) || !(fluid.viscosity >= 0.0)) {
     throw std::invalid_argument("navier-stokes: density must be > 0 and viscosity >= 0");
   }
@@ -196,14 +196,10 @@ NavierStokes::NavierStokes(const Forest& forest, const std::array<FlowBoundary, 
   g_ = make_vector_field(n, b);
   uf_ = make_vector_field(n, b);
   accel_ = make_vector_field(n, b);
-  scratch_ = make_vector_field(n, b);
   p_ = BlockField(n, b);
-  phi_ = BlockField(n, b);
   mu_ = BlockField(n, b);
   mu_.fill(fluid.viscosity);
-  solid_ = BlockField(n, b);
-  open_ = make_vector_field(n, b);
-  for (auto& f : open_) f.fill(1.0);
+  allocate_work_fields();
   const auto vk = velocity_kinds(boundaries_);
   for (int c = 0; c < 3; ++c) {
     ScalarBoundary& bc = velocity_bc_[D(c)];
@@ -219,11 +215,19 @@ NavierStokes::NavierStokes(const Forest& forest, const std::array<FlowBoundary, 
     }
   }
   pressure_bc_.kind = pressure_kinds(boundaries_);
-  composite_ = !forest.uniform();
-  if (composite_) {
-    for (auto& layer : interface_) layer = BlockField(n, b);  // zero, see fine_faces_to_coarse
-    face_flux_ = make_vector_field(n, b);
-  }
+}
+
+void NavierStokes::allocate_work_fields() {
+  const int n = forest_.local_blocks();
+  const int b = forest_.block_cells();
+  scratch_ = make_vector_field(n, b);
+  phi_ = BlockField(n, b);
+  solid_ = BlockField(n, b);
+  open_ = make_vector_field(n, b);
+  for (auto& f : open_) f.fill(1.0);
+  composite_ = !forest_.uniform();
+  for (auto& layer : interface_) layer = composite_ ? BlockField(n, b) : BlockField();  // zero
+  face_flux_ = composite_ ? make_vector_field(n, b) : FaceField{};
 }
 
 void NavierStokes::set_velocity(const std::function<Vec3(const Vec3&)>& u0, double time) {
@@ -275,6 +279,7 @@ void NavierStokes::set_velocity(const std::function<Vec3(const Vec3&)>& u0, doub
 }
 
 void NavierStokes::set_body_force(const std::function<Vec3(const Vec3&)>& f) {
+  if (&f != &body_force_) body_force_ = f;
   const int b = forest_.block_cells();
   forest_.for_each_block([&](int blk) {
     const Block& block = forest_.block(blk);
@@ -337,7 +342,7 @@ void NavierStokes::set_solid(const std::function<bool(const Vec3&)>& solid) {
   });
   // Solid cells leave the pressure problem: all their faces are closed
   // (beta = 0), so the multigrid treats them as inactive.
-  pressure_mg_.set_coefficients(nullptr, has_solids_ ? &open_ : nullptr);
+  pressure_mg_->set_coefficients(nullptr, has_solids_ ? &open_ : nullptr);
   viscosity_changed_ = true;
   clear_solid_cells(u_);
   close_solid_faces(uf_);
@@ -664,7 +669,7 @@ void NavierStokes::update_viscous_coefficients(double dt) {
       alpha.block(blk)[c] += walls * 2.0 * scale * mu[c] / (h * h);
     });
   });
-  viscous_mg_.set_coefficients(&alpha, &beta);
+  viscous_mg_->set_coefficients(&alpha, &beta);
   viscous_dt_ = dt;
   viscosity_changed_ = false;
 }
@@ -747,7 +752,7 @@ void NavierStokes::viscous_step(double dt, StepReport& report) {
         u(blk, i, j, k) = rhs(blk, i, j, k);
       });
     });
-    const auto r = viscous_mg_.solve(u, rhs, velocity_bc_[D(comp)], options_.viscous);
+    const auto r = viscous_mg_->solve(u, rhs, velocity_bc_[D(comp)], options_.viscous);
     report.viscous_cycles += r.cycles;
     if (!r.converged) {
       std::ostringstream what;
@@ -811,7 +816,7 @@ MultigridReport NavierStokes::project(BlockField& phi) {
   }
   MultigridOptions options = options_.pressure;
   options.absolute_tolerance = std::max(options.absolute_tolerance, 1e-12 * forest_.max(rate));
-  MultigridReport report = pressure_mg_.solve(phi, rhs, pressure_bc_, options);
+  MultigridReport report = pressure_mg_->solve(phi, rhs, pressure_bc_, options);
   if (!report.converged) {
     std::ostringstream what;
     what << "navier-stokes: projection did not converge: RMS residual " << report.residuals.front()
@@ -823,7 +828,7 @@ MultigridReport NavierStokes::project(BlockField& phi) {
   // (quadratic interpolation in fine ghosts, matched fluxes in coarse ones),
   // so that the correction below subtracts exactly the fluxes whose
   // divergence the multigrid drove to its residual.
-  if (composite_) pressure_mg_.residual(phi, rhs, pressure_bc_, scratch_[2]);
+  if (composite_) pressure_mg_->residual(phi, rhs, pressure_bc_, scratch_[2]);
   forest_.for_each_block([&](int blk) {
     const double h = forest_.block(blk).length / b;
     const double* pb = phi.block(blk);
@@ -930,6 +935,91 @@ StepReport NavierStokes::step(double dt) {
   });
   clear_solid_cells(u_);
   time_ += dt;
+  return report;
+}
+
+void NavierStokes::average_shared_faces(FaceField& uf) {
+  const int n = forest_.local_blocks();
+  const int b = forest_.block_cells();
+  // Each block writes its faces on a block face with a same-level neighbour
+  // into the cell layer beside it (layers[face]); the exchange brings the
+  // neighbour's copy into the ghost cell across, as in fine_faces_to_coarse.
+  std::array<BlockField, 6> layers;
+  for (auto& layer : layers) layer = BlockField(n, b);
+  const BlockLayout L = layers[0].layout();
+  auto shared = [&](const Block& block, int d, int side) {
+    const Neighbour& nb = block.neighbours[face_neighbour_slot(d, side)];
+    return nb.link != Link::Boundary && nb.jump == LevelJump::Same;
+  };
+  forest_.for_each_block([&](int blk) {
+    const Block& block = forest_.block(blk);
+    for (int d = 0; d < 3; ++d)
+      for (int side = 0; side < 2; ++side) {
+        if (!shared(block, d, side)) continue;
+        double* layer = layers[D(face_index(d, side))].block(blk);
+        const double* faces = uf[D(d)].block(blk);
+        for_face_layer(L, d, side,
+                       [&](std::ptrdiff_t c, std::ptrdiff_t f) { layer[c] = faces[f]; });
+      }
+  });
+  std::array<BlockField*, 6> fields{};
+  for (std::size_t f = 0; f < 6; ++f) fields[f] = &layers[f];
+  forest_.exchange(fields, 1, true);
+  forest_.for_each_block([&](int blk) {
+    const Block& block = forest_.block(blk);
+    for (int d = 0; d < 3; ++d)
+      for (int side = 0; side < 2; ++side) {
+        if (!shared(block, d, side)) continue;
+        // The neighbour wrote the shared face under its own opposite face.
+        const double* theirs = layers[D(face_index(d, 1 - side))].block(blk);
+        const std::ptrdiff_t beyond = side == 0 ? -L.stride(d) : L.stride(d);
+        double* faces = uf[D(d)].block(blk);
+        for_face_layer(L, d, side, [&](std::ptrdiff_t c, std::ptrdiff_t f) {
+          faces[f] = 0.5 * (faces[f] + theirs[c + beyond]);
+        });
+      }
+  });
+}
+
+RegridReport NavierStokes::regrid(Forest& forest, std::span<const AdaptFlag> flags,
+                                  std::span<BlockField* const> scalars, int max_level) {
+  if (&forest != &forest_) {
+    throw std::invalid_argument("navier-stokes: regrid needs the forest the solver was built on");
+  }
+  if (has_solids_) {
+    throw std::invalid_argument(
+        "navier-stokes: solid cells on an adapting forest are not available yet");
+  }
+  if (variable_viscosity_) {
+    throw std::invalid_argument(
+        "navier-stokes: variable viscosity on an adapting forest is not available yet");
+  }
+  RegridReport report;
+  report.blocks_before = forest.global_blocks();
+  // phi_ and the scratch fields are rebuilt from p and u at every step.
+  std::vector<BlockField*> cells{&u_[0], &u_[1], &u_[2], &g_[0], &g_[1], &g_[2], &p_, &mu_};
+  cells.insert(cells.end(), scalars.begin(), scalars.end());
+  FaceField* faces[] = {&uf_, &accel_};
+  report.changed = forest.adapt(flags, cells, faces, max_level);
+  report.blocks_after = forest.global_blocks();
+  if (!report.changed) return report;
+
+  allocate_work_fields();
+  pressure_mg_.emplace(forest_, pressure_kinds(boundaries_));
+  viscous_mg_.emplace(forest_, velocity_kinds(boundaries_));
+  viscous_dt_ = -1.0;
+  viscosity_changed_ = true;
+  if (body_force_) set_body_force(body_force_);
+  // The carried uf keeps every old face's flux, but a block refined beside
+  // finer ones gave its children the coarse face's value where the finer
+  // neighbour has its own: the copies are averaged (same total flux), the
+  // coarse faces take the fine faces' mean, and one projection removes the
+  // divergence this leaves (O(h^2), in those children only).
+  average_shared_faces(uf_);
+  set_boundary_faces(uf_);
+  BlockField potential(forest_.local_blocks(), forest_.block_cells());
+  report.projection_cycles = project(potential).cycles;
+  fill_velocity_ghosts(u_);
   return report;
 }
 

@@ -40,6 +40,8 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <optional>
+#include <span>
 
 #include "core/error.hpp"
 #include "flow/block_field.hpp"
@@ -86,6 +88,14 @@ struct StepReport {
   double pressure_reduction = 0.0;  ///< mean residual reduction per cycle (final projection)
 };
 
+/// What one regrid did.
+struct RegridReport {
+  bool changed = false;            ///< some block was refined or coarsened (any rank)
+  std::int64_t blocks_before = 0;  ///< blocks over all ranks
+  std::int64_t blocks_after = 0;
+  int projection_cycles = 0;  ///< V-cycles of the projection of the carried uf
+};
+
 class NavierStokes {
  public:
   NavierStokes(const Forest& forest, const std::array<FlowBoundary, 6>& boundaries,
@@ -94,7 +104,7 @@ class NavierStokes {
   /// Sets u(x) at cell centres, projects it (uf exactly divergence-free),
   /// resets the pressure and the time.
   void set_velocity(const std::function<Vec3(const Vec3&)>& u, double time = 0.0);
-  /// Body force density f_b(x) (N/m^3), sampled on faces.
+  /// Body force density f_b(x) (N/m^3), sampled on faces (again after each regrid).
   void set_body_force(const std::function<Vec3(const Vec3&)>& f);
   /// Dynamic viscosity mu(x) (Pa s) per cell.
   void set_viscosity(const std::function<double(const Vec3&)>& mu);
@@ -109,6 +119,20 @@ class NavierStokes {
   [[nodiscard]] double stable_dt() const;
   /// Advances by dt.
   StepReport step(double dt);
+
+  /// Adapts the forest during a run (issue #7): `forest` is the one the
+  /// solver was built on, passed again without const. Forest::adapt applies
+  /// `flags` (one per local block; 2:1 balance, repartition) and carries the
+  /// state: velocity, pressure, g, viscosity and the caller's `scalars`
+  /// (tracers) by volume-average restriction and minmod-limited second-order
+  /// prolongation (both keep every cell's total), the face velocity
+  /// flux-keeping. The multigrid solvers are rebuilt, the body force is
+  /// sampled on the new faces, and the carried face velocity is projected
+  /// once more (refinement beside finer blocks leaves an O(h^2) divergence),
+  /// so that uf is divergence-free to the projection tolerance, as after a
+  /// step. Not with solid cells or variable viscosity (refused).
+  RegridReport regrid(Forest& forest, std::span<const AdaptFlag> flags,
+                      std::span<BlockField* const> scalars = {}, int max_level = 18);
 
   [[nodiscard]] double time() const { return time_; }
   [[nodiscard]] const Forest& forest() const { return forest_; }
@@ -160,6 +184,11 @@ class NavierStokes {
   void close_solid_faces(FaceField& uf) const;
   void add_transpose_stress(double dt);
   void clear_solid_cells(VectorField& u) const;
+  /// Scratch, masks and interface layers sized to the current block list.
+  void allocate_work_fields();
+  /// Both copies of a face shared by two blocks of one level take their mean
+  /// (they differ after a regrid where a block was refined beside finer ones).
+  void average_shared_faces(FaceField& uf);
 
   const Forest& forest_;
   std::array<FlowBoundary, 6> boundaries_;
@@ -179,9 +208,10 @@ class NavierStokes {
 
   std::array<ScalarBoundary, 3> velocity_bc_;  ///< per velocity component
   ScalarBoundary pressure_bc_;
-  Multigrid pressure_mg_;
-  Multigrid viscous_mg_;
-  double viscous_dt_ = -1.0;  ///< dt the viscous coefficients were built for
+  std::optional<Multigrid> pressure_mg_;  ///< rebuilt when the forest adapts
+  std::optional<Multigrid> viscous_mg_;
+  std::function<Vec3(const Vec3&)> body_force_;  ///< as given, to sample again after a regrid
+  double viscous_dt_ = -1.0;                     ///< dt the viscous coefficients were built for
   bool viscosity_changed_ = true;
   bool has_solids_ = false;
   bool variable_viscosity_ = false;  ///< mu not uniform: the grad u^T stress is added

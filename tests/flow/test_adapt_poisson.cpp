@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <vector>
 
 #include "adapt_poisson.hpp"
 
@@ -111,6 +112,54 @@ TEST(AdaptPoisson, HelmholtzWithVariableCoefficientOnTheRefinedOctant) {
   const double coarse = run(1), fine = run(2);
   // Second order as for Poisson (1.8: pre-asymptotic mix of two grid sizes).
   EXPECT_GT(std::log2(coarse / fine), 1.8);
+}
+
+/// Periodic Poisson on 4^3 blocks of 8^3 cells with the level-2 blocks at
+/// `refined` refined once: V-cycles and reduction per cycle.
+MultigridReport solve_with_refined_blocks(const std::vector<std::array<std::int64_t, 3>>& refined) {
+  ForestSpec spec;
+  spec.level = 2;
+  spec.periodic = {true, true, true};
+  Forest forest(spec);
+  forest.adapt(
+      [&](const Block& block) {
+        for (const auto& c : refined)
+          if (block.coord == c) return AdaptFlag::Refine;
+        return AdaptFlag::Keep;
+      },
+      {});
+  EXPECT_EQ(forest.global_blocks(), static_cast<std::int64_t>(64 + 7 * refined.size()));
+  ScalarBoundary bc;
+  bc.kind = uniform_kinds(forest, BcKind::Periodic);
+  Multigrid mg(forest, bc.kind);
+  BlockField x(forest.local_blocks(), forest.block_cells());
+  MultigridOptions options;
+  options.tolerance = 1e-10;
+  const auto r = mg.solve(x, testing::sample(forest, testing::periodic_source), bc, options);
+  std::printf("  %zu blocks refined: %d V-cycles, %.1fx per cycle, max error %.3e\n",
+              refined.size(), r.cycles, r.mean_reduction(),
+              testing::max_error(forest, x, testing::periodic_exact));
+  return r;
+}
+
+TEST(AdaptPoisson, ConcaveRefinedRegionsConvergeAsFast) {
+  // Refined regions with re-entrant edges and corners, as the wavelet
+  // criterion makes around a moving blob (found by
+  // test_navier_stokes_adaptive): coarse blocks with finer neighbours across
+  // two faces (the blob) or three (an octant of 2 x 2 x 2 blocks refined but
+  // for one corner block). The relaxation that lagged the matched fluxes
+  // diverged on both (0.7x per cycle, residual growing).
+  std::printf("concave refined regions, periodic Poisson, V(2,2):\n");
+  const auto blob = solve_with_refined_blocks(
+      {{0, 1, 2}, {1, 0, 1}, {1, 0, 2}, {1, 1, 1}, {1, 1, 2}, {2, 1, 1}, {2, 1, 2}});
+  const auto corner = solve_with_refined_blocks(
+      {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 0}, {1, 0, 1}, {0, 1, 1}, {1, 1, 1}});
+  EXPECT_TRUE(blob.converged);
+  EXPECT_TRUE(corner.converged);
+  EXPECT_GT(blob.mean_reduction(), 10.0);  // the milestone's 10x, as on the octant (10.2x)
+  // Measured 8.9x: below the 10x target (issue #7, open); this bound only
+  // guards against a regression towards the diverging relaxation.
+  EXPECT_GT(corner.mean_reduction(), 8.0);
 }
 
 TEST(AdaptPoisson, TwoThreadsGiveTheOneThreadAnswerBitForBit) {
