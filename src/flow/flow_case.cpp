@@ -103,6 +103,52 @@ VelocityProfile parabolic_profile(const FlowCase& c, int face) {
   };
 }
 
+/// [flow.adapt]: levels relative to the grid's (the case's cells), the
+/// wavelet threshold on the velocity, refinement regions.
+void read_adaptivity(const ConfigTable& t, FlowCase& c) {
+  FlowAdaptivity& a = c.adapt;
+  a.enabled = true;
+  a.velocity_threshold = t.get_positive("velocity_threshold_m_s");
+  const int base = c.forest.level;
+  const std::int64_t refine = t.get_int("refine_levels", 1);
+  if (refine < 0 || refine > 8) t.fail("refine_levels", "must be in 0..8");
+  const std::int64_t coarsen = t.get_int("coarsen_levels", 0);
+  if (coarsen < 0 || coarsen > base) {
+    t.fail("coarsen_levels", "must be in 0.." + std::to_string(base) +
+                                 ": the grid's blocks can be merged " + std::to_string(base) +
+                                 " time(s) before they fill a p4est tree (more needs " +
+                                 "cells divisible by larger powers of two)");
+  }
+  a.min_level = base - static_cast<int>(coarsen);
+  a.max_level = base + static_cast<int>(refine);
+  const std::int64_t every = t.get_int("every_steps", 1);
+  if (every < 1 || every > 1000000) t.fail("every_steps", "must be >= 1");
+  a.every_steps = static_cast<int>(every);
+  // The estimate (4.11) restricts and prolongs inside a block: 4 cells at least.
+  if (c.forest.block_cells < 4) {
+    t.fail("velocity_threshold_m_s", "adaptivity needs [flow.grid] block_cells >= 4");
+  }
+  if (!c.solid_boxes.empty()) {
+    t.fail("velocity_threshold_m_s",
+           "solid cells ([[flow.solid]]) on an adapting grid are not available yet");
+  }
+  for (const ConfigTable& r : t.table_array("region")) {
+    RefinementRegion region;
+    region.min = r.get_vec3("min_m");
+    region.max = r.get_vec3("max_m");
+    for (int d = 0; d < 3; ++d) {
+      if (!(region.max[d] > region.min[d])) r.fail("max_m", "must be above min_m in x, y and z");
+    }
+    const std::int64_t levels = r.get_int("refine_levels");
+    if (levels < -static_cast<std::int64_t>(coarsen) || levels > refine) {
+      r.fail("refine_levels", "must be in -coarsen_levels..refine_levels of [flow.adapt] (" +
+                                  std::to_string(-coarsen) + ".." + std::to_string(refine) + ")");
+    }
+    region.refine_levels = static_cast<int>(levels);
+    a.regions.push_back(region);
+  }
+}
+
 }  // namespace
 
 bool is_flow_case(const ConfigTable& cfg) {
@@ -197,6 +243,8 @@ FlowCase load_flow_case(const ConfigTable& cfg, const std::filesystem::path& sou
     c.options.pressure.max_cycles = c.options.viscous.max_cycles = static_cast<int>(cycles);
   }
 
+  if (const auto adapt = flow.find_table("adapt")) read_adaptivity(*adapt, c);
+
   const auto output = cfg.find_table("output");
   c.output_interval = c.end_time / 100.0;
   if (output) {
@@ -236,6 +284,19 @@ std::string describe(const FlowCase& c) {
     << c.options.pressure.max_cycles << " V(" << c.options.pressure.pre_sweeps << ","
     << c.options.pressure.post_sweeps << ") cycles\n"
     << "threads " << c.forest.threads << "\n";
+  if (c.adapt.enabled) {
+    const int base = c.forest.level;
+    s << "adaptive grid: wavelet criterion (eq. 4.11) on the velocity, threshold "
+      << c.adapt.velocity_threshold << " m/s, every " << c.adapt.every_steps
+      << " step(s); cells from " << (1 << (base - c.adapt.min_level)) << "x coarser to "
+      << (1 << (c.adapt.max_level - base)) << "x finer than the grid (p4est levels "
+      << c.adapt.min_level << ".." << c.adapt.max_level << ")\n";
+    for (const auto& r : c.adapt.regions) {
+      s << "refinement region (" << r.min.x << ", " << r.min.y << ", " << r.min.z << ") - ("
+        << r.max.x << ", " << r.max.y << ", " << r.max.z << ") m: at least " << r.refine_levels
+        << " level(s) above the grid\n";
+    }
+  }
   return s.str();
 }
 

@@ -14,6 +14,22 @@
 
 namespace sanguis::flow {
 
+/// A box where the grid stays at least `refine_levels` finer than [flow.grid].
+struct RefinementRegion {
+  Vec3 min{}, max{};      ///< (m)
+  int refine_levels = 0;  ///< levels above the grid's
+};
+
+/// [flow.adapt]: the grid follows the flow (wavelet criterion, eq. 4.11).
+struct FlowAdaptivity {
+  bool enabled = false;
+  double velocity_threshold = 0.0;  ///< zeta for each velocity component (m/s)
+  int min_level = 0;                ///< p4est levels of the blocks (absolute)
+  int max_level = 0;
+  int every_steps = 1;  ///< regrid every this many steps
+  std::vector<RefinementRegion> regions;
+};
+
 struct FlowCase {
   std::string name;                          ///< [simulation].name, default the file's stem
   std::filesystem::path source;              ///< the case file
@@ -31,6 +47,7 @@ struct FlowCase {
   double output_interval = 0.0;      ///< (s)
   bool vtk = true;                   ///< write ParaView files
   double checkpoint_interval = 0.0;  ///< (s), 0: only at the end
+  FlowAdaptivity adapt;              ///< off unless [flow.adapt] is given
 };
 
 /// True when the case file has a [flow] section (the run is a flow run).

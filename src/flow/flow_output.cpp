@@ -1,8 +1,11 @@
 #include "flow/flow_output.hpp"
 
+#include <algorithm>
 #include <cstring>
 #include <fstream>
+#include <set>
 #include <type_traits>
+#include <vector>
 
 #include "core/error.hpp"
 #include "core/io/atomic_file.hpp"
@@ -59,7 +62,9 @@ io::HexMesh flow_mesh(NavierStokes& ns) {
 
 namespace {
 
-constexpr char kMagic[16] = "sanguis-flow-1";
+// Version 2: the header is followed by the level and coordinates of every
+// local block (4 int64 each), so that an adaptive run restarts on its grid.
+constexpr char kMagic[16] = "sanguis-flow-2";
 
 /// The fields a checkpoint holds, in file order.
 template <typename Solver>
@@ -80,6 +85,70 @@ struct Header {
   double time;
 };
 
+/// Level and coordinates of every local block, 4 numbers each.
+std::vector<std::int64_t> leaf_records(const Forest& forest) {
+  std::vector<std::int64_t> records;
+  records.reserve(static_cast<std::size_t>(forest.local_blocks()) * 4);
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    const Block& block = forest.block(blk);
+    records.push_back(block.level);
+    records.insert(records.end(), block.coord.begin(), block.coord.end());
+  }
+  return records;
+}
+
+using LeafKey = std::array<std::int64_t, 4>;  // level, x, y, z
+
+/// Refines and coarsens `forest` until its blocks are the leaves of all
+/// ranks' checkpoints (`mine` on this rank); false if it does not get there.
+bool rebuild_grid(Forest& forest, NavierStokes& ns, const std::vector<std::int64_t>& mine) {
+  // Every rank needs the whole leaf set to decide its own blocks' flags.
+  const int count = static_cast<int>(mine.size());
+  std::vector<int> counts(static_cast<std::size_t>(forest.ranks())),
+      offsets(static_cast<std::size_t>(forest.ranks()));
+  MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, forest.comm());
+  int total = 0;
+  for (std::size_t r = 0; r < counts.size(); ++r) {
+    offsets[r] = total;
+    total += counts[r];
+  }
+  std::vector<std::int64_t> all(static_cast<std::size_t>(total));
+  MPI_Allgatherv(mine.data(), count, MPI_INT64_T, all.data(), counts.data(), offsets.data(),
+                 MPI_INT64_T, forest.comm());
+  std::set<LeafKey> target;
+  int finest = 0;
+  for (std::size_t i = 0; i + 3 < all.size(); i += 4) {
+    target.insert({all[i], all[i + 1], all[i + 2], all[i + 3]});
+    finest = std::max(finest, static_cast<int>(all[i]));
+  }
+  auto has_ancestor = [&](const Block& block) {
+    for (int up = 1; up <= block.level; ++up) {
+      if (target.count({block.level - up, block.coord[0] >> up, block.coord[1] >> up,
+                        block.coord[2] >> up}) != 0) {
+        return true;
+      }
+    }
+    return false;
+  };
+  for (int round = 0; round < 2 * (finest + 1); ++round) {
+    std::vector<AdaptFlag> flags(static_cast<std::size_t>(forest.local_blocks()));
+    double differ = 0.0;
+    for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+      const Block& block = forest.block(blk);
+      AdaptFlag& flag = flags[static_cast<std::size_t>(blk)];
+      if (target.count({block.level, block.coord[0], block.coord[1], block.coord[2]}) != 0) {
+        flag = AdaptFlag::Keep;
+        continue;
+      }
+      flag = has_ancestor(block) ? AdaptFlag::Coarsen : AdaptFlag::Refine;
+      differ += 1.0;
+    }
+    if (forest.sum(differ) == 0.0) return true;
+    ns.regrid(forest, flags, {}, finest);
+  }
+  return false;
+}
+
 }  // namespace
 
 void save_flow_checkpoint(const std::filesystem::path& path, const NavierStokes& ns,
@@ -97,6 +166,9 @@ void save_flow_checkpoint(const std::filesystem::path& path, const NavierStokes&
   header.time = ns.time();
   io::write_file_atomically(path, [&](std::ostream& out) {
     out.write(reinterpret_cast<const char*>(&header), sizeof header);
+    const std::vector<std::int64_t> leaves = leaf_records(forest);
+    out.write(reinterpret_cast<const char*>(leaves.data()),
+              static_cast<std::streamsize>(leaves.size() * sizeof(std::int64_t)));
     for (const BlockField* f : state_fields(ns)) {
       out.write(reinterpret_cast<const char*>(f->raw().data()),
                 static_cast<std::streamsize>(f->raw().size() * sizeof(double)));
@@ -104,21 +176,38 @@ void save_flow_checkpoint(const std::filesystem::path& path, const NavierStokes&
   });
 }
 
-CheckpointCounters load_flow_checkpoint(const std::filesystem::path& path, NavierStokes& ns) {
+CheckpointCounters load_flow_checkpoint(const std::filesystem::path& path, NavierStokes& ns,
+                                        Forest* adaptable) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path.string(), "", "cannot read the checkpoint");
   Header header{};
   in.read(reinterpret_cast<char*>(&header), sizeof header);
   const Forest& forest = ns.forest();
   if (!in || std::memcmp(header.magic, kMagic, sizeof kMagic) != 0) {
-    throw InputError(path.string(), "", "not a sanguis flow checkpoint");
-  }
-  if (header.global_blocks != forest.global_blocks() ||
-      header.local_blocks != forest.local_blocks() || header.block_cells != forest.block_cells() ||
-      header.ranks != forest.ranks() || header.rank != forest.rank()) {
     throw InputError(path.string(), "",
-                     "written for another grid or number of ranks (the case's grid and the "
-                     "mpirun -np must be those of the run that wrote it)");
+                     "not a sanguis flow checkpoint (or one of an older version)");
+  }
+  const std::string mismatch =
+      "written for another grid or number of ranks (the case's grid and the mpirun -np must be "
+      "those of the run that wrote it)";
+  if (header.block_cells != forest.block_cells() || header.ranks != forest.ranks() ||
+      header.rank != forest.rank() || header.local_blocks < 0 || header.local_blocks > (1 << 28)) {
+    throw InputError(path.string(), "", mismatch);
+  }
+  std::vector<std::int64_t> leaves(static_cast<std::size_t>(header.local_blocks) * 4);
+  in.read(reinterpret_cast<char*>(leaves.data()),
+          static_cast<std::streamsize>(leaves.size() * sizeof(std::int64_t)));
+  if (!in) throw InputError(path.string(), "", "checkpoint is truncated");
+  const bool same = forest.sum(leaf_records(forest) == leaves ? 0.0 : 1.0) == 0.0;
+  if (!same) {
+    // An adaptive run: rebuild its grid (the solver's state is read below).
+    if (adaptable == nullptr || adaptable != &forest || !rebuild_grid(*adaptable, ns, leaves) ||
+        forest.sum(leaf_records(forest) == leaves ? 0.0 : 1.0) != 0.0) {
+      throw InputError(path.string(), "", mismatch);
+    }
+  }
+  if (header.global_blocks != forest.global_blocks()) {
+    throw InputError(path.string(), "", mismatch);
   }
   for (BlockField* f : state_fields(ns)) {
     auto& data = f->raw();

@@ -24,8 +24,13 @@ struct CheckpointCounters {
   std::int64_t frames = 0;
 };
 
-/// Restores a state written by save_flow_checkpoint on the same grid and
-/// number of ranks; throws InputError naming the file when it does not fit.
-CheckpointCounters load_flow_checkpoint(const std::filesystem::path& path, NavierStokes& ns);
+/// Restores a state written by save_flow_checkpoint with the same number of
+/// ranks. The checkpoint lists its blocks: when they differ from the
+/// solver's forest (an adaptive run) and `forest` is given (the solver's
+/// forest, mutable), the forest is first refined and coarsened to the
+/// checkpoint's blocks; otherwise, or when the grids cannot match, throws
+/// InputError naming the file.
+CheckpointCounters load_flow_checkpoint(const std::filesystem::path& path, NavierStokes& ns,
+                                        Forest* forest = nullptr);
 
 }  // namespace sanguis::flow

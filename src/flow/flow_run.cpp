@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -15,6 +16,7 @@
 #include "core/io/vtk.hpp"
 #include "core/progress.hpp"
 #include "core/version.hpp"
+#include "flow/adapt_criterion.hpp"
 #include "flow/flow_output.hpp"
 
 namespace sanguis::flow {
@@ -30,7 +32,8 @@ const std::vector<std::string> kColumns = {"time_s",
                                            "max_velocity_m_s",
                                            "max_divergence_1_s",
                                            "pressure_vcycles",
-                                           "pressure_reduction_per_cycle"};
+                                           "pressure_reduction_per_cycle",
+                                           "cells"};
 
 struct Diagnostics {
   double kinetic_energy = 0.0;
@@ -72,12 +75,48 @@ fs::path checkpoint_path(const fs::path& dir, const Forest& forest) {
                              : dir / ("checkpoint_r" + std::to_string(forest.rank()) + ".bin");
 }
 
+/// Cells over all ranks.
+double leaf_cells(const Forest& forest) {
+  const double b = forest.block_cells();
+  return static_cast<double>(forest.global_blocks()) * b * b * b;
+}
+
+/// [flow.adapt]: the wavelet criterion (eq. 4.11) on the three velocity
+/// components within the case's levels, then at least the regions' levels.
+std::vector<AdaptFlag> adapt_flags(const FlowAdaptivity& a, const Forest& forest,
+                                   NavierStokes& ns) {
+  const double zeta = a.velocity_threshold;
+  const WaveletCriterion criterion{{zeta, zeta, zeta}, a.min_level, a.max_level};
+  BlockField* velocity[] = {&ns.velocity()[0], &ns.velocity()[1], &ns.velocity()[2]};
+  std::vector<AdaptFlag> flags = wavelet_flags(forest, velocity, criterion);
+  const int base = forest.spec().level;
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    const Block& block = forest.block(blk);
+    int floor = a.min_level;
+    for (const RefinementRegion& r : a.regions) {
+      bool overlaps = true;
+      for (int d = 0; d < 3; ++d) {
+        overlaps =
+            overlaps && block.lower[d] < r.max[d] && block.lower[d] + block.length > r.min[d];
+      }
+      if (overlaps) floor = std::max(floor, base + r.refine_levels);
+    }
+    AdaptFlag& flag = flags[static_cast<std::size_t>(blk)];
+    if (block.level < floor) {
+      flag = AdaptFlag::Refine;
+    } else if (block.level == floor && flag == AdaptFlag::Coarsen) {
+      flag = AdaptFlag::Keep;
+    }
+  }
+  return flags;
+}
+
 }  // namespace
 
 FlowRunSummary run_flow_case(const FlowCase& c, const FlowRunOptions& options,
                              std::ostream& console) {
   const fs::path dir = options.output_dir;
-  const Forest forest(c.forest);
+  Forest forest(c.forest);
   const bool root = forest.rank() == 0;
   const fs::path checkpoint = checkpoint_path(dir, forest);
   const fs::path csv_path = dir / "diagnostics.csv";
@@ -104,13 +143,25 @@ FlowRunSummary run_flow_case(const FlowCase& c, const FlowRunOptions& options,
   }
   ns.set_body_force([&](const Vec3&) { return c.body_force; });
   std::int64_t steps = 0, frames = 0;
+  double regrid_seconds = 0.0;
+  const auto regrid = [&]() {
+    const auto start = std::chrono::steady_clock::now();
+    ns.regrid(forest, adapt_flags(c.adapt, forest, ns), {}, c.adapt.max_level);
+    regrid_seconds +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
   if (options.restart) {
-    const auto counters = load_flow_checkpoint(checkpoint, ns);
+    const auto counters = load_flow_checkpoint(checkpoint, ns, c.adapt.enabled ? &forest : nullptr);
     steps = counters.steps;
     frames = counters.frames;
     if (root && fs::exists(csv_path)) io::CsvWriter::truncate_after(csv_path, ns.time());
   } else {
     ns.set_velocity([&](const Vec3&) { return c.initial_velocity; });
+    if (c.adapt.enabled) {
+      // The initial grid: one level per pass, then the initial field on it.
+      for (int pass = 0; pass <= c.adapt.max_level - c.adapt.min_level; ++pass) regrid();
+      ns.set_velocity([&](const Vec3&) { return c.initial_velocity; });
+    }
   }
   fs::create_directories(dir / "flow");
 
@@ -154,7 +205,8 @@ FlowRunSummary run_flow_case(const FlowCase& c, const FlowRunOptions& options,
     const double divergence = ns.max_divergence();
     if (csv) {
       csv->row({ns.time(), static_cast<double>(steps), last.dt, d.kinetic_energy, d.max_velocity,
-                divergence, static_cast<double>(last.pressure_cycles), last.pressure_reduction});
+                divergence, static_cast<double>(last.pressure_cycles), last.pressure_reduction,
+                leaf_cells(forest)});
     }
     if (!std::isfinite(d.max_velocity))
       throw SimulationError("non-finite velocity at t = " + std::to_string(ns.time()));
@@ -169,20 +221,23 @@ FlowRunSummary run_flow_case(const FlowCase& c, const FlowRunOptions& options,
           ? c.checkpoint_interval * (std::floor(ns.time() / c.checkpoint_interval + 1e-9) + 1.0)
           : std::numeric_limits<double>::infinity();
   if (root) {
-    console << "sanguis run: " << c.name << ": flow, "
-            << static_cast<long long>(c.cells[0]) * c.cells[1] * c.cells[2] << " cells in "
-            << forest.global_blocks() << " blocks on " << forest.ranks()
+    console << "sanguis run: " << c.name << ": flow, " << static_cast<long long>(leaf_cells(forest))
+            << " cells in " << forest.global_blocks() << " blocks"
+            << (c.adapt.enabled ? " (adaptive)" : "") << " on " << forest.ranks()
             << " rank(s), to t = " << end << " s, output to " << dir.string() << "\n";
   }
   ProgressReporter progress(std::cerr, root && !options.quiet && isatty(STDERR_FILENO) != 0);
   const std::int64_t first_step = steps;
-  const double cells = static_cast<double>(c.cells[0]) * c.cells[1] * c.cells[2];
+  double cell_updates = 0.0;
   try {
     while (ns.time() < end - eps) {
+      // Every k steps counted from the start (a restart keeps the schedule).
+      if (c.adapt.enabled && steps > 0 && steps % c.adapt.every_steps == 0) regrid();
       double dt = ns.stable_dt();
       dt = std::min({dt, next_output - ns.time(), end - ns.time()});
       last = ns.step(dt);
       ++steps;
+      cell_updates += leaf_cells(forest);
       if (ns.time() >= next_output - eps) {
         record();
         next_output += c.output_interval;
@@ -194,7 +249,7 @@ FlowRunSummary run_flow_case(const FlowCase& c, const FlowRunOptions& options,
       if (root && !options.quiet && (steps & 15) == 0) {
         char status[128];
         std::snprintf(status, sizeof status, "t = %.4g / %.4g s, dt %.3g s", ns.time(), end, dt);
-        progress.update(ns.time() / end, status, cells * static_cast<double>(steps - first_step));
+        progress.update(ns.time() / end, status, cell_updates);
       }
     }
   } catch (const SimulationError& e) {
@@ -213,10 +268,12 @@ FlowRunSummary run_flow_case(const FlowCase& c, const FlowRunOptions& options,
   done.precision(4);
   done << "done: t = " << ns.time() << " s, " << summary.steps << " steps in "
        << ProgressReporter::format_duration(summary.wall_seconds) << " ("
-       << (summary.wall_seconds > 0
-               ? cells * static_cast<double>(summary.steps) / summary.wall_seconds
-               : 0.0)
+       << (summary.wall_seconds > 0 ? cell_updates / summary.wall_seconds : 0.0)
        << " cell-updates/s)";
+  if (c.adapt.enabled && summary.wall_seconds > 0) {
+    done << "; " << static_cast<long long>(leaf_cells(forest)) << " cells at the end, regridding "
+         << 100.0 * regrid_seconds / summary.wall_seconds << " % of the time";
+  }
   if (root) progress.finish(done.str());
   if (root) {
     log << done.str() << "\n";

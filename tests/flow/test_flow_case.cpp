@@ -2,11 +2,14 @@
 // restart that continues bit for bit.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "core/config.hpp"
 #include "flow/flow_case.hpp"
@@ -155,6 +158,90 @@ TEST(FlowRun, WritesFramesDiagnosticsAndRestartsBitForBit) {
   EXPECT_EQ(read_bytes(whole.output_dir / "diagnostics.csv"),
             read_bytes(split.output_dir / "diagnostics.csv"));
   EXPECT_EQ(read_bytes(whole.output_dir / "flow.pvd"), read_bytes(split.output_dir / "flow.pvd"));
+  std::filesystem::remove_all(base);
+}
+
+/// The channel on an adaptive grid: the lower half kept one level finer, the
+/// rest refined or not by the wavelet criterion on the velocity.
+const std::string kAdaptiveChannel = kChannel + R"(
+[flow.adapt]
+velocity_threshold_m_s = 7e-4
+refine_levels = 1
+every_steps = 2
+region = [{ min_m = [0.0, 0.0, 0.0], max_m = [0.5, 0.5, 0.5], refine_levels = 1 }]
+)";
+
+TEST(FlowCaseErrors, AdaptivityKeysAreChecked) {
+  const FlowCase c = parse(kAdaptiveChannel);
+  EXPECT_TRUE(c.adapt.enabled);
+  EXPECT_EQ(c.adapt.min_level, 0);
+  EXPECT_EQ(c.adapt.max_level, 1);
+  ASSERT_EQ(c.adapt.regions.size(), 1u);
+  expect_input_error(replaced(kAdaptiveChannel, "every_steps = 2", "every_step = 2"), "every_step");
+  // 8 x 16 x 8 cells in blocks of 8: the blocks already fill their trees.
+  expect_input_error(replaced(kAdaptiveChannel, "every_steps = 2", "coarsen_levels = 1"),
+                     "coarsen_levels");
+  expect_input_error(replaced(kAdaptiveChannel, "refine_levels = 1 }]", "refine_levels = 2 }]"),
+                     "region[0].refine_levels");
+  expect_input_error(
+      replaced(kAdaptiveChannel, "cells = [8, 16, 8]", "cells = [8, 16, 8]\nblock_cells = 2"),
+      "block_cells >= 4");
+  expect_input_error(replaced(kAdaptiveChannel, "[flow.time]",
+                              "[[flow.solid]]\nmin_m = [0.1, 0.1, 0.1]\nmax_m = [0.2, 0.2, "
+                              "0.2]\n\n[flow.time]"),
+                     "not available yet");
+  expect_input_error(
+      replaced(kAdaptiveChannel, "velocity_threshold_m_s = 7e-4", "velocity_threshold_m_s = -1.0"),
+      "velocity_threshold_m_s");
+}
+
+TEST(FlowRun, AdaptiveRunRefinesAndRestartsOnItsGridBitForBit) {
+  const auto base = std::filesystem::temp_directory_path() / "sanguis_flow_adaptive_test";
+  std::filesystem::remove_all(base);
+  const FlowCase c = parse(kAdaptiveChannel);
+  std::ostringstream console;
+  FlowRunOptions whole;
+  whole.output_dir = base / "whole";
+  whole.quiet = true;
+  run_flow_case(c, whole, console);
+  // The cells column: the region alone makes 8 of the 16 level-1 regions
+  // fine (8 x 512 + 1 x 512 of the coarse upper half = 4608 cells at least).
+  const std::string csv = read_bytes(whole.output_dir / "diagnostics.csv");
+  EXPECT_NE(csv.find(",cells\n"), std::string::npos);
+  std::vector<double> cells;  // last column of every row
+  for (std::size_t at = csv.find('\n'); at + 1 < csv.size(); at = csv.find('\n', at + 1)) {
+    const std::size_t end = csv.find('\n', at + 1);
+    const std::string row = csv.substr(at + 1, end - at - 1);
+    cells.push_back(std::stod(row.substr(row.rfind(',') + 1)));
+  }
+  ASSERT_EQ(cells.size(), 5u);  // t = 0, 0.01, ..., 0.04
+  std::printf(
+      "adaptive channel, cells at t = 0, 0.01, .., 0.04: %g %g %g %g %g (uniform fine "
+      "grid 8192)\n",
+      cells[0], cells[1], cells[2], cells[3], cells[4]);
+  for (const double n : cells) {
+    EXPECT_GE(n, 4608.0);
+    EXPECT_LE(n, 8192.0);
+  }
+  // The grid followed the flow: refined while the lid's shear layer grows
+  // (t = 0.02, 0.03), coarse again once the profile is smooth on the
+  // coarse cells (measured 4608 4608 8192 8192 4608).
+  EXPECT_GT(*std::max_element(cells.begin(), cells.end()),
+            *std::min_element(cells.begin(), cells.end()));
+
+  // Stopped half way (after a regrid) and restarted: the checkpoint rebuilds
+  // the adapted grid and the run continues bit for bit.
+  FlowRunOptions split = whole;
+  split.output_dir = base / "split";
+  split.stop_at = 0.02;
+  run_flow_case(c, split, console);
+  split.stop_at = -1.0;
+  split.restart = true;
+  run_flow_case(c, split, console);
+  EXPECT_EQ(read_bytes(whole.output_dir / "checkpoint.bin"),
+            read_bytes(split.output_dir / "checkpoint.bin"));
+  EXPECT_EQ(read_bytes(whole.output_dir / "diagnostics.csv"),
+            read_bytes(split.output_dir / "diagnostics.csv"));
   std::filesystem::remove_all(base);
 }
 
