@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "adapt_poisson.hpp"
+#include "flow/adapt_criterion.hpp"
 #include "flow/mpi_session.hpp"
 #include "flow/navier_stokes.hpp"
 #include "poisson_problems.hpp"
@@ -271,12 +272,83 @@ int check_refined_navier_stokes() {
   return diff <= 1e-11 ? 0 : 1;
 }
 
+/// Navier-Stokes on a forest that adapts during the run (a tracer blob in a
+/// sheared stream, the wavelet criterion on the tracer every 2 steps, as in
+/// test_navier_stokes_adaptive): 2 ranks against 1, blocks refined and
+/// coarsened on both and data moved between ranks by the repartitions.
+int check_adaptive_navier_stokes() {
+  struct Result {
+    std::int64_t blocks = 0;
+    std::array<std::vector<double>, 5> values;
+  };
+  auto run = [](MPI_Comm comm) {
+    ForestSpec spec;
+    spec.periodic = {true, true, true};
+    spec.level = 2;
+    spec.block_cells = 4;
+    spec.comm = comm;
+    Forest forest(spec);
+    std::array<FlowBoundary, 6> bcs{};
+    for (auto& bc : bcs) bc.kind = FlowBoundaryKind::Periodic;
+    NavierStokesOptions options;
+    options.pressure.tolerance = 1e-10;
+    options.viscous.tolerance = 1e-10;
+    NavierStokes ns(forest, bcs, Fluid{1.0, 1e-3}, options);
+    ns.set_velocity([](const sanguis::Vec3& x) {
+      return sanguis::Vec3{1.0 + 0.2 * std::sin(2 * testing::kPi * x.y), 0.5,
+                           0.1 * std::sin(2 * testing::kPi * x.x)};
+    });
+    BlockField tracer(forest.local_blocks(), forest.block_cells());
+    testing::fill_cells(forest, tracer, [](const sanguis::Vec3& x) {
+      const sanguis::Vec3 r = x - sanguis::Vec3{0.3, 0.3, 0.5};
+      return 1.0 + std::exp(-dot(r, r) / 0.01);
+    });
+    const WaveletCriterion criterion{{1e-2}, 2, 3};
+    BlockField* scalars[] = {&tracer};
+    auto adapt = [&]() {
+      ns.regrid(forest, wavelet_flags(forest, scalars, criterion), scalars, criterion.max_level);
+    };
+    adapt();
+    adapt();
+    for (int s = 0; s < 8; ++s) {
+      ns.step(0.02);
+      ns.advect_scalar(tracer, 0.02);
+      if (s % 2 == 1) adapt();
+    }
+    Result result;
+    result.blocks = forest.global_blocks();
+    for (std::size_t c = 0; c < 3; ++c)
+      result.values[c] = gathered_by_block(forest, ns.velocity()[c]);
+    result.values[3] = gathered_by_block(forest, ns.pressure());
+    result.values[4] = gathered_by_block(forest, tracer);
+    return result;
+  };
+  const Result shared = run(MPI_COMM_WORLD);
+  const Result alone = run(MPI_COMM_SELF);
+  double diff = 0.0, scale = 0.0;
+  const bool same_grid = shared.blocks == alone.blocks;
+  for (std::size_t f = 0; same_grid && f < shared.values.size(); ++f)
+    for (std::size_t i = 0; i < shared.values[f].size(); ++i) {
+      diff = std::max(diff, std::abs(shared.values[f][i] - alone.values[f][i]));
+      scale = std::max(scale, std::abs(alone.values[f][i]));
+    }
+  const auto& session = MpiSession::ensure();
+  if (session.rank() == 0) {
+    std::printf(
+        "adaptive Navier-Stokes (tracer blob, regrid every 2 steps), 8 steps: %d ranks vs 1: "
+        "%lld / %lld blocks, max difference of u, p and the tracer %.3e (max |value| %.3f)\n",
+        session.size(), static_cast<long long>(shared.blocks), static_cast<long long>(alone.blocks),
+        diff, scale);
+  }
+  return same_grid && diff <= 1e-11 ? 0 : 1;
+}
+
 }  // namespace
 
 int main() {
   MpiSession::ensure();
   const int failures = check(true) + check(false) + check_navier_stokes() +
                        check_adaptive_ghosts() + check_refined(true) + check_refined(false) +
-                       check_refined_navier_stokes();
+                       check_refined_navier_stokes() + check_adaptive_navier_stokes();
   return failures == 0 ? 0 : 1;
 }
