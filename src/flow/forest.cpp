@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
+#include <vector>
 
 #include "flow/coarse_fine.hpp"
 #include "flow/forest_p4est.hpp"
@@ -282,14 +283,63 @@ void fill_from_coarser(const Block& block, const std::array<int, 3>& o,
   }
   double* dst = field.block(blk);
   const BlockLayout& L = field.layout();
-  for (int k = r[2].begin; k < r[2].end; ++k)
-    for (int j = r[1].begin; j < r[1].end; ++j)
-      for (int i = r[0].begin; i < r[0].end; ++i) {
-        const std::array<int, 3> fine{child_offset[0] + i + r[0].shift,
-                                      child_offset[1] + j + r[1].shift,
-                                      child_offset[2] + k + r[2].shift};
-        dst[L.index(i, j, k)] = interpolate_from_coarse(coarse, b, fine);
+  // The tensor-product interpolant of coarse_fine.hpp, one direction at a
+  // time (x, then y, then z: the same operations in the same order as
+  // interpolate_from_coarse, so the same bits, with ~4x fewer of them on a
+  // face region): the weights per fine index, then the coarse rows needed.
+  thread_local std::array<std::vector<AxisWeights>, 3> w;
+  std::array<int, 3> lo{}, hi{};  // coarse cells read, per direction
+  for (std::size_t d = 0; d < 3; ++d) {
+    w[d].clear();
+    lo[d] = b;
+    hi[d] = 0;
+    for (int n = r[d].begin; n < r[d].end; ++n) {
+      const AxisWeights a = axis_weights(child_offset[d] + n + r[d].shift, b);
+      w[d].push_back(a);
+      lo[d] = std::min(lo[d], a.first);
+      hi[d] = std::max(hi[d], a.first + a.count);
+    }
+  }
+  const int ni = r[0].end - r[0].begin, nj = r[1].end - r[1].begin, nk = r[2].end - r[2].begin;
+  const int cy = hi[1] - lo[1], cz = hi[2] - lo[2];
+  thread_local std::vector<double> rows, planes;  // [i][y][z] and [i][j][z]
+  rows.assign(static_cast<std::size_t>(ni) * cy * cz, 0.0);
+  planes.assign(static_cast<std::size_t>(ni) * nj * cz, 0.0);
+  for (int i = 0; i < ni; ++i) {
+    const AxisWeights& ax = w[0][static_cast<std::size_t>(i)];
+    for (int y = 0; y < cy; ++y)
+      for (int z = 0; z < cz; ++z) {
+        double row = 0.0;
+        for (int a = 0; a < ax.count; ++a) {
+          row += ax.w[static_cast<std::size_t>(a)] * coarse(ax.first + a, lo[1] + y, lo[2] + z);
+        }
+        rows[(static_cast<std::size_t>(i) * cy + y) * cz + z] = row;
       }
+  }
+  for (int i = 0; i < ni; ++i)
+    for (int j = 0; j < nj; ++j) {
+      const AxisWeights& ay = w[1][static_cast<std::size_t>(j)];
+      for (int z = 0; z < cz; ++z) {
+        double plane = 0.0;
+        for (int c = 0; c < ay.count; ++c) {
+          plane += ay.w[static_cast<std::size_t>(c)] *
+                   rows[(static_cast<std::size_t>(i) * cy + (ay.first + c - lo[1])) * cz + z];
+        }
+        planes[(static_cast<std::size_t>(i) * nj + j) * cz + z] = plane;
+      }
+    }
+  for (int k = 0; k < nk; ++k) {
+    const AxisWeights& az = w[2][static_cast<std::size_t>(k)];
+    for (int j = 0; j < nj; ++j)
+      for (int i = 0; i < ni; ++i) {
+        double value = 0.0;
+        for (int c = 0; c < az.count; ++c) {
+          value += az.w[static_cast<std::size_t>(c)] *
+                   planes[(static_cast<std::size_t>(i) * nj + j) * cz + (az.first + c - lo[2])];
+        }
+        dst[L.index(r[0].begin + i, r[1].begin + j, r[2].begin + k)] = value;
+      }
+  }
 }
 
 /// Ghosts of a coarse block in the region towards offset o from the finer

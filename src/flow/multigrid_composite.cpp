@@ -39,9 +39,12 @@ void Multigrid::match_fluxes(int level, BlockField& x) {
     const double h = block.length / b;
     for (int d = 0; d < 3; ++d)
       for (int side = 0; side < 2; ++side) {
-        double* flux = lv.face_flux[D(face_index(d, side))].block(blk);
-        std::fill(flux, flux + L.size(), 0.0);
+        // Only the face layer beside a coarser block is ever written (the
+        // same cells at every call while the forest stands); the rest of
+        // the array keeps the zeros it was allocated with, which the 8-cell
+        // mean relies on.
         if (block.neighbours[face_neighbour_slot(d, side)].jump != LevelJump::Coarser) continue;
+        double* flux = lv.face_flux[D(face_index(d, side))].block(blk);
         const double* xb = x.block(blk);
         const double* beta = lv.beta[D(d)].block(blk);
         for_face_cells(L, d, side, [&](std::ptrdiff_t c, std::ptrdiff_t g) {
