@@ -328,8 +328,10 @@ bool Forest::adapt(std::span<const AdaptFlag> flags, std::span<BlockField* const
   for (FaceField* uf : face_fields) {
     for (BlockField& component : *uf) moving.push_back(&component);
   }
-  partition(moving);
-  return changed != 0;
+  // A repartition alone also changes the local block lists (the forests
+  // built uniform are split evenly, adapt() keeps families together).
+  const bool moved = partition(moving);
+  return changed != 0 || moved;
 }
 
 }  // namespace sanguis::flow

@@ -105,7 +105,7 @@ VelocityProfile parabolic_profile(const FlowCase& c, int face) {
 
 /// [flow.adapt]: levels relative to the grid's (the case's cells), the
 /// wavelet threshold on the velocity, refinement regions.
-void read_adaptivity(const ConfigTable& t, FlowCase& c) {
+void read_adaptivity(const ConfigTable& flow, const ConfigTable& t, FlowCase& c) {
   FlowAdaptivity& a = c.adapt;
   a.enabled = true;
   a.velocity_threshold = t.get_positive("velocity_threshold_m_s");
@@ -122,15 +122,17 @@ void read_adaptivity(const ConfigTable& t, FlowCase& c) {
   a.min_level = base - static_cast<int>(coarsen);
   a.max_level = base + static_cast<int>(refine);
   const std::int64_t every = t.get_int("every_steps", 1);
-  if (every < 1 || every > 1000000) t.fail("every_steps", "must be >= 1");
+  if (every < 1 || every > 1000000) t.fail("every_steps", "must be in 1..1000000");
   a.every_steps = static_cast<int>(every);
   // The estimate (4.11) restricts and prolongs inside a block: 4 cells at least.
   if (c.forest.block_cells < 4) {
-    t.fail("velocity_threshold_m_s", "adaptivity needs [flow.grid] block_cells >= 4");
+    flow.table("grid").fail("block_cells",
+                            "must be >= 4 with [flow.adapt] (the wavelet "
+                            "estimate restricts and prolongs inside a block)");
   }
   if (!c.solid_boxes.empty()) {
-    t.fail("velocity_threshold_m_s",
-           "solid cells ([[flow.solid]]) on an adapting grid are not available yet");
+    flow.table_array("solid").front().fail(
+        "min_m", "solid cells on an adapting grid ([flow.adapt]) are not available yet");
   }
   for (const ConfigTable& r : t.table_array("region")) {
     RefinementRegion region;
@@ -243,7 +245,7 @@ FlowCase load_flow_case(const ConfigTable& cfg, const std::filesystem::path& sou
     c.options.pressure.max_cycles = c.options.viscous.max_cycles = static_cast<int>(cycles);
   }
 
-  if (const auto adapt = flow.find_table("adapt")) read_adaptivity(*adapt, c);
+  if (const auto adapt = flow.find_table("adapt")) read_adaptivity(flow, *adapt, c);
 
   const auto output = cfg.find_table("output");
   c.output_interval = c.end_time / 100.0;

@@ -83,7 +83,23 @@ struct Header {
   char magic[16];
   std::int64_t global_blocks, local_blocks, block_cells, ranks, rank, steps, frames;
   double time;
+  std::int64_t trees[3], level;  ///< the case's grid: brick and initial level
+  double tree_length, origin[3];
 };
+
+/// Whether the header describes the grid and ranks of `forest`'s case.
+bool same_case_grid(const Header& h, const Forest& forest) {
+  const ForestSpec& spec = forest.spec();
+  bool same = h.block_cells == forest.block_cells() && h.ranks == forest.ranks() &&
+              h.rank == forest.rank() && h.level == spec.level &&
+              h.tree_length == spec.tree_length && h.local_blocks >= 0 &&
+              h.local_blocks <= (std::int64_t{1} << 28);
+  for (int d = 0; d < 3; ++d) {
+    same = same && h.trees[d] == spec.trees[static_cast<std::size_t>(d)] &&
+           h.origin[d] == spec.origin[d];
+  }
+  return same;
+}
 
 /// Level and coordinates of every local block, 4 numbers each.
 std::vector<std::int64_t> leaf_records(const Forest& forest) {
@@ -143,7 +159,14 @@ bool rebuild_grid(Forest& forest, NavierStokes& ns, const std::vector<std::int64
       flag = has_ancestor(block) ? AdaptFlag::Coarsen : AdaptFlag::Refine;
       differ += 1.0;
     }
-    if (forest.sum(differ) == 0.0) return true;
+    if (forest.sum(differ) == 0.0) {
+      // The same blocks; split over the ranks as adapt() splits them (the
+      // writer's forest went through it), unless they already are.
+      if (forest.sum(leaf_records(forest) == mine ? 0.0 : 1.0) != 0.0) {
+        ns.regrid(forest, std::vector<AdaptFlag>(flags.size(), AdaptFlag::Keep), {}, finest);
+      }
+      return true;
+    }
     ns.regrid(forest, flags, {}, finest);
   }
   return false;
@@ -164,6 +187,13 @@ void save_flow_checkpoint(const std::filesystem::path& path, const NavierStokes&
   header.steps = steps;
   header.frames = frames;
   header.time = ns.time();
+  const ForestSpec& spec = forest.spec();
+  for (int d = 0; d < 3; ++d) {
+    header.trees[d] = spec.trees[static_cast<std::size_t>(d)];
+    header.origin[d] = spec.origin[d];
+  }
+  header.level = spec.level;
+  header.tree_length = spec.tree_length;
   io::write_file_atomically(path, [&](std::ostream& out) {
     out.write(reinterpret_cast<const char*>(&header), sizeof header);
     const std::vector<std::int64_t> leaves = leaf_records(forest);
@@ -178,43 +208,58 @@ void save_flow_checkpoint(const std::filesystem::path& path, const NavierStokes&
 
 CheckpointCounters load_flow_checkpoint(const std::filesystem::path& path, NavierStokes& ns,
                                         Forest* adaptable) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path.string(), "", "cannot read the checkpoint");
-  Header header{};
-  in.read(reinterpret_cast<char*>(&header), sizeof header);
   const Forest& forest = ns.forest();
-  if (!in || std::memcmp(header.magic, kMagic, sizeof kMagic) != 0) {
-    throw InputError(path.string(), "",
-                     "not a sanguis flow checkpoint (or one of an older version)");
-  }
-  const std::string mismatch =
-      "written for another grid or number of ranks (the case's grid and the mpirun -np must be "
-      "those of the run that wrote it)";
-  if (header.block_cells != forest.block_cells() || header.ranks != forest.ranks() ||
-      header.rank != forest.rank() || header.local_blocks < 0 || header.local_blocks > (1 << 28)) {
-    throw InputError(path.string(), "", mismatch);
-  }
-  std::vector<std::int64_t> leaves(static_cast<std::size_t>(header.local_blocks) * 4);
-  in.read(reinterpret_cast<char*>(leaves.data()),
-          static_cast<std::streamsize>(leaves.size() * sizeof(std::int64_t)));
-  if (!in) throw InputError(path.string(), "", "checkpoint is truncated");
-  const bool same = forest.sum(leaf_records(forest) == leaves ? 0.0 : 1.0) == 0.0;
-  if (!same) {
-    // An adaptive run: rebuild its grid (the solver's state is read below).
-    if (adaptable == nullptr || adaptable != &forest || !rebuild_grid(*adaptable, ns, leaves) ||
-        forest.sum(leaf_records(forest) == leaves ? 0.0 : 1.0) != 0.0) {
-      throw InputError(path.string(), "", mismatch);
+  // Every rank reads its own file; a fault on one rank is made known to all
+  // before anyone throws, so that none waits in a collective.
+  std::string fault;
+  std::ifstream in(path, std::ios::binary);
+  Header header{};
+  std::vector<std::int64_t> leaves;
+  if (!in) {
+    fault = "cannot read the checkpoint";
+  } else {
+    in.read(reinterpret_cast<char*>(&header), sizeof header);
+    if (!in || std::memcmp(header.magic, kMagic, sizeof kMagic) != 0) {
+      fault = "not a sanguis flow checkpoint (or one of an older version)";
+    } else if (!same_case_grid(header, forest)) {
+      fault =
+          "written for another grid or number of ranks (the case's [flow.grid] and the mpirun "
+          "-np must be those of the run that wrote it)";
+    } else {
+      leaves.resize(static_cast<std::size_t>(header.local_blocks) * 4);
+      in.read(reinterpret_cast<char*>(leaves.data()),
+              static_cast<std::streamsize>(leaves.size() * sizeof(std::int64_t)));
+      if (!in) fault = "checkpoint is truncated";
     }
   }
-  if (header.global_blocks != forest.global_blocks()) {
-    throw InputError(path.string(), "", mismatch);
+  auto agree = [&](const std::string& reason) {
+    if (forest.max(fault.empty() ? 0.0 : 1.0) > 0.0) {
+      throw InputError(path.string(), "",
+                       fault.empty() ? "the checkpoint of another rank " + reason : fault);
+    }
+  };
+  agree("cannot be used");
+  if (forest.sum(leaf_records(forest) == leaves ? 0.0 : 1.0) != 0.0) {
+    // An adaptive run: rebuild its grid (the solver's state is read below).
+    if (adaptable == nullptr || adaptable != &forest) {
+      fault =
+          "written by an adaptive run ([flow.adapt]) or on another grid: restart with the case "
+          "file that wrote it";
+    } else if (!rebuild_grid(*adaptable, ns, leaves) ||
+               forest.sum(leaf_records(forest) == leaves ? 0.0 : 1.0) != 0.0) {
+      fault = "its blocks could not be rebuilt on this case's grid";
+    }
+    agree("does not fit");
   }
+  if (header.global_blocks != forest.global_blocks()) fault = "the block count does not match";
+  agree("does not fit");
   for (BlockField* f : state_fields(ns)) {
     auto& data = f->raw();
     in.read(reinterpret_cast<char*>(data.data()),
             static_cast<std::streamsize>(data.size() * sizeof(double)));
   }
-  if (!in) throw InputError(path.string(), "", "checkpoint is truncated");
+  if (!in) fault = "checkpoint is truncated";
+  agree("is truncated");
   ns.set_time(header.time);
   return {header.steps, header.frames};
 }

@@ -58,7 +58,7 @@ Forest::Forest(const ForestSpec& spec) : spec_(spec), p4est_(std::make_unique<P4
 
 Forest::~Forest() = default;
 
-void Forest::partition(std::span<BlockField* const> fields) {
+bool Forest::partition(std::span<BlockField* const> fields) {
   p8est_t* forest = p4est_->forest.get();
   for (const BlockField* f : fields) {
     if (f->blocks() != forest->local_num_quadrants) {
@@ -72,6 +72,7 @@ void Forest::partition(std::span<BlockField* const> fields) {
   const bool moved = !std::equal(before.begin(), before.end(), forest->global_first_quadrant);
   if (moved && !fields.empty()) migrate_fields(before, fields);
   rebuild_tables();
+  return moved;
 }
 
 void Forest::rebuild_tables() {

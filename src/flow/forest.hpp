@@ -152,12 +152,14 @@ class Forest {
   /// Global number (p8est order over all ranks) of this rank's first block.
   [[nodiscard]] std::int64_t first_global_block() const { return first_global_block_; }
 
-  /// Repartitions the blocks evenly over the ranks (a no-op on uniform
-  /// forests built here) and moves `fields` (BlockFields of any layout, one
-  /// entry per local block, e.g. also FaceField components) with them by
+  /// Repartitions the blocks evenly over the ranks, keeping families of 8
+  /// on one rank (so the split may differ from the even one of a forest
+  /// just built), and moves `fields` (BlockFields of any layout, one entry
+  /// per local block, e.g. also FaceField components) with them by
   /// p8est_transfer_fixed: each block's whole storage, ghosts included (so a
-  /// face field keeps its slot b; cell ghosts are stale until the next exchange).
-  void partition(std::span<BlockField* const> fields = {});
+  /// face field keeps its slot b; cell ghosts are stale until the next
+  /// exchange). Returns whether any block changed rank (the same on all ranks).
+  bool partition(std::span<BlockField* const> fields = {});
 
   /// Refines and coarsens blocks by `flags` (one per local block), restores
   /// the 2:1 balance across faces, edges and corners (which may refine more
@@ -173,7 +175,8 @@ class Forest {
   /// face takes that face's value and a child face inside a parent cell the
   /// mean of the parent's two faces along its normal (exact for components
   /// linear along their own direction; constant across). Refinement beyond
-  /// `max_level` is ignored. Returns whether any block changed (on any rank).
+  /// `max_level` is ignored. Returns whether any block changed or moved to
+  /// another rank (the same on all ranks): the local block list is new.
   bool adapt(std::span<const AdaptFlag> flags, std::span<BlockField* const> fields,
              std::span<FaceField* const> face_fields = {}, int max_level = 18);
   /// The same with the flag of every block given by a callback.

@@ -446,8 +446,9 @@ void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const Sc
                     implicit += 2.0 * k.beta[D(d)][c + s[D(d)]];
                   }
                   // A matched ghost moves with the cell as 1 - 2 w
-                  // (fine_ghost_self_weight): its face has 2 w beta on the
-                  // diagonal. Treating the ghost as fixed relative to the cell
+                  // (fine_ghost_self_weight): exactly, its face has 2 w beta
+                  // on the diagonal (kMatchedDiagonal w beta is used, see
+                  // there). Treating the ghost as fixed relative to the cell
                   // (beta removed from the diagonal, as first written) makes
                   // Gauss-Seidel diverge at coarse cells with finer blocks
                   // across two or three faces (concave refined regions).

@@ -75,26 +75,33 @@ void for_face_layer(const BlockLayout& L, int d, int side, Body&& body) {
                  [&](std::ptrdiff_t c, std::ptrdiff_t g) { body(c, side == 0 ? c : g); });
 }
 
-/// Composite grids, first half of "the fine faces win": every block beside a
-/// coarser face neighbour writes fine_value(blk, d, f) of its faces f on that
-/// block face into its face layer of layers[face], and the exchange carries
-/// them to the coarse block, whose ghost cell there is the mean of the 8 fine
-/// cells behind it: the 4 of the face layer and 4 zeros (the layers are only
-/// ever written in their face layer), so twice the ghost is the mean of the 4
-/// fine faces (the trick of Multigrid::match_fluxes).
-template <typename FineValue>
-void fine_faces_to_coarse(const Forest& forest, std::array<BlockField, 6>& layers,
-                          FineValue&& fine_value) {
+/// Whether the block's neighbour across face (d, side) is a block with level relation `jump`.
+bool face_neighbour_is(const Block& block, int d, int side, LevelJump jump) {
+  const Neighbour& nb = block.neighbours[face_neighbour_slot(d, side)];
+  return nb.link != Link::Boundary && nb.jump == jump;
+}
+
+/// Face values sent across block faces through the ordinary exchange (the
+/// trick of Multigrid::match_fluxes): every block writes value(blk, d, f) of
+/// its faces f on each block face whose neighbour has relation `toward`
+/// into its face layer of layers[face], and the exchange carries them into
+/// the neighbour's ghost cell across. Same level: the ghost is the copy
+/// itself. Toward a coarser block (the fine faces win): the coarse ghost is
+/// the mean of the 8 fine cells behind it, the 4 of the face layer and 4
+/// zeros (the layers are only ever written in their face layer), so twice
+/// the ghost is the mean of the 4 fine faces.
+template <typename Value>
+void send_faces(const Forest& forest, std::array<BlockField, 6>& layers, LevelJump toward,
+                Value&& value) {
   const BlockLayout L = layers[0].layout();
   forest.for_each_block([&](int blk) {
     const Block& block = forest.block(blk);
     for (int d = 0; d < 3; ++d)
       for (int side = 0; side < 2; ++side) {
-        if (block.neighbours[face_neighbour_slot(d, side)].jump != LevelJump::Coarser) continue;
+        if (!face_neighbour_is(block, d, side, toward)) continue;
         double* layer = layers[D(face_index(d, side))].block(blk);
-        for_face_layer(L, d, side, [&](std::ptrdiff_t c, std::ptrdiff_t f) {
-          layer[c] = fine_value(blk, d, f);
-        });
+        for_face_layer(L, d, side,
+                       [&](std::ptrdiff_t c, std::ptrdiff_t f) { layer[c] = value(blk, d, f); });
       }
   });
   std::array<BlockField*, 6> fields{};
@@ -102,21 +109,23 @@ void fine_faces_to_coarse(const Forest& forest, std::array<BlockField, 6>& layer
   forest.exchange(fields, 1, true);
 }
 
-/// Second half: for a block, calls use(d, f, mean) for every face f of it on a
-/// block face whose neighbour is finer, with the mean of the 4 fine faces.
+/// The receiving half, for one block: use(d, f, v) for every face f of it on
+/// a block face whose neighbour has relation `from` (Same: the neighbour's
+/// copy; Finer: the mean of the 4 fine faces across).
 template <typename Use>
-void for_coarse_faces(const Forest& forest, const std::array<BlockField, 6>& layers, int blk,
-                      Use&& use) {
+void for_received_faces(const Forest& forest, const std::array<BlockField, 6>& layers, int blk,
+                        LevelJump from, Use&& use) {
   const BlockLayout L = layers[0].layout();
   const Block& block = forest.block(blk);
+  const double factor = from == LevelJump::Finer ? 2.0 : 1.0;
   for (int d = 0; d < 3; ++d)
     for (int side = 0; side < 2; ++side) {
-      if (block.neighbours[face_neighbour_slot(d, side)].jump != LevelJump::Finer) continue;
-      // The fine blocks wrote under their own face: the opposite one.
-      const double* fine = layers[D(face_index(d, 1 - side))].block(blk);
+      if (!face_neighbour_is(block, d, side, from)) continue;
+      // The neighbour wrote under its own face: the opposite one.
+      const double* sent = layers[D(face_index(d, 1 - side))].block(blk);
       const std::ptrdiff_t beyond = side == 0 ? -L.stride(d) : L.stride(d);
       for_face_layer(L, d, side, [&](std::ptrdiff_t c, std::ptrdiff_t f) {
-        use(d, f, 2.0 * fine[c + beyond]);
+        use(d, f, factor * sent[c + beyond]);
       });
     }
 }
@@ -443,11 +452,12 @@ void NavierStokes::fill_face_ghosts(FaceField& uf) {
 
 void NavierStokes::synchronise_coarse_faces(FaceField& uf) {
   if (!composite_) return;
-  fine_faces_to_coarse(forest_, interface_,
-                       [&](int blk, int d, std::ptrdiff_t f) { return uf[D(d)].block(blk)[f]; });
+  send_faces(forest_, interface_, LevelJump::Coarser,
+             [&](int blk, int d, std::ptrdiff_t f) { return uf[D(d)].block(blk)[f]; });
   forest_.for_each_block([&](int blk) {
-    for_coarse_faces(forest_, interface_, blk,
-                     [&](int d, std::ptrdiff_t f, double mean) { uf[D(d)].block(blk)[f] = mean; });
+    for_received_faces(
+        forest_, interface_, blk, LevelJump::Finer,
+        [&](int d, std::ptrdiff_t f, double mean) { uf[D(d)].block(blk)[f] = mean; });
   });
 }
 
@@ -501,6 +511,11 @@ void NavierStokes::advect(double dt) {
 }
 
 void NavierStokes::advect_scalar(BlockField& c, double dt) {
+  if (c.blocks() != forest_.local_blocks() || c.cells() != forest_.block_cells()) {
+    throw std::invalid_argument(
+        "navier-stokes: advect_scalar: the field does not match the forest's blocks (pass "
+        "tracers to regrid() so that they follow the grid)");
+  }
   fill_scalar_neumann(c, kGhost);
   fill_face_ghosts(uf_);
   set_boundary_faces(uf_);
@@ -590,9 +605,8 @@ void NavierStokes::advect_field(const BlockField& field, const BlockField* sourc
   forest_.for_each_block([&](int blk) {
     for (int d = 0; d < 3; ++d) block_fluxes(blk, d, face_flux_[D(d)].block(blk));
   });
-  fine_faces_to_coarse(forest_, interface_, [&](int blk, int d, std::ptrdiff_t f) {
-    return face_flux_[D(d)].block(blk)[f];
-  });
+  send_faces(forest_, interface_, LevelJump::Coarser,
+             [&](int blk, int d, std::ptrdiff_t f) { return face_flux_[D(d)].block(blk)[f]; });
   BlockField* fluxes[] = {&face_flux_[0], &face_flux_[1], &face_flux_[2]};
   forest_.exchange(fluxes, 1, true);
   forest_.for_each_block([&](int blk) {
@@ -610,9 +624,9 @@ void NavierStokes::advect_field(const BlockField& field, const BlockField* sourc
         });
       }
     }
-    for_coarse_faces(forest_, interface_, blk, [&](int d, std::ptrdiff_t face, double mean) {
-      face_flux_[D(d)].block(blk)[face] = mean;
-    });
+    for_received_faces(
+        forest_, interface_, blk, LevelJump::Finer,
+        [&](int d, std::ptrdiff_t face, double mean) { face_flux_[D(d)].block(blk)[face] = mean; });
     update(blk, {face_flux_[0].block(blk), face_flux_[1].block(blk), face_flux_[2].block(blk)});
   });
 }
@@ -939,45 +953,17 @@ StepReport NavierStokes::step(double dt) {
 }
 
 void NavierStokes::average_shared_faces(FaceField& uf) {
-  const int n = forest_.local_blocks();
-  const int b = forest_.block_cells();
-  // Each block writes its faces on a block face with a same-level neighbour
-  // into the cell layer beside it (layers[face]); the exchange brings the
-  // neighbour's copy into the ghost cell across, as in fine_faces_to_coarse.
+  // Fresh layers: send_faces relies on zeros outside the face layers.
   std::array<BlockField, 6> layers;
-  for (auto& layer : layers) layer = BlockField(n, b);
-  const BlockLayout L = layers[0].layout();
-  auto shared = [&](const Block& block, int d, int side) {
-    const Neighbour& nb = block.neighbours[face_neighbour_slot(d, side)];
-    return nb.link != Link::Boundary && nb.jump == LevelJump::Same;
-  };
+  for (auto& layer : layers) layer = BlockField(forest_.local_blocks(), forest_.block_cells());
+  send_faces(forest_, layers, LevelJump::Same,
+             [&](int blk, int d, std::ptrdiff_t f) { return uf[D(d)].block(blk)[f]; });
   forest_.for_each_block([&](int blk) {
-    const Block& block = forest_.block(blk);
-    for (int d = 0; d < 3; ++d)
-      for (int side = 0; side < 2; ++side) {
-        if (!shared(block, d, side)) continue;
-        double* layer = layers[D(face_index(d, side))].block(blk);
-        const double* faces = uf[D(d)].block(blk);
-        for_face_layer(L, d, side,
-                       [&](std::ptrdiff_t c, std::ptrdiff_t f) { layer[c] = faces[f]; });
-      }
-  });
-  std::array<BlockField*, 6> fields{};
-  for (std::size_t f = 0; f < 6; ++f) fields[f] = &layers[f];
-  forest_.exchange(fields, 1, true);
-  forest_.for_each_block([&](int blk) {
-    const Block& block = forest_.block(blk);
-    for (int d = 0; d < 3; ++d)
-      for (int side = 0; side < 2; ++side) {
-        if (!shared(block, d, side)) continue;
-        // The neighbour wrote the shared face under its own opposite face.
-        const double* theirs = layers[D(face_index(d, 1 - side))].block(blk);
-        const std::ptrdiff_t beyond = side == 0 ? -L.stride(d) : L.stride(d);
-        double* faces = uf[D(d)].block(blk);
-        for_face_layer(L, d, side, [&](std::ptrdiff_t c, std::ptrdiff_t f) {
-          faces[f] = 0.5 * (faces[f] + theirs[c + beyond]);
-        });
-      }
+    for_received_faces(forest_, layers, blk, LevelJump::Same,
+                       [&](int d, std::ptrdiff_t f, double theirs) {
+                         double& mine = uf[D(d)].block(blk)[f];
+                         mine = 0.5 * (mine + theirs);
+                       });
   });
 }
 

@@ -221,7 +221,7 @@ class NavierStokes {
   MultigridReport pressure_report_;
   bool composite_ = false;  ///< blocks at more than one level
   /// Composite grids: per block face, the fine faces' values travelling to
-  /// the coarse block (face layer of the fine block, see fine_faces_to_coarse).
+  /// the coarse block (face layer of the fine block, see send_faces).
   std::array<BlockField, 6> interface_;
   FaceField face_flux_;  ///< composite grids: advective fluxes of all faces
 };
