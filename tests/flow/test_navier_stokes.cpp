@@ -8,19 +8,17 @@
 #include <cstdio>
 
 #include "flow/navier_stokes.hpp"
+#include "navier_stokes_problems.hpp"
 #include "poisson_problems.hpp"
 
 namespace sanguis::flow {
 namespace {
 
+using testing::all_periodic;
 using testing::cell_centre;
 using testing::kPi;
-
-std::array<FlowBoundary, 6> all_periodic() {
-  std::array<FlowBoundary, 6> bcs{};
-  for (auto& bc : bcs) bc.kind = FlowBoundaryKind::Periodic;
-  return bcs;
-}
+using testing::rough;
+using testing::total;
 
 /// Channel periodic in x and z, walls at y = 0 and y = H (the upper one moving with `lid`).
 std::array<FlowBoundary, 6> channel(double lid) {

@@ -12,20 +12,18 @@
 #include "adapt_problems.hpp"
 #include "flow/adapt_criterion.hpp"
 #include "flow/navier_stokes.hpp"
+#include "navier_stokes_problems.hpp"
 #include "poisson_problems.hpp"
 
 namespace sanguis::flow {
 namespace {
 
+using testing::all_periodic;
 using testing::block_centre;
 using testing::cell_centre;
 using testing::kPi;
-
-std::array<FlowBoundary, 6> all_periodic() {
-  std::array<FlowBoundary, 6> bcs{};
-  for (auto& bc : bcs) bc.kind = FlowBoundaryKind::Periodic;
-  return bcs;
-}
+using testing::rough;
+using testing::total;
 
 /// Periodic unit cube, 8 blocks of 8^3 cells (16^3 cells).
 ForestSpec periodic_cube(int threads = 1) {
@@ -34,27 +32,6 @@ ForestSpec periodic_cube(int threads = 1) {
   spec.periodic = {true, true, true};
   spec.threads = threads;
   return spec;
-}
-
-/// A deterministic rough field in [-1, 1].
-double rough(const Vec3& x, int seed) {
-  const double v = std::sin(12.9898 * x.x + 78.233 * x.y + 37.719 * x.z + 4.1 * seed) * 43758.5453;
-  return 2.0 * (v - std::floor(v)) - 1.0;
-}
-
-/// Volume integral of a cell field over all cells (all ranks).
-double total(const Forest& forest, const BlockField& c) {
-  const int b = forest.block_cells();
-  double sum = 0.0;
-  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
-    const double h = forest.block(blk).length / b;
-    double block_sum = 0.0;
-    for (int k = 0; k < b; ++k)
-      for (int j = 0; j < b; ++j)
-        for (int i = 0; i < b; ++i) block_sum += c(blk, i, j, k);
-    sum += block_sum * h * h * h;
-  }
-  return forest.sum(sum);
 }
 
 /// One flag per local block from a predicate on the block.

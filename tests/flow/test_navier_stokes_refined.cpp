@@ -11,20 +11,18 @@
 
 #include "adapt_problems.hpp"
 #include "flow/navier_stokes.hpp"
+#include "navier_stokes_problems.hpp"
 #include "poisson_problems.hpp"
 
 namespace sanguis::flow {
 namespace {
 
+using testing::all_periodic;
 using testing::cell_centre;
 using testing::kPi;
 using testing::refine_where;
-
-std::array<FlowBoundary, 6> all_periodic() {
-  std::array<FlowBoundary, 6> bcs{};
-  for (auto& bc : bcs) bc.kind = FlowBoundaryKind::Periodic;
-  return bcs;
-}
+using testing::rough;
+using testing::total;
 
 /// Channel periodic in x and z, walls at y = 0 and y = H (the upper one moving with `lid`).
 std::array<FlowBoundary, 6> channel(double lid) {
@@ -33,12 +31,6 @@ std::array<FlowBoundary, 6> channel(double lid) {
   bcs[face_index(1, 1)].kind = FlowBoundaryKind::Wall;
   bcs[face_index(1, 1)].wall_velocity = {lid, 0.0, 0.0};
   return bcs;
-}
-
-/// A deterministic rough field in [-1, 1] (no structure the projection could exploit).
-double rough(const Vec3& x, int seed) {
-  const double v = std::sin(12.9898 * x.x + 78.233 * x.y + 37.719 * x.z + 4.1 * seed) * 43758.5453;
-  return 2.0 * (v - std::floor(v)) - 1.0;
 }
 
 /// Periodic unit cube, 16^3 cells in 8 blocks, the two blocks at x, y < 1/2
@@ -52,21 +44,6 @@ ForestSpec periodic_cube() {
   spec.level = 1;
   spec.periodic = {true, true, true};
   return spec;
-}
-
-/// Total amount sum(c V) over all cells (all ranks).
-double total(const Forest& forest, const BlockField& c) {
-  const int b = forest.block_cells();
-  double sum = 0.0;
-  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
-    const double h = forest.block(blk).length / b;
-    double block_sum = 0.0;
-    for (int k = 0; k < b; ++k)
-      for (int j = 0; j < b; ++j)
-        for (int i = 0; i < b; ++i) block_sum += c(blk, i, j, k);
-    sum += block_sum * h * h * h;
-  }
-  return forest.sum(sum);
 }
 
 TEST(FlowRefinedNavierStokes, ProjectionLeavesEveryCellDivergenceFree) {
