@@ -111,9 +111,11 @@ def run_gate(exe, gate, out, threads):
         advance(t + COLLAPSE_S, ["--set", f"obstacle[{GATE_INDEX}].remove_at_s={t}"])
         return t
     t = math.ceil(10 * (CROSSES[gate] / pour_rate(gate) + SETTLE_S)) / 10
-    if os.path.exists(checkpoint):  # stopped in the pour: go on from where it is
-        t = max(t, math.ceil(2 * diagnostics(out)[-1]["time_s"] + 1e-9) / 2)
-    advance(t)
+    reached = diagnostics(out)[-1]["time_s"] if os.path.exists(checkpoint) else 0.0
+    if reached > t + 1e-9:  # stopped in an extension of the pour: on the 0.5 s grid beyond t
+        t = round(t + 0.5 * math.ceil((reached - t) / 0.5 - 1e-9), 1)
+    if reached < t - 1e-9:  # a fresh run, or stopped in the pour: go on to t
+        advance(t)
     while not poured_and_at_rest(out, CROSSES[gate]):
         if t > 20.0:
             sys.exit(f"gate {gate} cm: the pour has not come to rest by {t} s")
