@@ -130,10 +130,6 @@ void read_adaptivity(const ConfigTable& flow, const ConfigTable& t, FlowCase& c)
                             "must be >= 4 with [flow.adapt] (the wavelet "
                             "estimate restricts and prolongs inside a block)");
   }
-  if (!c.solid_boxes.empty()) {
-    flow.table_array("solid").front().fail(
-        "min_m", "solid cells on an adapting grid ([flow.adapt]) are not available yet");
-  }
   for (const ConfigTable& r : t.table_array("region")) {
     RefinementRegion region;
     region.min = r.get_vec3("min_m");

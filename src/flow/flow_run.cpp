@@ -33,7 +33,10 @@ const std::vector<std::string> kColumns = {"time_s",
                                            "max_divergence_1_s",
                                            "pressure_vcycles",
                                            "pressure_reduction_per_cycle",
-                                           "cells"};
+                                           "cells",
+                                           "solid_force_x_N",
+                                           "solid_force_y_N",
+                                           "solid_force_z_N"};
 
 struct Diagnostics {
   double kinetic_energy = 0.0;
@@ -206,10 +209,11 @@ FlowRunSummary run_flow_case(const FlowCase& c, const FlowRunOptions& options,
     }
     const Diagnostics d = diagnostics(ns);
     const double divergence = ns.max_divergence();
+    const Vec3 force = ns.solid_force();
     if (csv) {
       csv->row({ns.time(), static_cast<double>(steps), last.dt, d.kinetic_energy, d.max_velocity,
                 divergence, static_cast<double>(last.pressure_cycles), last.pressure_reduction,
-                leaf_cells(forest)});
+                leaf_cells(forest), force.x, force.y, force.z});
     }
     if (!std::isfinite(d.max_velocity))
       throw SimulationError("non-finite velocity at t = " + std::to_string(ns.time()));

@@ -78,6 +78,9 @@ struct Neighbour {
 };
 
 /// Per-block request to `Forest::adapt`.
+/// The deepest level p8est blocks may reach (P8EST_QMAXLEVEL).
+inline constexpr int kForestMaxLevel = 18;
+
 enum class AdaptFlag : std::int8_t {
   Coarsen = -1,  ///< merge with its 7 siblings (only when all 8 ask and sit on one rank)
   Keep = 0,
@@ -178,11 +181,11 @@ class Forest {
   /// `max_level` is ignored. Returns whether any block changed or moved to
   /// another rank (the same on all ranks): the local block list is new.
   bool adapt(std::span<const AdaptFlag> flags, std::span<BlockField* const> fields,
-             std::span<FaceField* const> face_fields = {}, int max_level = 18);
+             std::span<FaceField* const> face_fields = {}, int max_level = kForestMaxLevel);
   /// The same with the flag of every block given by a callback.
   bool adapt(const std::function<AdaptFlag(const Block&)>& decide,
              std::span<BlockField* const> fields, std::span<FaceField* const> face_fields = {},
-             int max_level = 18);
+             int max_level = kForestMaxLevel);
 
  private:
   void build_blocks();

@@ -319,19 +319,39 @@ void NavierStokes::set_viscosity(const std::function<double(const Vec3&)>& mu) {
 
 void NavierStokes::set_solid(const std::function<bool(const Vec3&)>& solid) {
   // Closed faces (beta = 0) at a coarse-fine face have no matched flux in the
-  // multigrid, and the no-slip closure there is not written for two levels.
+  // multigrid, and the no-slip closure there is not written for two levels:
+  // blocks near solids must be at the finest level.
+  solid_function_ = solid;
   if (composite_) {
-    throw std::invalid_argument(
-        "navier-stokes: solid cells on a forest with several levels are not available yet");
+    double misplaced = 0.0;
+    for (int blk = 0; blk < forest_.local_blocks(); ++blk) {
+      const Block& block = forest_.block(blk);
+      if (block.level < forest_.max_level() && near_solid(block.lower, block.length, block.level))
+        misplaced += 1.0;
+    }
+    if (forest_.sum(misplaced) > 0.0) {
+      solid_function_ = nullptr;
+      throw std::invalid_argument(
+          "navier-stokes: solid cells within 2 cells of a block coarser than the finest level; "
+          "refine the blocks near solids to the finest level first (regrid with max_level does)");
+    }
   }
+  sample_solid();
+  clear_solid_cells(u_);
+  close_solid_faces(uf_);
+}
+
+void NavierStokes::sample_solid() {
   const int b = forest_.block_cells();
   bool any = false;
+  solid_.fill(0.0);
   for (int blk = 0; blk < forest_.local_blocks(); ++blk) {
     const Block& block = forest_.block(blk);
     const double h = block.length / b;
     for_each_cell(b, [&](int i, int j, int k) {
-      const bool inside = solid({block.lower.x + (i + 0.5) * h, block.lower.y + (j + 0.5) * h,
-                                 block.lower.z + (k + 0.5) * h});
+      const bool inside =
+          solid_function_({block.lower.x + (i + 0.5) * h, block.lower.y + (j + 0.5) * h,
+                           block.lower.z + (k + 0.5) * h});
       solid_(blk, i, j, k) = inside ? 1.0 : 0.0;
       any = any || inside;
     });
@@ -353,8 +373,55 @@ void NavierStokes::set_solid(const std::function<bool(const Vec3&)>& solid) {
   // (beta = 0), so the multigrid treats them as inactive.
   pressure_mg_->set_coefficients(nullptr, has_solids_ ? &open_ : nullptr);
   viscosity_changed_ = true;
-  clear_solid_cells(u_);
-  close_solid_faces(uf_);
+}
+
+bool NavierStokes::near_solid(const Vec3& lower, double length, int level) const {
+  const ForestSpec& spec = forest_.spec();
+  const int b = forest_.block_cells();
+  // Blocks coarser than the initial grid test each of their cells at its
+  // resolution, so that a solid one initial cell thick is not missed.
+  const int sub = 1 << std::max(0, spec.level - level);
+  const double h = length / (b * sub);
+  const int lo = -kGhost * sub, hi = (b + kGhost) * sub;
+  for (int k = lo; k < hi; ++k)
+    for (int j = lo; j < hi; ++j)
+      for (int i = lo; i < hi; ++i) {
+        Vec3 x{lower.x + (i + 0.5) * h, lower.y + (j + 0.5) * h, lower.z + (k + 0.5) * h};
+        for (int d = 0; d < 3; ++d) {
+          if (!spec.periodic[D(d)]) continue;
+          const double extent = spec.trees[D(d)] * spec.tree_length;
+          if (x[d] < spec.origin[d]) x[d] += extent;
+          if (x[d] >= spec.origin[d] + extent) x[d] -= extent;
+        }
+        if (solid_function_(x)) return true;
+      }
+  return false;
+}
+
+bool NavierStokes::keep_solids_finest(std::vector<AdaptFlag>& flags, int max_level) const {
+  std::vector<char> near(flags.size(), 0);
+  forest_.for_each_block([&](int blk) {
+    const Block& block = forest_.block(blk);
+    near[static_cast<std::size_t>(blk)] = near_solid(block.lower, block.length, block.level);
+  });
+  double refine = 0.0;
+  for (int blk = 0; blk < forest_.local_blocks(); ++blk) {
+    const Block& block = forest_.block(blk);
+    AdaptFlag& flag = flags[static_cast<std::size_t>(blk)];
+    if (near[static_cast<std::size_t>(blk)] != 0) {
+      flag = block.level < max_level ? AdaptFlag::Refine : AdaptFlag::Keep;
+      refine += flag == AdaptFlag::Refine ? 1.0 : 0.0;
+    } else if (flag == AdaptFlag::Coarsen) {
+      // The parent the family would merge into: its cells are twice as large,
+      // so it reaches twice as far.
+      Vec3 parent = block.lower;
+      for (int d = 0; d < 3; ++d) {
+        if (block.coord[D(d)] % 2 != 0) parent[d] -= block.length;
+      }
+      if (near_solid(parent, 2.0 * block.length, block.level - 1)) flag = AdaptFlag::Keep;
+    }
+  }
+  return forest_.sum(refine) > 0.0;
 }
 
 void NavierStokes::close_solid_faces(FaceField& uf) const {
@@ -382,6 +449,33 @@ void NavierStokes::clear_solid_cells(VectorField& u) const {
       }
     });
   });
+}
+
+Vec3 NavierStokes::solid_force() const {
+  if (!has_solids_) return {};
+  const int b = forest_.block_cells();
+  const BlockLayout L = solid_.layout();
+  Vec3 force{};
+  for (int blk = 0; blk < forest_.local_blocks(); ++blk) {
+    const double h = forest_.block(blk).length / b;
+    const double* sb = solid_.block(blk);
+    for_each_cell(b, [&](int i, int j, int k) {
+      const std::ptrdiff_t c = L.index(i, j, k);
+      if (sb[c] != 0.0) return;
+      for (int d = 0; d < 3; ++d) {
+        for (int side = -1; side <= 1; side += 2) {
+          if (sb[c + side * L.stride(d)] == 0.0) continue;
+          // The pressure pushes into the solid; the wall shear drags it along
+          // the fluid's tangential velocity (no-slip closure of the viscous step).
+          force[d] += side * p_.block(blk)[c] * h * h;
+          for (int e = 0; e < 3; ++e) {
+            if (e != d) force[e] += mu_.block(blk)[c] * u_[D(e)].block(blk)[c] / (0.5 * h) * h * h;
+          }
+        }
+      }
+    });
+  }
+  return {forest_.sum(force.x), forest_.sum(force.y), forest_.sum(force.z)};
 }
 
 void NavierStokes::fill_velocity_ghosts(VectorField& u, int width) {
@@ -972,9 +1066,10 @@ RegridReport NavierStokes::regrid(Forest& forest, std::span<const AdaptFlag> fla
   if (&forest != &forest_) {
     throw std::invalid_argument("navier-stokes: regrid needs the forest the solver was built on");
   }
-  if (has_solids_) {
+  if (has_solids_ && max_level >= kForestMaxLevel) {
     throw std::invalid_argument(
-        "navier-stokes: solid cells on an adapting forest are not available yet");
+        "navier-stokes: with solid cells, regrid needs max_level: the blocks near solids are "
+        "kept at that level");
   }
   if (variable_viscosity_) {
     throw std::invalid_argument(
@@ -986,7 +1081,16 @@ RegridReport NavierStokes::regrid(Forest& forest, std::span<const AdaptFlag> fla
   std::vector<BlockField*> cells{&u_[0], &u_[1], &u_[2], &g_[0], &g_[1], &g_[2], &p_, &mu_};
   cells.insert(cells.end(), scalars.begin(), scalars.end());
   FaceField* faces[] = {&uf_, &accel_};
-  report.changed = forest.adapt(flags, cells, faces, max_level);
+  std::vector<AdaptFlag> wanted(flags.begin(), flags.end());
+  if (has_solids_) keep_solids_finest(wanted, max_level);
+  report.changed = forest.adapt(wanted, cells, faces, max_level);
+  // Blocks near solids that are not yet at max_level (a first regrid, or the
+  // 2:1 balance) are refined on until every one is.
+  for (int pass = 0; has_solids_ && pass <= max_level; ++pass) {
+    std::vector<AdaptFlag> more(static_cast<std::size_t>(forest.local_blocks()), AdaptFlag::Keep);
+    if (!keep_solids_finest(more, max_level)) break;
+    report.changed = forest.adapt(more, cells, faces, max_level) || report.changed;
+  }
   report.blocks_after = forest.global_blocks();
   if (!report.changed) return report;
 
@@ -996,6 +1100,11 @@ RegridReport NavierStokes::regrid(Forest& forest, std::span<const AdaptFlag> fla
   viscous_dt_ = -1.0;
   viscosity_changed_ = true;
   if (body_force_) set_body_force(body_force_);
+  if (has_solids_) {
+    sample_solid();
+    clear_solid_cells(u_);
+    close_solid_faces(uf_);
+  }
   // The carried uf keeps every old face's flux, but a block refined beside
   // finer ones gave its children the coarse face's value where the finer
   // neighbour has its own: the copies are averaged (same total flux), the

@@ -33,8 +33,12 @@
 // the composite Poisson problem of Multigrid (flux matching), leaves every
 // cell, coarse ones beside the interface included, divergence-free to the
 // solver's residual. One dt for all levels (no subcycling), from the CFL
-// condition on the finest cells. Not available there yet: solid masks,
-// variable viscosity (the explicit grad u^T stress is not flux-matched).
+// condition on the finest cells. Solid masks on such forests are kept clear of
+// level jumps: every block whose cells, or the 2 cells beyond its faces, edges
+// and corners, hold a solid cell is at the finest level (regrid keeps it so), so
+// a coarse-fine face never has a closed face or a wall closure within reach of
+// its stencils. Not available there yet: variable viscosity (the explicit
+// grad u^T stress is not flux-matched).
 
 #include <array>
 #include <cstdint>
@@ -42,6 +46,7 @@
 #include <limits>
 #include <optional>
 #include <span>
+#include <vector>
 
 #include "core/error.hpp"
 #include "flow/block_field.hpp"
@@ -112,8 +117,17 @@ class NavierStokes {
   /// Solid cells (cell masks aligned with the grid): solid(x) at cell
   /// centres. Solid cells hold no flow; their faces with fluid cells are
   /// no-slip walls (linear closure) closed to the flow. Call before set_velocity.
+  /// The mask is sampled again after each regrid, so solid(x) must stay
+  /// valid; it should be resolved by the forest's initial grid (ForestSpec
+  /// level): coarser blocks test it at that resolution. On a forest with
+  /// several levels the blocks near solids (see the header) must already be
+  /// at the finest level (std::invalid_argument otherwise).
   void set_solid(const std::function<bool(const Vec3&)>& solid);
   [[nodiscard]] const BlockField& solid() const { return solid_; }
+  /// Force of the fluid on the solid cells (N): on every face between a fluid
+  /// and a solid cell, the fluid cell's pressure along the normal and the wall
+  /// shear of the no-slip closure, mu u_t / (h/2), as the viscous step applies it.
+  [[nodiscard]] Vec3 solid_force() const;
 
   /// Largest stable step: min(dt_max, cfl h / max|uf|).
   [[nodiscard]] double stable_dt() const;
@@ -130,9 +144,12 @@ class NavierStokes {
   /// sampled on the new faces, and the carried face velocity is projected
   /// once more (refinement beside finer blocks leaves an O(h^2) divergence),
   /// so that uf is divergence-free to the projection tolerance, as after a
-  /// step. Not with solid cells or variable viscosity (refused).
+  /// step. With solid cells, blocks near them are refined to `max_level`
+  /// and never coarsened (max_level must then be given), and the mask is
+  /// sampled again. Not with variable viscosity (refused).
   RegridReport regrid(Forest& forest, std::span<const AdaptFlag> flags,
-                      std::span<BlockField* const> scalars = {}, int max_level = 18);
+                      std::span<BlockField* const> scalars = {},
+                      int max_level = kForestMaxLevel);
 
   [[nodiscard]] double time() const { return time_; }
   [[nodiscard]] const Forest& forest() const { return forest_; }
@@ -184,6 +201,15 @@ class NavierStokes {
   void close_solid_faces(FaceField& uf) const;
   void add_transpose_stress(double dt);
   void clear_solid_cells(VectorField& u) const;
+  /// solid_, open_ and the pressure coefficients from solid_function_.
+  void sample_solid();
+  /// Whether a solid cell lies in the cube (lower, length) of a block at
+  /// `level` or within kGhost of its cells beyond it, sampled at its cell
+  /// centres (at the initial grid's resolution where that is finer).
+  [[nodiscard]] bool near_solid(const Vec3& lower, double length, int level) const;
+  /// Overrides `flags` so that blocks near solids go to max_level and no
+  /// family coarsens into a block near solids; true if any rank refines.
+  bool keep_solids_finest(std::vector<AdaptFlag>& flags, int max_level) const;
   /// Scratch, masks and interface layers sized to the current block list.
   void allocate_work_fields();
   /// Both copies of a face shared by two blocks of one level take their mean
@@ -214,6 +240,7 @@ class NavierStokes {
   double viscous_dt_ = -1.0;                     ///< dt the viscous coefficients were built for
   bool viscosity_changed_ = true;
   bool has_solids_ = false;
+  std::function<bool(const Vec3&)> solid_function_;  ///< as given, to sample again after a regrid
   bool variable_viscosity_ = false;  ///< mu not uniform: the grad u^T stress is added
   BlockField solid_;                 ///< 1 in solid cells, 0 in fluid cells
   FaceField

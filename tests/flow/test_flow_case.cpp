@@ -186,10 +186,6 @@ TEST(FlowCaseErrors, AdaptivityKeysAreChecked) {
   expect_input_error(
       replaced(kAdaptiveChannel, "cells = [8, 16, 8]", "cells = [8, 16, 8]\nblock_cells = 2"),
       "grid.block_cells");
-  expect_input_error(replaced(kAdaptiveChannel, "[flow.time]",
-                              "[[flow.solid]]\nmin_m = [0.1, 0.1, 0.1]\nmax_m = [0.2, 0.2, "
-                              "0.2]\n\n[flow.time]"),
-                     "solid[0].min_m");
   expect_input_error(
       replaced(kAdaptiveChannel, "velocity_threshold_m_s = 7e-4", "velocity_threshold_m_s = -1.0"),
       "velocity_threshold_m_s");

@@ -255,5 +255,107 @@ TEST(FlowAdaptiveNavierStokes, TwoThreadsGiveTheOneThreadAnswerBitForBit) {
   EXPECT_EQ(differ, 0u);
 }
 
+/// The slabs y < 0.25 and y > 1.25 of the periodic box 0.5 x 1.5 x 0.5 of the
+/// uniform solid-mask test (test_navier_stokes.cpp): a channel of height 1.
+bool channel_slabs(const Vec3& x) { return x.y < 0.25 || x.y > 1.25; }
+
+ForestSpec slab_box(int level) {
+  ForestSpec spec;
+  spec.trees = {1, 3, 1};
+  spec.tree_length = 0.5;
+  spec.level = level;
+  spec.periodic = {true, true, true};
+  return spec;
+}
+
+/// Blocks with a solid cell centre within 2 of their cells beyond their
+/// faces, edges or corners (the test's own reading of the rule) below `level`.
+int blocks_near_slabs_below(const Forest& forest, int level) {
+  const int b = forest.block_cells();
+  int count = 0;
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    const Block& block = forest.block(blk);
+    const double h = block.length / b;
+    bool near = false;
+    for (int j = -2; j < b + 2; ++j) {
+      double y = block.lower.y + (j + 0.5) * h;
+      y = y < 0.0 ? y + 1.5 : (y >= 1.5 ? y - 1.5 : y);
+      near = near || channel_slabs({0.0, y, 0.0});
+    }
+    count += near && block.level < level ? 1 : 0;
+  }
+  return count;
+}
+
+TEST(FlowAdaptiveNavierStokes, SolidWallsOnAForestWithTwoLevels) {
+  // The channel between solid slabs on 16 cells across (level 0), then
+  // regridded with max_level 1: the blocks near the slabs go to 32 across,
+  // the middle of the channel stays at 16. Steady Poiseuille flow: the flow
+  // rate of the exact profile, and the force of the fluid on the slabs equals
+  // the body force on the fluid (the wall shear balances it; p is uniform).
+  Forest forest(slab_box(0));
+  const double G = 2.0, mu = 1.0;
+  NavierStokesOptions options;
+  options.dt_max = 0.05;  // backward Euler: the slowest mode decays 1.5x per step
+  options.viscous.tolerance = 1e-10;
+  options.pressure.tolerance = 1e-10;
+  NavierStokes ns(forest, all_periodic(), Fluid{1.0, mu}, options);
+  ns.set_solid(channel_slabs);
+  ns.set_velocity([](const Vec3&) { return Vec3{}; });
+  ns.set_body_force([G](const Vec3&) { return Vec3{G, 0.0, 0.0}; });
+  EXPECT_THROW(ns.regrid(forest, std::vector<AdaptFlag>(3, AdaptFlag::Keep)),
+               std::invalid_argument);  // solids need an explicit max_level
+  const RegridReport report =
+      ns.regrid(forest, std::vector<AdaptFlag>(3, AdaptFlag::Keep), {}, /*max_level=*/1);
+  EXPECT_TRUE(report.changed);
+  EXPECT_EQ(report.blocks_after, 17);  // the two slab trees refined, the middle one kept
+  EXPECT_EQ(forest.min_level(), 0);
+  EXPECT_EQ(blocks_near_slabs_below(forest, 1), 0);
+  // Asked to coarsen everywhere, the blocks near the slabs stay.
+  ns.regrid(forest, std::vector<AdaptFlag>(17, AdaptFlag::Coarsen), {}, 1);
+  EXPECT_EQ(forest.global_blocks(), 17);
+
+  for (int s = 0; s < 80; ++s) ns.step(ns.stable_dt());
+  const int b = forest.block_cells();
+  double flux = 0.0, inside = 0.0, fluid_volume = 0.0;
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    const double h = forest.block(blk).length / b;
+    for (int k = 0; k < b; ++k)
+      for (int j = 0; j < b; ++j)
+        for (int i = 0; i < b; ++i) {
+          const double u = ns.velocity()[0](blk, i, j, k);
+          if (channel_slabs(cell_centre(forest, blk, i, j, k))) {
+            inside = std::max({inside, std::abs(u), std::abs(ns.velocity()[1](blk, i, j, k))});
+          } else {
+            flux += u * h * h * h;
+            fluid_volume += h * h * h;
+          }
+        }
+  }
+  const double rate = forest.sum(flux) / (0.5 * 0.5);
+  const double error = rate / (G / (12 * mu)) - 1.0;
+  const Vec3 force = ns.solid_force();
+  const double body = G * forest.sum(fluid_volume);
+  std::printf(
+      "channel between solid slabs, 32 across at the walls, 16 in the middle: flow rate error "
+      "%.3e, force on the slabs %.9f (body force on the fluid %.9f), |F_y| + |F_z| %.1e, max "
+      "|div uf| %.1e\n",
+      error, force.x, body, std::abs(force.y) + std::abs(force.z), ns.max_divergence());
+  EXPECT_LT(std::abs(error), 0.01);  // the uniform 16-across grid: 0.6 %
+  EXPECT_EQ(forest.max(inside), 0.0);
+  EXPECT_LT(std::abs(force.x / body - 1.0), 1e-6);
+  EXPECT_LT(std::abs(force.y) + std::abs(force.z), 1e-8 * body);
+  EXPECT_LT(ns.max_divergence(), 1e-7);
+}
+
+TEST(FlowAdaptiveNavierStokes, SolidsBesideCoarserBlocksAreRefused) {
+  // A forest already refined away from the slabs: their blocks are coarse.
+  Forest forest(slab_box(0));
+  forest.adapt([](const Block& b) { return b.lower.y == 0.5 ? AdaptFlag::Refine : AdaptFlag::Keep; },
+               {});
+  NavierStokes ns(forest, all_periodic(), Fluid{1.0, 1.0});
+  EXPECT_THROW(ns.set_solid(channel_slabs), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace sanguis::flow
