@@ -231,12 +231,13 @@ int main(int argc, char** argv) {
   auto* bench_cmd = app.add_subcommand("bench", "throughput benchmarks (one JSON line)");
   bench_cmd
       ->add_option("name", bench_name,
-                   "benchmark: dem-spheres | dem-crosses | membrane | flow-cavity")
+                   "benchmark: dem-spheres | dem-crosses | membrane | flow-cavity | flow-adaptive")
       ->required();
   auto* particles_opt = bench_cmd->add_option(
       "--particles", bo.particles, "number of particles (dem-spheres 32000, dem-crosses 3000)");
   auto* steps_opt = bench_cmd->add_option(
-      "--steps", bo.steps, "time steps (dem-spheres 2000, dem-crosses 500, membrane 20)");
+      "--steps", bo.steps, "time steps (dem-spheres 2000, dem-crosses 500, membrane 20, flow-cavity 20, "
+      "flow-adaptive 100)");
   bench_cmd->add_option("--threads", bo.threads, "threads")->capture_default_str();
   bench_cmd->add_option("--seed", bo.seed, "random seed")->capture_default_str();
   bench_cmd->add_option("--triangles", bo.triangles, "membrane: triangles per capsule (20*4^k)")
@@ -245,6 +246,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   bench_cmd->add_option("--cells-per-side", bo.cells_per_side, "flow-cavity: cells per edge")
       ->capture_default_str();
+  std::string bench_case;
+  bench_cmd->add_option("--case", bench_case,
+                        "flow-adaptive: flow case file (default cases/flow/obstacle-wake.toml)");
 
   const auto run_analysis = app::add_analysis_commands(app);
 
@@ -277,13 +281,19 @@ int main(int argc, char** argv) {
       } else if (bench_name == "membrane") {
         if (!steps_given) bo.steps = 20;
         std::cout << bench::run_membrane(bo) << std::endl;
+      } else if (bench_name == "flow-adaptive") {
+        if (!steps_given) bo.steps = 100;
+        const std::string case_file =
+            bench_case.empty() ? std::string(SANGUIS_SOURCE_DIR) + "/cases/flow/obstacle-wake.toml"
+                               : bench_case;
+        std::cout << bench::run_flow_adaptive(bo, case_file) << std::endl;
       } else if (bench_name == "flow-cavity") {
         if (!steps_given) bo.steps = 20;
         std::cout << bench::run_flow_cavity(bo) << std::endl;
       } else {
         throw InputError("", "bench",
                          "unknown benchmark '" + bench_name +
-                             "' (dem-spheres, dem-crosses, membrane, flow-cavity)");
+                             "' (dem-spheres, dem-crosses, membrane, flow-cavity, flow-adaptive)");
       }
       return 0;
     }

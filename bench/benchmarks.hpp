@@ -4,6 +4,7 @@
 // LAMMPS reports its loop time) and returns one JSON line.
 #include <array>
 #include <cstdint>
+#include <filesystem>
 #include <string>
 
 #include "flow/navier_stokes.hpp"
@@ -43,6 +44,12 @@ std::string run_membrane(const BenchOptions& options);
 // flow-cavity: lid-driven cubic cavity at Re = 100, cells_per_side^3 cells,
 // dt = 0.01, multigrid tolerance 1e-3; also times V-cycles of the multigrid alone.
 std::string run_flow_cavity(const BenchOptions& options);
+
+// flow-adaptive: the adaptive obstacle wake (cases/flow/obstacle-wake.toml, or
+// another flow case with [flow.adapt]) run for options.steps steps from its start;
+// reports the leaf cells at the end, the cells of the uniform finest grid, seconds
+// per step and the share of the time loop spent regridding.
+std::string run_flow_adaptive(const BenchOptions& options, const std::filesystem::path& case_file);
 
 /// Walls all round, the one at y = max moving along x (the cavity's lid).
 std::array<flow::FlowBoundary, 6> cavity_boundaries(double lid_velocity);

@@ -237,7 +237,8 @@ FlowRunSummary run_flow_case(const FlowCase& c, const FlowRunOptions& options,
   const std::int64_t first_step = steps;
   double cell_updates = 0.0;
   try {
-    while (ns.time() < end - eps) {
+    while (ns.time() < end - eps &&
+           (options.max_steps < 0 || steps - first_step < options.max_steps)) {
       // Every k steps counted from the start (a restart keeps the schedule).
       if (c.adapt.enabled && steps > 0 && steps % c.adapt.every_steps == 0) regrid();
       double dt = ns.stable_dt();
@@ -271,6 +272,8 @@ FlowRunSummary run_flow_case(const FlowCase& c, const FlowRunOptions& options,
   summary.steps = steps - first_step;
   summary.simulated_time = ns.time();
   summary.wall_seconds = progress.elapsed_seconds();
+  summary.regrid_seconds = regrid_seconds;
+  summary.cells = leaf_cells(forest);
   std::ostringstream done;
   done.precision(4);
   done << "done: t = " << ns.time() << " s, " << summary.steps << " steps in "

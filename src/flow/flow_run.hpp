@@ -4,6 +4,7 @@
 // checkpoints and a progress line with ETA. Restart continues bit for bit
 // from the checkpoint (one file per MPI rank).
 
+#include <cstdint>
 #include <filesystem>
 #include <iosfwd>
 
@@ -16,12 +17,15 @@ struct FlowRunOptions {
   bool restart = false;   ///< continue from the checkpoint in output_dir
   bool quiet = false;     ///< no progress line
   double stop_at = -1.0;  ///< stop (with a checkpoint) at this time instead of the end; < 0: off
+  std::int64_t max_steps = -1;  ///< stop (with a checkpoint) after this many steps; < 0: off
 };
 
 struct FlowRunSummary {
   std::int64_t steps = 0;       ///< steps done by this call
   double simulated_time = 0.0;  ///< time reached (s)
-  double wall_seconds = 0.0;
+  double wall_seconds = 0.0;    ///< of the time loop
+  double regrid_seconds = 0.0;  ///< of the time loop spent regridding ([flow.adapt])
+  double cells = 0.0;           ///< leaf cells at the end (all ranks)
 };
 
 FlowRunSummary run_flow_case(const FlowCase& c, const FlowRunOptions& options,
