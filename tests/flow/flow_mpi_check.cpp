@@ -275,12 +275,13 @@ int check_refined_navier_stokes() {
 
 /// Navier-Stokes on a forest that adapts during the run (a tracer blob in a
 /// sheared stream, the wavelet criterion on the tracer every 2 steps, as in
-/// test_navier_stokes_adaptive): 2 ranks against 1, blocks refined and
-/// coarsened on both and data moved between ranks by the repartitions.
+/// test_navier_stokes_adaptive, and a small solid cube whose blocks are kept
+/// finest): 2 ranks against 1, blocks refined and coarsened on both and data
+/// moved between ranks by the repartitions.
 int check_adaptive_navier_stokes() {
   struct Result {
     std::int64_t blocks = 0;
-    std::array<std::vector<double>, 5> values;
+    std::array<std::vector<double>, 6> values;  ///< u, p, tracer, force on the cube
   };
   auto run = [](MPI_Comm comm) {
     ForestSpec spec;
@@ -295,6 +296,9 @@ int check_adaptive_navier_stokes() {
     options.pressure.tolerance = 1e-10;
     options.viscous.tolerance = 1e-10;
     NavierStokes ns(forest, bcs, Fluid{1.0, 1e-3}, options);
+    ns.set_solid([](const sanguis::Vec3& x) {
+      return x.x > 0.625 && x.x < 0.75 && x.y > 0.625 && x.y < 0.75 && x.z > 0.625 && x.z < 0.75;
+    });
     ns.set_velocity([](const sanguis::Vec3& x) {
       return sanguis::Vec3{1.0 + 0.2 * std::sin(2 * testing::kPi * x.y), 0.5,
                            0.1 * std::sin(2 * testing::kPi * x.x)};
@@ -322,6 +326,8 @@ int check_adaptive_navier_stokes() {
       result.values[c] = gathered_by_block(forest, ns.velocity()[c]);
     result.values[3] = gathered_by_block(forest, ns.pressure());
     result.values[4] = gathered_by_block(forest, tracer);
+    const sanguis::Vec3 force = ns.solid_force();
+    result.values[5] = {force.x, force.y, force.z};
     return result;
   };
   const Result shared = run(MPI_COMM_WORLD);
@@ -336,10 +342,11 @@ int check_adaptive_navier_stokes() {
   const auto& session = MpiSession::ensure();
   if (session.rank() == 0) {
     std::printf(
-        "adaptive Navier-Stokes (tracer blob, regrid every 2 steps), 8 steps: %d ranks vs 1: "
-        "%lld / %lld blocks, max difference of u, p and the tracer %.3e (max |value| %.3f)\n",
+        "adaptive Navier-Stokes (tracer blob, solid cube, regrid every 2 steps), 8 steps: %d "
+        "ranks vs 1: %lld / %lld blocks, max difference of u, p, the tracer and the force on the "
+        "cube %.3e (max |value| %.3f; force x %.6f)\n",
         session.size(), static_cast<long long>(shared.blocks), static_cast<long long>(alone.blocks),
-        diff, scale);
+        diff, scale, alone.values[5][0]);
   }
   return same_grid && diff <= 1e-11 ? 0 : 1;
 }
