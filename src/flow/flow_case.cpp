@@ -203,10 +203,12 @@ FlowCase load_flow_case(const ConfigTable& cfg, const std::filesystem::path& sou
         bounds.fail(std::string(kFaceNames[f]) + ".velocity_m_s",
                     "a wall can only move tangentially");
       }
-      if (c.boundaries[f].kind == FlowBoundaryKind::Inflow && !c.boundaries[f].inflow) {
-        c.boundaries[f].inflow = parabolic_profile(c, static_cast<int>(f));
-      }
     }
+  }
+  // After the loop: the profile depends on the periodicity of all three directions.
+  for (int f = 0; f < 6; ++f) {
+    auto& bc = c.boundaries[static_cast<std::size_t>(f)];
+    if (bc.kind == FlowBoundaryKind::Inflow && !bc.inflow) bc.inflow = parabolic_profile(c, f);
   }
 
   c.initial_velocity = flow.get_vec3("initial_velocity_m_s", {});

@@ -89,6 +89,23 @@ TEST(FlowCase, ValidCaseResolvesGridBoundariesAndFluid) {
   EXPECT_DOUBLE_EQ(c.options.dt_max, 0.005);
 }
 
+TEST(FlowCase, ParabolicInflowVariesOnlyAcrossTheWalls) {
+  // Inflow at x_min, walls at y, periodic in z (read after x): the profile is
+  // 6 s (1 - s) U in y and uniform in z (a bug once made it parabolic in z too,
+  // because z's periodicity was read after the x faces' profiles were built).
+  std::string text = replaced(kChannel, "x_min = { type = \"periodic\" }",
+                              "x_min = { type = \"inflow\", velocity_m_s = [2.0, 0.0, 0.0], "
+                              "profile = \"parabolic\" }");
+  text = replaced(text, "x_max = { type = \"periodic\" }", "x_max = { type = \"outflow\" }");
+  const FlowCase c = parse(text);
+  const VelocityProfile& inflow = c.boundaries[face_index(0, 0)].inflow;
+  ASSERT_TRUE(inflow);
+  for (const double z : {0.01, 0.25, 0.49}) {
+    EXPECT_DOUBLE_EQ(inflow({0.0, 0.5, z}, 0.0).x, 2.0 * 1.5);  // centre of the channel
+    EXPECT_DOUBLE_EQ(inflow({0.0, 0.25, z}, 0.0).x, 2.0 * 6.0 * 0.25 * 0.75);
+  }
+}
+
 TEST(FlowCase, SolidBoxesAreReadAndRun) {
   const std::string text = kChannel + R"(
 [[flow.solid]]
