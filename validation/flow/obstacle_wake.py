@@ -216,6 +216,7 @@ def main():
     ax1.set_xlim(0, 16)
     ax1.set_ylim(0, 8)
     ax1.set_aspect("equal")
+    ax1.set_anchor("C")
     ax1.set_xlabel("x [m]")
     ax1.set_ylabel("y [m]")
     ax1.set_title(f"adaptive run at t = {END:g} s, mid-plane z = 4: speed and blocks "
