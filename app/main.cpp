@@ -236,7 +236,8 @@ int main(int argc, char** argv) {
   auto* particles_opt = bench_cmd->add_option(
       "--particles", bo.particles, "number of particles (dem-spheres 32000, dem-crosses 3000)");
   auto* steps_opt = bench_cmd->add_option(
-      "--steps", bo.steps, "time steps (dem-spheres 2000, dem-crosses 500, membrane 20, flow-cavity 20, "
+      "--steps", bo.steps,
+      "time steps (dem-spheres 2000, dem-crosses 500, membrane 20, flow-cavity 20, "
       "flow-adaptive 100)");
   bench_cmd->add_option("--threads", bo.threads, "threads")->capture_default_str();
   bench_cmd->add_option("--seed", bo.seed, "random seed")->capture_default_str();

@@ -274,6 +274,7 @@ FlowRunSummary run_flow_case(const FlowCase& c, const FlowRunOptions& options,
   summary.wall_seconds = progress.elapsed_seconds();
   summary.regrid_seconds = regrid_seconds;
   summary.cells = leaf_cells(forest);
+  summary.ranks = forest.ranks();
   std::ostringstream done;
   done.precision(4);
   done << "done: t = " << ns.time() << " s, " << summary.steps << " steps in "

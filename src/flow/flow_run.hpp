@@ -26,6 +26,7 @@ struct FlowRunSummary {
   double wall_seconds = 0.0;    ///< of the time loop
   double regrid_seconds = 0.0;  ///< of the time loop spent regridding ([flow.adapt])
   double cells = 0.0;           ///< leaf cells at the end (all ranks)
+  int ranks = 1;                ///< MPI ranks sharing the forest
 };
 
 FlowRunSummary run_flow_case(const FlowCase& c, const FlowRunOptions& options,

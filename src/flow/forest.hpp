@@ -77,10 +77,10 @@ struct Neighbour {
   std::array<BlockRef, 8> children{};
 };
 
-/// Per-block request to `Forest::adapt`.
 /// The deepest level p8est blocks may reach (P8EST_QMAXLEVEL).
 inline constexpr int kForestMaxLevel = 18;
 
+/// Per-block request to `Forest::adapt`.
 enum class AdaptFlag : std::int8_t {
   Coarsen = -1,  ///< merge with its 7 siblings (only when all 8 ask and sit on one rank)
   Keep = 0,

@@ -321,20 +321,13 @@ void NavierStokes::set_solid(const std::function<bool(const Vec3&)>& solid) {
   // Closed faces (beta = 0) at a coarse-fine face have no matched flux in the
   // multigrid, and the no-slip closure there is not written for two levels:
   // blocks near solids must be at the finest level.
+  std::function<bool(const Vec3&)> previous = std::move(solid_function_);
   solid_function_ = solid;
-  if (composite_) {
-    double misplaced = 0.0;
-    for (int blk = 0; blk < forest_.local_blocks(); ++blk) {
-      const Block& block = forest_.block(blk);
-      if (block.level < forest_.max_level() && near_solid(block.lower, block.length, block.level))
-        misplaced += 1.0;
-    }
-    if (forest_.sum(misplaced) > 0.0) {
-      solid_function_ = nullptr;
-      throw std::invalid_argument(
-          "navier-stokes: solid cells within 2 cells of a block coarser than the finest level; "
-          "refine the blocks near solids to the finest level first (regrid with max_level does)");
-    }
+  if (composite_ && blocks_near_solids_below(forest_.max_level()) > 0) {
+    solid_function_ = std::move(previous);  // the solver stays as it was
+    throw std::invalid_argument(
+        "navier-stokes: solid cells within 2 cells of a block coarser than the finest level; "
+        "refine the blocks near solids to the finest level first (regrid with max_level does)");
   }
   sample_solid();
   clear_solid_cells(u_);
@@ -398,6 +391,15 @@ bool NavierStokes::near_solid(const Vec3& lower, double length, int level) const
   return false;
 }
 
+std::int64_t NavierStokes::blocks_near_solids_below(int level) const {
+  double count = 0.0;
+  for (int blk = 0; blk < forest_.local_blocks(); ++blk) {
+    const Block& block = forest_.block(blk);
+    if (block.level < level && near_solid(block.lower, block.length, block.level)) count += 1.0;
+  }
+  return static_cast<std::int64_t>(forest_.sum(count));
+}
+
 bool NavierStokes::keep_solids_finest(std::vector<AdaptFlag>& flags, int max_level) const {
   std::vector<char> near(flags.size(), 0);
   forest_.for_each_block([&](int blk) {
@@ -411,7 +413,7 @@ bool NavierStokes::keep_solids_finest(std::vector<AdaptFlag>& flags, int max_lev
     if (near[static_cast<std::size_t>(blk)] != 0) {
       flag = block.level < max_level ? AdaptFlag::Refine : AdaptFlag::Keep;
       refine += flag == AdaptFlag::Refine ? 1.0 : 0.0;
-    } else if (flag == AdaptFlag::Coarsen) {
+    } else if (flag == AdaptFlag::Coarsen && block.level > 0) {  // tree roots never merge
       // The parent the family would merge into: its cells are twice as large,
       // so it reaches twice as far.
       Vec3 parent = block.lower;
@@ -1066,10 +1068,13 @@ RegridReport NavierStokes::regrid(Forest& forest, std::span<const AdaptFlag> fla
   if (&forest != &forest_) {
     throw std::invalid_argument("navier-stokes: regrid needs the forest the solver was built on");
   }
-  if (has_solids_ && max_level >= kForestMaxLevel) {
+  if (flags.size() != static_cast<std::size_t>(forest.local_blocks())) {
+    throw std::invalid_argument("navier-stokes: regrid needs one flag per local block");
+  }
+  if (has_solids_ && (max_level >= kForestMaxLevel || max_level < forest.max_level())) {
     throw std::invalid_argument(
-        "navier-stokes: with solid cells, regrid needs max_level: the blocks near solids are "
-        "kept at that level");
+        "navier-stokes: with solid cells, regrid needs max_level (below 18 and not below the "
+        "forest's finest level): the blocks near solids are kept at that level");
   }
   if (variable_viscosity_) {
     throw std::invalid_argument(
@@ -1090,6 +1095,9 @@ RegridReport NavierStokes::regrid(Forest& forest, std::span<const AdaptFlag> fla
     std::vector<AdaptFlag> more(static_cast<std::size_t>(forest.local_blocks()), AdaptFlag::Keep);
     if (!keep_solids_finest(more, max_level)) break;
     report.changed = forest.adapt(more, cells, faces, max_level) || report.changed;
+  }
+  if (has_solids_ && blocks_near_solids_below(max_level) > 0) {
+    throw std::logic_error("navier-stokes: regrid left blocks near solids below max_level");
   }
   report.blocks_after = forest.global_blocks();
   if (!report.changed) return report;

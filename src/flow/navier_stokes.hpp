@@ -118,15 +118,21 @@ class NavierStokes {
   /// centres. Solid cells hold no flow; their faces with fluid cells are
   /// no-slip walls (linear closure) closed to the flow. Call before set_velocity.
   /// The mask is sampled again after each regrid, so solid(x) must stay
-  /// valid; it should be resolved by the forest's initial grid (ForestSpec
-  /// level): coarser blocks test it at that resolution. On a forest with
-  /// several levels the blocks near solids (see the header) must already be
-  /// at the finest level (std::invalid_argument otherwise).
+  /// valid, and it is called from several threads at once: it must be
+  /// thread-safe and must not throw. Solids should be aligned with the
+  /// forest's initial grid (ForestSpec level): the test that keeps blocks
+  /// near solids at the finest level samples solid(x) at the cell centres of
+  /// the block and of its 2-cell ghost band (at the initial grid's resolution
+  /// in coarser blocks), so a solid face between finer cells' centres in the
+  /// outer half of that band can be missed. On a forest with several levels
+  /// the blocks near solids must already be at the finest level
+  /// (std::invalid_argument otherwise; the solver is left unchanged).
   void set_solid(const std::function<bool(const Vec3&)>& solid);
   [[nodiscard]] const BlockField& solid() const { return solid_; }
   /// Force of the fluid on the solid cells (N): on every face between a fluid
-  /// and a solid cell, the fluid cell's pressure along the normal and the wall
-  /// shear of the no-slip closure, mu u_t / (h/2), as the viscous step applies it.
+  /// and a solid cell, the fluid cell's pressure along the normal and the
+  /// tangential wall shear of the no-slip closure, mu u_t / (h/2) with the
+  /// fluid cell's velocity at the end of the step.
   [[nodiscard]] Vec3 solid_force() const;
 
   /// Largest stable step: min(dt_max, cfl h / max|uf|).
@@ -148,8 +154,7 @@ class NavierStokes {
   /// and never coarsened (max_level must then be given), and the mask is
   /// sampled again. Not with variable viscosity (refused).
   RegridReport regrid(Forest& forest, std::span<const AdaptFlag> flags,
-                      std::span<BlockField* const> scalars = {},
-                      int max_level = kForestMaxLevel);
+                      std::span<BlockField* const> scalars = {}, int max_level = kForestMaxLevel);
 
   [[nodiscard]] double time() const { return time_; }
   [[nodiscard]] const Forest& forest() const { return forest_; }
@@ -210,6 +215,8 @@ class NavierStokes {
   /// Overrides `flags` so that blocks near solids go to max_level and no
   /// family coarsens into a block near solids; true if any rank refines.
   bool keep_solids_finest(std::vector<AdaptFlag>& flags, int max_level) const;
+  /// Blocks near solids (all ranks) below `level`.
+  [[nodiscard]] std::int64_t blocks_near_solids_below(int level) const;
   /// Scratch, masks and interface layers sized to the current block list.
   void allocate_work_fields();
   /// Both copies of a face shared by two blocks of one level take their mean

@@ -257,7 +257,9 @@ TEST(FlowAdaptiveNavierStokes, TwoThreadsGiveTheOneThreadAnswerBitForBit) {
 
 /// The slabs y < 0.25 and y > 1.25 of the periodic box 0.5 x 1.5 x 0.5 of the
 /// uniform solid-mask test (test_navier_stokes.cpp): a channel of height 1.
-bool channel_slabs(const Vec3& x) { return x.y < 0.25 || x.y > 1.25; }
+bool channel_slabs(const Vec3& x) {
+  return x.y < 0.25 || x.y > 1.25;
+}
 
 ForestSpec slab_box(int level) {
   ForestSpec spec;
@@ -351,8 +353,8 @@ TEST(FlowAdaptiveNavierStokes, SolidWallsOnAForestWithTwoLevels) {
 TEST(FlowAdaptiveNavierStokes, SolidsBesideCoarserBlocksAreRefused) {
   // A forest already refined away from the slabs: their blocks are coarse.
   Forest forest(slab_box(0));
-  forest.adapt([](const Block& b) { return b.lower.y == 0.5 ? AdaptFlag::Refine : AdaptFlag::Keep; },
-               {});
+  forest.adapt(
+      [](const Block& b) { return b.lower.y == 0.5 ? AdaptFlag::Refine : AdaptFlag::Keep; }, {});
   NavierStokes ns(forest, all_periodic(), Fluid{1.0, 1.0});
   EXPECT_THROW(ns.set_solid(channel_slabs), std::invalid_argument);
 }
