@@ -376,15 +376,15 @@ bool NavierStokes::near_solid(const Vec3& lower, double length, int level) const
   const int sub = 1 << std::max(0, spec.level - level);
   const double h = length / (b * sub);
   const int lo = -kGhost * sub, hi = (b + kGhost) * sub;
+  const Vec3 extent = forest_.extent();
   for (int k = lo; k < hi; ++k)
     for (int j = lo; j < hi; ++j)
       for (int i = lo; i < hi; ++i) {
         Vec3 x{lower.x + (i + 0.5) * h, lower.y + (j + 0.5) * h, lower.z + (k + 0.5) * h};
         for (int d = 0; d < 3; ++d) {
           if (!spec.periodic[D(d)]) continue;
-          const double extent = spec.trees[D(d)] * spec.tree_length;
-          if (x[d] < spec.origin[d]) x[d] += extent;
-          if (x[d] >= spec.origin[d] + extent) x[d] -= extent;
+          if (x[d] < spec.origin[d]) x[d] += extent[d];
+          if (x[d] >= spec.origin[d] + extent[d]) x[d] -= extent[d];
         }
         if (solid_function_(x)) return true;
       }
@@ -1090,13 +1090,15 @@ RegridReport NavierStokes::regrid(Forest& forest, std::span<const AdaptFlag> fla
   if (has_solids_) keep_solids_finest(wanted, max_level);
   report.changed = forest.adapt(wanted, cells, faces, max_level);
   // Blocks near solids that are not yet at max_level (a first regrid, or the
-  // 2:1 balance) are refined on until every one is.
-  for (int pass = 0; has_solids_ && pass <= max_level; ++pass) {
+  // 2:1 balance) are refined on until every one is. An unchanged forest is
+  // settled: its near blocks below max_level were all flagged Refine above.
+  bool settled = !has_solids_ || !report.changed;
+  for (int pass = 0; !settled && pass <= max_level; ++pass) {
     std::vector<AdaptFlag> more(static_cast<std::size_t>(forest.local_blocks()), AdaptFlag::Keep);
-    if (!keep_solids_finest(more, max_level)) break;
-    report.changed = forest.adapt(more, cells, faces, max_level) || report.changed;
+    settled = !keep_solids_finest(more, max_level);
+    if (!settled) forest.adapt(more, cells, faces, max_level);
   }
-  if (has_solids_ && blocks_near_solids_below(max_level) > 0) {
+  if (!settled) {
     throw std::logic_error("navier-stokes: regrid left blocks near solids below max_level");
   }
   report.blocks_after = forest.global_blocks();

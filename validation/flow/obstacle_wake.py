@@ -118,22 +118,22 @@ def drag_stats(rows):
     return float(f[np.argmin(np.abs(t - END))]), float(f[late].mean())
 
 
+def cell_boxes(arrays):
+    """Lower and upper corners of every cell of a frame."""
+    corners = arrays["Points"][arrays["connectivity"].reshape(-1, 8)]
+    return corners.min(axis=1), corners.max(axis=1)
+
+
 def slice_cells(arrays, z):
     """The cells the plane at height z cuts: lower and upper corners, level, speed, block."""
-    points = arrays["Points"]
-    cells = arrays["connectivity"].reshape(-1, 8)
-    lo = points[cells].min(axis=1)
-    hi = points[cells].max(axis=1)
+    lo, hi = cell_boxes(arrays)
     cut = (lo[:, 2] <= z) & (hi[:, 2] > z)
     speed = np.linalg.norm(arrays["velocity"], axis=1)
     return lo[cut], hi[cut], arrays["level"][cut], speed[cut], arrays["block"][cut]
 
 
 def wake_finest_fraction(arrays):
-    points = arrays["Points"]
-    cells = arrays["connectivity"].reshape(-1, 8)
-    lo = points[cells].min(axis=1)
-    hi = points[cells].max(axis=1)
+    lo, hi = cell_boxes(arrays)
     centre = 0.5 * (lo + hi)
     volume = np.prod(hi - lo, axis=1)
     wake = ((centre[:, 0] > 4.5) & (centre[:, 0] < 8.0) & (np.abs(centre[:, 1] - 4.0) < 0.5)
