@@ -1,6 +1,7 @@
 #include "flow/adapt_criterion.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 
@@ -8,11 +9,27 @@ namespace sanguis::flow {
 
 namespace {
 
-/// Estimate (4.11) of one block whose ghosts hold its neighbours' cells.
-double block_estimate(const Block& block, const BlockField& field, int blk) {
-  const int b = field.cells();
-  const BlockLayout& L = field.layout();
-  const double* u = field.block(blk);
+/// Faces of a cube that are domain faces (2d + side): slopes there are one-sided.
+using DomainFaces = std::array<bool, 6>;
+
+DomainFaces domain_faces(const Block& block) {
+  DomainFaces wall{};
+  for (int d = 0; d < 3; ++d)
+    for (int side = 0; side < 2; ++side) {
+      std::array<int, 3> o{0, 0, 0};
+      o[static_cast<std::size_t>(d)] = side == 0 ? -1 : 1;
+      wall[static_cast<std::size_t>(2 * d + side)] =
+          block.neighbours[static_cast<std::size_t>(neighbour_slot(o[0], o[1], o[2]))].link ==
+          Link::Boundary;
+    }
+  return wall;
+}
+
+/// Estimate (4.11) of a cube of b^3 cells whose values `u` (offsets of
+/// `layout`) include 2 face-ghost layers beyond every face that is not a
+/// domain face: the largest |u - P(R(u))| over its cells.
+double cube_estimate(const double* u, const BlockLayout& L, const DomainFaces& wall) {
+  const int b = L.cells;
   // R: the mean of the 8 cells of coarse cell (I,J,K); I = -1 or b/2 reads
   // the two ghost layers beside a face.
   auto coarse = [&](int ci, int cj, int ck) {
@@ -22,15 +39,6 @@ double block_estimate(const Block& block, const BlockField& field, int blk) {
         for (int di = 0; di < 2; ++di) sum += u[L.index(2 * ci + di, 2 * cj + dj, 2 * ck + dk)];
     return sum / 8.0;
   };
-  std::array<bool, 6> wall{};
-  for (int d = 0; d < 3; ++d)
-    for (int side = 0; side < 2; ++side) {
-      std::array<int, 3> o{0, 0, 0};
-      o[static_cast<std::size_t>(d)] = side == 0 ? -1 : 1;
-      wall[static_cast<std::size_t>(2 * d + side)] =
-          block.neighbours[static_cast<std::size_t>(neighbour_slot(o[0], o[1], o[2]))].link ==
-          Link::Boundary;
-    }
   const int n = b / 2;
   double worst = 0.0;
   for (int k = 0; k < b; ++k)
@@ -61,6 +69,67 @@ double block_estimate(const Block& block, const BlockField& field, int blk) {
   return worst;
 }
 
+/// Whether local blocks first..first+7 are the 8 children of one parent, in
+/// p4est's child order (x fastest): the families the forest may coarsen.
+bool is_local_family(const Forest& forest, int first) {
+  if (first + 8 > forest.local_blocks()) return false;
+  const Block& b0 = forest.block(first);
+  if (b0.level == 0 || b0.coord[0] % 2 != 0 || b0.coord[1] % 2 != 0 || b0.coord[2] % 2 != 0) {
+    return false;
+  }
+  for (int c = 1; c < 8; ++c) {
+    const Block& child = forest.block(first + c);
+    if (child.level != b0.level || child.coord[0] != b0.coord[0] + (c & 1) ||
+        child.coord[1] != b0.coord[1] + ((c >> 1) & 1) ||
+        child.coord[2] != b0.coord[2] + ((c >> 2) & 1)) {
+      return false;
+    }
+  }
+  return true;
+}
+
+/// The estimate (4.11) the parent of the family at `first` would have after
+/// coarsening: the family's cells and 4 face-ghost layers of `deep` (the
+/// field with 4 ghost layers, exchanged) averaged onto the parent's cells and
+/// 2 ghost layers, then estimated as a block. Coarsening only where this is
+/// small keeps the parent from being refined again at the next regrid: a
+/// smooth field's estimate grows about 8x per coarser level, so the children's
+/// own estimates cannot tell.
+double parent_estimate(const Forest& forest, const BlockField& deep, int first,
+                       std::vector<double>& scratch) {
+  const int b = deep.cells();
+  const BlockLayout& F = deep.layout();
+  const BlockLayout P{b, 2};
+  scratch.assign(static_cast<std::size_t>(P.size()), 0.0);
+  // The fine value at family index (x, y, z), each in [-4, 2b + 4) with at
+  // most one outside [0, 2b): a cell of child (x >= b, y >= b, z >= b), or of
+  // its ghost layers beyond the family's face.
+  auto fine = [&](int x, int y, int z) {
+    const int cx = x >= b, cy = y >= b, cz = z >= b;
+    return deep.block(first + cx + 2 * cy + 4 * cz)[F.index(x - cx * b, y - cy * b, z - cz * b)];
+  };
+  for (int k = -2; k < b + 2; ++k)
+    for (int j = -2; j < b + 2; ++j)
+      for (int i = -2; i < b + 2; ++i) {
+        const int outside = (i < 0 || i >= b) + (j < 0 || j >= b) + (k < 0 || k >= b);
+        if (outside > 1) continue;  // edges and corners: not read by the estimate
+        double sum = 0.0;
+        for (int dk = 0; dk < 2; ++dk)
+          for (int dj = 0; dj < 2; ++dj)
+            for (int di = 0; di < 2; ++di) sum += fine(2 * i + di, 2 * j + dj, 2 * k + dk);
+        scratch[static_cast<std::size_t>(P.index(i, j, k))] = sum / 8.0;
+      }
+  // A parent face is a domain face where the children beside it have one.
+  DomainFaces wall{};
+  for (int d = 0; d < 3; ++d)
+    for (int side = 0; side < 2; ++side) {
+      const int child = side << d;
+      wall[static_cast<std::size_t>(2 * d + side)] =
+          domain_faces(forest.block(first + child))[static_cast<std::size_t>(2 * d + side)];
+    }
+  return cube_estimate(scratch.data(), P, wall);
+}
+
 }  // namespace
 
 std::vector<double> wavelet_estimate(const Forest& forest, BlockField& field) {
@@ -70,7 +139,8 @@ std::vector<double> wavelet_estimate(const Forest& forest, BlockField& field) {
   forest.exchange(field, 2, true);  // face ghosts: the slopes are taken along one direction
   std::vector<double> estimate(static_cast<std::size_t>(forest.local_blocks()));
   forest.for_each_block([&](int blk) {
-    estimate[static_cast<std::size_t>(blk)] = block_estimate(forest.block(blk), field, blk);
+    estimate[static_cast<std::size_t>(blk)] =
+        cube_estimate(field.block(blk), field.layout(), domain_faces(forest.block(blk)));
   });
   return estimate;
 }
@@ -83,12 +153,48 @@ std::vector<AdaptFlag> wavelet_flags(const Forest& forest, std::span<BlockField*
   }
   const auto blocks = static_cast<std::size_t>(forest.local_blocks());
   std::vector<bool> refine(blocks, false), coarsen(blocks, true);
+  std::vector<BlockField> deep;  // each field with 4 ghost layers, for the parents' estimates
+  deep.reserve(fields.size());
   for (std::size_t f = 0; f < fields.size(); ++f) {
-    const std::vector<double> e = wavelet_estimate(forest, *fields[f]);
+    const int b = fields[f]->cells();
+    if (b < 4 || fields[f]->layout().ghost < 2) {
+      throw std::invalid_argument("wavelet flags: needs blocks of >= 4 cells and 2 ghost layers");
+    }
+    BlockField& copy = deep.emplace_back(forest.local_blocks(), b, 4);
+    forest.for_each_block([&](int blk) {
+      for (int k = 0; k < b; ++k)
+        for (int j = 0; j < b; ++j)
+          for (int i = 0; i < b; ++i) copy(blk, i, j, k) = (*fields[f])(blk, i, j, k);
+    });
+    forest.exchange(copy, 4, true);  // the same first 2 layers as a width-2 exchange
     const double zeta = criterion.thresholds[f];
+    std::vector<double> e(blocks);
+    forest.for_each_block([&](int blk) {
+      e[static_cast<std::size_t>(blk)] =
+          cube_estimate(copy.block(blk), copy.layout(), domain_faces(forest.block(blk)));
+    });
     for (std::size_t blk = 0; blk < blocks; ++blk) {
       refine[blk] = refine[blk] || e[blk] > zeta;
       coarsen[blk] = coarsen[blk] && e[blk] < criterion.coarsen_fraction * zeta;
+    }
+  }
+  // A family whose 8 blocks would all coarsen does so only if its parent's
+  // estimate stays below the coarsening threshold too (no flip-flop).
+  std::vector<double> scratch;
+  for (int first = 0; first + 8 <= forest.local_blocks(); ++first) {
+    if (!is_local_family(forest, first)) continue;
+    const auto f0 = static_cast<std::size_t>(first);
+    first += 7;
+    bool all = true;
+    for (std::size_t c = 0; c < 8; ++c) all = all && coarsen[f0 + c];
+    if (!all) continue;  // the forest will not merge it anyway
+    bool parent_resolved = true;
+    for (std::size_t f = 0; f < fields.size() && parent_resolved; ++f) {
+      parent_resolved = parent_estimate(forest, deep[f], static_cast<int>(f0), scratch) <
+                        criterion.coarsen_fraction * criterion.thresholds[f];
+    }
+    if (!parent_resolved) {
+      for (std::size_t c = 0; c < 8; ++c) coarsen[f0 + c] = false;
     }
   }
   std::vector<AdaptFlag> flags(blocks, AdaptFlag::Keep);

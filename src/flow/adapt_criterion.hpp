@@ -12,11 +12,14 @@
 // exceeds its threshold zeta and coarsened where every field stays below
 // 2 zeta / 3 (the hysteresis of adapt_wavelet), within [min_level,
 // max_level]; cells tagged in the "forced finest" field keep their block at
-// max_level. The hysteresis does not stop every flip-flop: a smooth field's
+// max_level. The hysteresis alone does not stop flip-flop: a smooth field's
 // estimate grows about 8x per coarser level (its quadratic part has none), so
-// a block whose own estimate lies between zeta/8 and 2 zeta/3 is coarsened
-// and its parent refined again at the next regrid (seen on the steady
-// obstacle wake: 10 % of the cells come and go every regrid).
+// a block whose own estimate lies between zeta/8 and 2 zeta/3 would be
+// coarsened and its parent refined again at the next regrid (10 % of the
+// cells of the steady obstacle wake came and went every regrid). A family of
+// 8 blocks therefore coarsens only if the estimate its parent would have,
+// computed from the family's cells and 4 ghost layers averaged onto the
+// parent, is below 2 zeta / 3 as well.
 
 #include <span>
 #include <vector>
@@ -41,7 +44,9 @@ std::vector<double> wavelet_estimate(const Forest& forest, BlockField& field);
 
 /// Refine/keep/coarsen flags for Forest::adapt from the estimates of
 /// `fields` (one threshold each) and an optional tag field: a block with a
-/// tag cell > 0 is refined up to max_level and never coarsened.
+/// tag cell > 0 is refined up to max_level and never coarsened. A local
+/// family asks to coarsen only if its parent's estimate is below
+/// coarsen_fraction * zeta too (families split across ranks never merge).
 std::vector<AdaptFlag> wavelet_flags(const Forest& forest, std::span<BlockField* const> fields,
                                      const WaveletCriterion& criterion,
                                      const BlockField* finest_tag = nullptr);

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <vector>
 
 #include "adapt_problems.hpp"
 #include "flow/adapt_criterion.hpp"
@@ -118,6 +120,43 @@ TEST(FlowAdaptCriterion, RepeatedAdaptationResolvesTheFrontAtTheFinestLevel) {
     // Far from the front (tanh flat to 1e-5), only the 2:1 grading keeps blocks fine.
     if (block.lower.x > 0.8 || block.lower.x + block.length < 0.25) {
       EXPECT_LE(block.level, 2);
+    }
+  }
+}
+
+double bump(const Vec3& x) {
+  const double r2 =
+      (x.x - 0.45) * (x.x - 0.45) + (x.y - 0.5) * (x.y - 0.5) + (x.z - 0.55) * (x.z - 0.55);
+  return std::exp(-r2 / 0.02);
+}
+
+TEST(FlowAdaptCriterion, ASmoothFieldSettlesInsteadOfFlipFlopping) {
+  // A smooth field's estimate grows about 8x per coarser level, so blocks
+  // whose own estimate lies between zeta/8 and 2 zeta/3 would coarsen and be
+  // refined again at every pass. With the parent's estimate checked, the grid
+  // reaches a fixed point, and every block is either resolved (estimate
+  // <= zeta) or at the finest level.
+  Forest forest(spec_at(1));
+  BlockField u(forest.local_blocks(), 8);
+  fill_cells(forest, u, bump);
+  const WaveletCriterion criterion{{2e-3}, 1, 3};
+  std::vector<std::int64_t> counts;
+  bool settled = false;
+  for (int pass = 0; pass < 8 && !settled; ++pass) {
+    BlockField* fields[] = {&u};
+    settled = !forest.adapt(wavelet_flags(forest, fields, criterion), {});
+    u = BlockField(forest.local_blocks(), 8);
+    fill_cells(forest, u, bump);
+    counts.push_back(forest.global_blocks());
+  }
+  EXPECT_TRUE(settled) << "blocks per pass: " << ::testing::PrintToString(counts);
+  EXPECT_EQ(forest.max_level(), 3);
+  EXPECT_GT(counts.back(), 8);    // refined where the bump is curved
+  EXPECT_LT(counts.back(), 512);  // and coarser than the uniform finest grid elsewhere
+  const auto e = wavelet_estimate(forest, u);
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    if (forest.block(blk).level < 3) {
+      EXPECT_LE(e[static_cast<std::size_t>(blk)], 2e-3);
     }
   }
 }
