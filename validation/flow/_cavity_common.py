@@ -1,5 +1,5 @@
-"""Shared by the cavity validation scripts: reading our .vtu frames, centre-line
-profiles, running variants of a case file."""
+"""Shared by the flow validation scripts: reading our .vtu frames, cell boxes,
+centre-line profiles, running variants of a case file."""
 import base64
 import re
 import subprocess
@@ -21,6 +21,12 @@ def read_vtu(path):
     cells = arrays["connectivity"].reshape(-1, 8)
     centres = points[cells].mean(axis=1)
     return centres, arrays
+
+
+def cell_boxes(arrays):
+    """Lower and upper corners of every cell of a frame."""
+    corners = arrays["Points"][arrays["connectivity"].reshape(-1, 8)]
+    return corners.min(axis=1), corners.max(axis=1)
 
 
 def centre_lines(centres, velocity, two_d):

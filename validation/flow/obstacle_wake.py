@@ -39,7 +39,7 @@ import matplotlib
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _cavity_common import read_vtu  # noqa: E402
+from _cavity_common import cell_boxes, read_vtu  # noqa: E402
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -116,12 +116,6 @@ def drag_stats(rows):
     f = np.array([r["solid_force_x_N"] for r in rows])
     late = (t >= 0.75 * END - 1e-9) & (t <= END + 1e-9)
     return float(f[np.argmin(np.abs(t - END))]), float(f[late].mean())
-
-
-def cell_boxes(arrays):
-    """Lower and upper corners of every cell of a frame."""
-    corners = arrays["Points"][arrays["connectivity"].reshape(-1, 8)]
-    return corners.min(axis=1), corners.max(axis=1)
 
 
 def slice_cells(arrays, z):

@@ -1,0 +1,211 @@
+#!/usr/bin/python3
+"""How many cells can the wavelet criterion save on a given flow? An a-priori bound.
+
+The adaptive grid that the criterion (thesis eq. 4.11, src/flow/adapt_criterion.hpp)
+settles on for a steady field is bounded by that field on the uniform finest
+grid. Whatever the path, a settled grid has
+no block coarser than the finest whose estimate exceeds zeta (it would be
+refined), so the fewest cells it can have are those of the grid that takes,
+top-down, every block allowed as a leaf. This script computes that grid from
+the block estimates of the field restricted to each level (max over the
+block's cells of |u - P(R(u))|, central slopes, one-sided at walls, periodic
+where the flow is). The 2:1 balance between blocks is ignored (it only adds
+cells) and a block's ghosts come from the same level (on a real composite grid
+they come from its neighbours' levels): the count is an estimate of the lower
+bound, and "uniform cells / adaptive cells" of the best ratio the criterion
+can give at each zeta.
+
+Fields (blocks of 8^3 cells, as in the flow cases):
+  * the shielded Gaussian vortex of validation/flow/vortex_adaptive.py (exact
+    field, 128^2 x 32 cells, periodic): a check of the estimate against the
+    cells that the measured adaptive runs of that validation end with;
+  * the Taylor-Green vortex u = sin x cos y cos z, v = -cos x sin y cos z,
+    w = 0 on the periodic (2 pi)^3 box at 64^3 (exact field);
+  * the steady Re = 1000 cubic lid-driven cavity at 64^3: the last frame of
+    the uniform run of validation/flow/cavity_re1000.py (run it first:
+    `validation/flow/cavity_re1000.py --sizes 64`, about 30 min on one core).
+
+Writes validation/flow/results/adaptive_potential.json and
+docs/validation/figures/flow_adaptive_potential.png.
+
+Usage: /usr/bin/python3 validation/flow/adaptive_potential.py
+"""
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _cavity_common import last_frame, read_vtu  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[2]
+RESULTS = ROOT / "validation" / "flow" / "results"
+FIGURE = ROOT / "docs" / "validation" / "figures" / "flow_adaptive_potential.png"
+B = 8  # cells per block edge
+FRACTIONS = [float(f) for f in np.geomspace(1e-3, 1e-1, 13)]  # zeta / reference speed
+
+
+def restrict(u):
+    """8-cell means onto a grid twice as coarse (R of eq. 4.11)."""
+    m = [s // 2 for s in u.shape]
+    return u.reshape(m[0], 2, m[1], 2, m[2], 2).mean(axis=(1, 3, 5))
+
+
+def cell_estimate(u, periodic):
+    """|u - P(R(u))| per cell: P the linear prolongation with central slopes,
+    one-sided at non-periodic domain faces."""
+    coarse = restrict(u)
+    up = np.repeat(np.repeat(np.repeat(coarse, 2, 0), 2, 1), 2, 2)
+    for d in range(3):
+        c = np.moveaxis(coarse, d, 0)
+        if periodic[d]:
+            slope = 0.5 * (np.roll(c, -1, 0) - np.roll(c, 1, 0))
+        else:
+            slope = np.empty_like(c)
+            slope[1:-1] = 0.5 * (c[2:] - c[:-2])
+            slope[0], slope[-1] = c[1] - c[0], c[-1] - c[-2]
+        slope = np.repeat(np.repeat(np.repeat(np.moveaxis(slope, 0, d), 2, 0), 2, 1), 2, 2)
+        sign = np.where(np.arange(u.shape[d]) % 2 == 1, 0.25, -0.25)
+        shape = [1, 1, 1]
+        shape[d] = u.shape[d]
+        up += slope * sign.reshape(shape)
+    return np.abs(u - up)
+
+
+def block_max(e):
+    m = [s // B for s in e.shape]
+    return e.reshape(m[0], B, m[1], B, m[2], B).max(axis=(1, 3, 5))
+
+
+def level_estimates(components, periodic):
+    """Block estimates (max over components) at the finest grid and every
+    coarser one that still holds whole blocks of B^3 cells."""
+    levels = []
+    fields = list(components)
+    while min(fields[0].shape) >= 2 * B:
+        levels.append(np.max([block_max(cell_estimate(f, periodic)) for f in fields], axis=0))
+        fields = [restrict(f) for f in fields]
+    return levels  # levels[0]: finest blocks
+
+
+def fewest_cells(levels, zeta):
+    """The fewest cells of any grid the criterion can settle on: every block
+    coarser than the finest must have an estimate <= zeta (else it is
+    refined), so taking, top-down, every block whose estimate allows it as a
+    leaf gives the minimum. Returns the cells and the leaf blocks per level
+    (finest first)."""
+    top = len(levels) - 1
+    counts = [0] * len(levels)
+    # open[k]: blocks of level k not covered by a coarser leaf.
+    open_blocks = np.ones_like(levels[top], dtype=bool)
+    for k in range(top, -1, -1):
+        leaf = open_blocks if k == 0 else open_blocks & (levels[k] <= zeta)
+        counts[k] = int(leaf.sum())
+        if k > 0:
+            rest = open_blocks & ~leaf
+            open_blocks = np.repeat(np.repeat(np.repeat(rest, 2, 0), 2, 1), 2, 2)
+    return sum(counts) * B ** 3, counts
+
+
+def vortex_field():
+    """Exact velocity of vortex_adaptive_main.cpp at t = 0 on 128 x 128 x 32 cells:
+    u = U - r_y g, v = r_x g, g = A / sigma^2 exp(-r^2 / 2 sigma^2), A = swirl sigma e^(1/2)."""
+    n, nz = 128, 32
+    sigma, swirl = 0.05, 0.5
+    x = (np.arange(n) + 0.5) / n
+    X, Y = np.meshgrid(x, x, indexing="ij")
+    rx, ry = X - 0.5, Y - 0.5
+    g = swirl * sigma * np.exp(0.5) / sigma ** 2 * np.exp(-(rx * rx + ry * ry) / (2 * sigma ** 2))
+    u = np.repeat((1.0 - ry * g)[:, :, None], nz, axis=2)
+    v = np.repeat((rx * g)[:, :, None], nz, axis=2)
+    return [u, v, np.zeros_like(u)], (True, True, True), 1.0 / n, 0.5
+
+
+def taylor_green_field():
+    n = 64
+    x = (np.arange(n) + 0.5) * 2 * np.pi / n
+    X, Y, Z = np.meshgrid(x, x, x, indexing="ij")
+    u = np.sin(X) * np.cos(Y) * np.cos(Z)
+    v = -np.cos(X) * np.sin(Y) * np.cos(Z)
+    return [u, v, np.zeros_like(u)], (True, True, True), 2 * np.pi / n, 1.0
+
+
+def cavity_field():
+    runs = RESULTS / "runs"
+    name = "cavity-re1000-64"
+    if not (runs / name / "flow").exists():
+        return None
+    centres, arrays = read_vtu(last_frame(runs, name))
+    n = 64
+    index = np.floor(centres * n).astype(int)
+    fields = []
+    for d in range(3):
+        f = np.zeros((n, n, n))
+        f[index[:, 0], index[:, 1], index[:, 2]] = arrays["velocity"][:, d]
+        fields.append(f)
+    return fields, (False, False, False), 1.0 / n, 1.0
+
+
+def main():
+    cases = {"vortex (128^2 x 32)": vortex_field(), "Taylor-Green (64^3)": taylor_green_field()}
+    cavity = cavity_field()
+    if cavity is None:
+        print("cavity: no uniform 64^3 run on disk (validation/flow/cavity_re1000.py --sizes 64); skipped")
+    else:
+        cases["cavity Re 1000 (64^3)"] = cavity
+    results = {}
+    for name, (components, periodic, h, speed) in cases.items():
+        levels = level_estimates(components, periodic)
+        uniform = components[0].size
+        rows = []
+        for fraction in FRACTIONS:
+            zeta = fraction * speed
+            cells, counts = fewest_cells(levels, zeta)
+            rows.append({"zeta_over_speed": fraction, "zeta": zeta, "cells": cells,
+                         "ratio": uniform / cells, "blocks_per_level_finest_first": counts})
+            print(f"{name:24s} zeta = {fraction:7.1e} x {speed:g} m/s: {cells:8d} cells, "
+                  f"{uniform / cells:5.2f}x fewer than {uniform}")
+        results[name] = {"uniform_cells": uniform, "reference_speed": speed, "rows": rows}
+    # The measured adaptive vortex runs (cells at the end of the crossing) against the estimate.
+    measured = []
+    vortex_json = RESULTS / "vortex_adaptive.json"
+    if vortex_json.exists():
+        vortex = results["vortex (128^2 x 32)"]
+        levels = level_estimates(*vortex_field()[:2])
+        for run in json.loads(vortex_json.read_text())["runs"].values():
+            if run["zeta"] > 0:
+                estimate, _ = fewest_cells(levels, run["zeta"])
+                measured.append({"zeta": run["zeta"], "cells_end": run["cells_end"], "estimate": estimate,
+                                 "ratio_end": vortex["uniform_cells"] / run["cells_end"]})
+                print(f"vortex, measured at zeta = {run['zeta']:g} m/s: {run['cells_end']:.0f} cells at the end "
+                      f"against the estimate {estimate} ({run['cells_end'] / estimate - 1:+.0%})")
+        vortex["measured"] = measured
+    RESULTS.mkdir(parents=True, exist_ok=True)
+    (RESULTS / "adaptive_potential.json").write_text(json.dumps(results, indent=1))
+
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    for name, r in results.items():
+        ax.semilogx([row["zeta_over_speed"] for row in r["rows"]], [row["ratio"] for row in r["rows"]],
+                    "o-", label=name)
+    if measured:
+        ax.semilogx([m["zeta"] / 0.5 for m in measured], [m["ratio_end"] for m in measured], "k*", ms=9,
+                    label="vortex, measured adaptive runs (end)")
+    ax.axhline(5.0, color="r", ls="--", lw=0.8, label="5x fewer (issue #7)")
+    ax.set_xlabel(r"$\zeta$ / reference speed")
+    ax.set_ylabel("uniform cells / fewest settled cells (estimate)")
+    ax.set_yscale("log")
+    ax.set_title("What the wavelet criterion can save, blocks of 8$^3$", fontsize=10)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    FIGURE.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(FIGURE, dpi=120)
+    print(f"wrote {FIGURE.relative_to(ROOT)}")
+
+
+if __name__ == "__main__":
+    main()
