@@ -88,6 +88,21 @@ bool is_local_family(const Forest& forest, int first) {
   return true;
 }
 
+/// Whether a block of the family at `first` has a finer neighbour across a face.
+bool beside_finer_blocks(const Forest& forest, int first) {
+  for (int c = 0; c < 8; ++c)
+    for (int d = 0; d < 3; ++d)
+      for (int side = 0; side < 2; ++side) {
+        std::array<int, 3> o{0, 0, 0};
+        o[static_cast<std::size_t>(d)] = side == 0 ? -1 : 1;
+        const Neighbour& nb =
+            forest.block(first + c)
+                .neighbours[static_cast<std::size_t>(neighbour_slot(o[0], o[1], o[2]))];
+        if (nb.link != Link::Boundary && nb.jump == LevelJump::Finer) return true;
+      }
+  return false;
+}
+
 /// The estimate (4.11) the parent of the family at `first` would have after
 /// coarsening: the family's cells and 4 face-ghost layers of `deep` (the
 /// field with 4 ghost layers, exchanged) averaged onto the parent's cells and
@@ -188,7 +203,13 @@ std::vector<AdaptFlag> wavelet_flags(const Forest& forest, std::span<BlockField*
     bool all = true;
     for (std::size_t c = 0; c < 8; ++c) all = all && coarsen[f0 + c];
     if (!all) continue;  // the forest will not merge it anyway
-    bool parent_resolved = true;
+    // With b = 4 the 4 ghost layers reach 2 finer blocks deep beside a finer
+    // neighbour, whose second block does not touch the family (the exchange
+    // clamps it): such a family waits until its finer neighbours have merged
+    // (the 2:1 balance refuses it before that anyway, unless they merge in
+    // the same pass).
+    bool parent_resolved =
+        fields[0]->cells() >= 8 || !beside_finer_blocks(forest, static_cast<int>(f0));
     for (std::size_t f = 0; f < fields.size() && parent_resolved; ++f) {
       parent_resolved = parent_estimate(forest, deep[f], static_cast<int>(f0), scratch) <
                         criterion.coarsen_fraction * criterion.thresholds[f];

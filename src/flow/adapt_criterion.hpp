@@ -19,7 +19,9 @@
 // cells of the steady obstacle wake came and went every regrid). A family of
 // 8 blocks therefore coarsens only if the estimate its parent would have,
 // computed from the family's cells and 4 ghost layers averaged onto the
-// parent, is below 2 zeta / 3 as well.
+// parent, is below 2 zeta / 3 as well. (With blocks of 4 cells, 4 ghost
+// layers beside a finer neighbour would reach a block that does not touch
+// the family: such a family waits until its finer neighbours have merged.)
 
 #include <span>
 #include <vector>

@@ -1,6 +1,7 @@
 #pragma once
 // Storage for fields on a forest of blocks: each local block holds a cube of
-// b^3 cells surrounded by ghost layers of width 2, contiguous per block (one
+// b^3 cells surrounded by ghost layers (kGhost = 2 for the flow fields; any
+// width, e.g. 4 for the wavelet criterion's parent test), contiguous per block (one
 // array per scalar: structure of arrays). A vector field is three scalars; a
 // face-centred field (fluxes, face velocities, face coefficients) is three
 // scalars of the same shape where component d at cell (i,j,k) is the value on

@@ -147,6 +147,40 @@ void read_adaptivity(const ConfigTable& flow, const ConfigTable& t, FlowCase& c)
   }
 }
 
+/// On an adaptive grid every face of a solid box that lies inside the domain
+/// must be a face of the [flow.grid] cells: the blocks kept at the finest
+/// level next to solids are found by sampling the boxes at that grid's
+/// resolution (NavierStokes::regrid), which sees a box between cell faces
+/// only where it covers a cell centre of that grid.
+void check_solids_on_grid_faces(const ConfigTable& flow, const FlowCase& c, const Vec3& size) {
+  const auto boxes = flow.table_array("solid");
+  for (std::size_t n = 0; n < boxes.size(); ++n) {
+    const Vec3 lo = boxes[n].get_vec3("min_m"), hi = boxes[n].get_vec3("max_m");
+    bool overlaps = true;  // a box outside the domain masks no cell
+    for (int d = 0; d < 3; ++d) {
+      overlaps = overlaps && hi[d] > c.forest.origin[d] && lo[d] < c.forest.origin[d] + size[d];
+    }
+    if (!overlaps) continue;
+    for (const char* key : {"min_m", "max_m"}) {
+      const Vec3 corner = boxes[n].get_vec3(key);
+      for (int d = 0; d < 3; ++d) {
+        const double h = size[d] / c.cells[static_cast<std::size_t>(d)];
+        const double at = (corner[d] - c.forest.origin[d]) / h;  // in cells from the origin
+        if (at <= 0.0 || at >= c.cells[static_cast<std::size_t>(d)]) continue;  // outside
+        if (std::abs(at - std::round(at)) > 1e-6) {
+          std::ostringstream why;
+          why << "with [flow.adapt], solid boxes must lie on the [flow.grid] cell faces; "
+              << "coordinate "
+              << "xyz"[d] << " = " << corner[d] << " m is " << at - std::floor(at)
+              << " of a cell past the face at " << c.forest.origin[d] + std::floor(at) * h
+              << " m (cells of " << h << " m)";
+          boxes[n].fail(key, why.str());
+        }
+      }
+    }
+  }
+}
+
 }  // namespace
 
 bool is_flow_case(const ConfigTable& cfg) {
@@ -243,7 +277,10 @@ FlowCase load_flow_case(const ConfigTable& cfg, const std::filesystem::path& sou
     c.options.pressure.max_cycles = c.options.viscous.max_cycles = static_cast<int>(cycles);
   }
 
-  if (const auto adapt = flow.find_table("adapt")) read_adaptivity(flow, *adapt, c);
+  if (const auto adapt = flow.find_table("adapt")) {
+    read_adaptivity(flow, *adapt, c);
+    check_solids_on_grid_faces(flow, c, size);
+  }
 
   const auto output = cfg.find_table("output");
   c.output_interval = c.end_time / 100.0;

@@ -346,8 +346,9 @@ void fill_from_coarser(const Block& block, const std::array<int, 3>& o,
 /// Ghosts of a coarse block in the region towards offset o from the finer
 /// children there: the mean of the 8 fine cells of each ghost cell. Fine
 /// cells that would lie in a child not touching the block (ghosts deeper
-/// than b/2 cells, i.e. blocks of 1 cell on the coarsest multigrid level)
-/// are clamped to the touching child's last layer.
+/// than b/2 cells: blocks of 1 cell on the coarsest multigrid level, or the
+/// 4 layers of the wavelet criterion's parent test with b = 4) are clamped
+/// to the touching child's last layer.
 void fill_from_finer(const std::array<int, 3>& o, const std::array<Range, 3>& r,
                      const std::array<CellReader, 8>& children, BlockField& field, int blk) {
   const int b = field.cells();

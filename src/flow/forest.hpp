@@ -129,11 +129,10 @@ class Forest {
   [[nodiscard]] int ranks() const { return ranks_; }
 
   /// Fills the ghost cells of every block that face another block (within
-  /// `width` <= min(kGhost, b) of the block) with copies of that block's
-  /// interior, for all the given fields (same b). Boundary ghosts are left
-  /// for boundary.hpp.
-  /// With `faces_only` the edge and corner ghosts are left as they are
-  /// (7-point stencils read face ghosts only).
+  /// `width` <= min(ghost layers of the fields' layout, b) of the block) with copies of that
+  /// block's interior, for all the given fields (same b). Boundary ghosts are left for
+  /// boundary.hpp. With `faces_only` the edge and corner ghosts are left as they are (7-point
+  /// stencils read face ghosts only).
   void exchange(std::span<BlockField* const> fields, int width, bool faces_only = false) const;
   void exchange(BlockField& field, int width, bool faces_only = false) const {
     BlockField* one[] = {&field};

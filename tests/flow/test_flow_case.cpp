@@ -188,6 +188,23 @@ every_steps = 2
 region = [{ min_m = [0.0, 0.0, 0.0], max_m = [0.5, 0.5, 0.5], refine_levels = 1 }]
 )";
 
+TEST(FlowCaseErrors, SolidBoxesOnAnAdaptiveGridMustLieOnCellFaces) {
+  // Cells of 1/16 m in y: 0.6 m is 0.6 of a cell past the face at 0.5625 m.
+  const std::string solid = R"(
+[[flow.solid]]
+min_m = [0.0, 0.375, -1.0]
+max_m = [0.25, 0.625, 2.0]
+)";
+  const FlowCase c = parse(kAdaptiveChannel + solid);  // on faces; z beyond the domain
+  EXPECT_EQ(c.solid_boxes.size(), 1u);
+  expect_input_error(kAdaptiveChannel + replaced(solid, "0.625", "0.6"),
+                     "flow.solid[0].max_m': with [flow.adapt], solid boxes must lie on the "
+                     "[flow.grid] cell faces; coordinate y = 0.6 m is 0.6 of a cell past the face "
+                     "at 0.5625 m");
+  // Without [flow.adapt] such a box is the cells whose centres it holds, as documented.
+  EXPECT_EQ(parse(kChannel + replaced(solid, "0.625", "0.6")).solid_boxes.size(), 1u);
+}
+
 TEST(FlowCaseErrors, AdaptivityKeysAreChecked) {
   const FlowCase c = parse(kAdaptiveChannel);
   EXPECT_TRUE(c.adapt.enabled);

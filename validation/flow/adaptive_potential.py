@@ -83,7 +83,7 @@ def level_estimates(components, periodic):
     coarser one that still holds whole blocks of B^3 cells."""
     levels = []
     fields = list(components)
-    while min(fields[0].shape) >= 2 * B:
+    while min(fields[0].shape) >= B:
         levels.append(np.max([block_max(cell_estimate(f, periodic)) for f in fields], axis=0))
         fields = [restrict(f) for f in fields]
     return levels  # levels[0]: finest blocks
