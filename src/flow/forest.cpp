@@ -384,6 +384,16 @@ void fill_from_finer(const std::array<int, 3>& o, const std::array<Range, 3>& r,
 }  // namespace
 
 void Forest::exchange(std::span<BlockField* const> fields, int width, bool faces_only) const {
+  exchange_scoped(fields, width, faces_only, -1);
+}
+
+void Forest::exchange_from_finer(BlockField& field, int face) const {
+  BlockField* one[] = {&field};
+  exchange_scoped(one, 1, true, face);
+}
+
+void Forest::exchange_scoped(std::span<BlockField* const> fields, int width, bool faces_only,
+                             int finer_face) const {
   if (fields.empty()) return;
   const BlockLayout layout = fields[0]->layout();
   const int b = layout.cells;
@@ -420,9 +430,11 @@ void Forest::exchange(std::span<BlockField* const> fields, int width, bool faces
         for (int ox = -1; ox <= 1; ++ox) {
           const int nonzero = (ox != 0) + (oy != 0) + (oz != 0);
           if (nonzero == 0 || (faces_only && nonzero > 1)) continue;
+          if (finer_face >= 0 && (nonzero != 1 || offset_face(ox, oy, oz) != finer_face)) continue;
           const Neighbour nb =
               block.neighbours[static_cast<std::size_t>(neighbour_slot(ox, oy, oz))];
           if (nb.link == Link::Boundary) continue;
+          if (finer_face >= 0 && nb.jump != LevelJump::Finer) continue;
           const Range rx = ghost_range(ox, b, width), ry = ghost_range(oy, b, width),
                       rz = ghost_range(oz, b, width);
           if (nb.jump != LevelJump::Same) {

@@ -92,6 +92,13 @@ constexpr int neighbour_slot(int ox, int oy, int oz) {
   return (ox + 1) + 3 * (oy + 1) + 9 * (oz + 1);
 }
 
+/// Face index 2 d + side of a face offset (exactly one of ox, oy, oz nonzero).
+constexpr int offset_face(int ox, int oy, int oz) {
+  const int d = ox != 0 ? 0 : (oy != 0 ? 1 : 2);
+  const int o = ox + oy + oz;
+  return 2 * d + (o > 0 ? 1 : 0);
+}
+
 /// Slot of the neighbour across face (d, side) (side 0: the lower face).
 constexpr std::size_t face_neighbour_slot(int d, int side) {
   const int o = side == 0 ? -1 : 1;
@@ -138,6 +145,13 @@ class Forest {
     BlockField* one[] = {&field};
     exchange(one, width, faces_only);
   }
+
+  /// Only the ghost layer (width 1) beyond face `face` (2 d + side) of the
+  /// blocks whose neighbour there is finer: the 8-cell means of the finer
+  /// blocks' cells, exactly as exchange() fills it, and nothing else. For
+  /// data that only coarse-fine faces read (Multigrid::match_fluxes), at a
+  /// fraction of a full exchange's cost. Collective like exchange().
+  void exchange_from_finer(BlockField& field, int face) const;
 
   /// Runs body(b) for every local block, on the forest's OpenMP threads.
   template <typename Body>
@@ -187,6 +201,9 @@ class Forest {
              int max_level = kForestMaxLevel);
 
  private:
+  /// exchange(); with finer_face >= 0 only that face of blocks beside finer ones.
+  void exchange_scoped(std::span<BlockField* const> fields, int width, bool faces_only,
+                       int finer_face) const;
   void build_blocks();
   void build_ghost_tables();
   void build_neighbours();
