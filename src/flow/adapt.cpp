@@ -178,19 +178,6 @@ void prolong_faces(const BlockField& parent, int parent_blk, const std::array<in
   });
 }
 
-std::array<bool, 6> boundary_faces(const Block& block) {
-  std::array<bool, 6> wall{};
-  for (int d = 0; d < 3; ++d)
-    for (int side = 0; side < 2; ++side) {
-      std::array<int, 3> o{0, 0, 0};
-      o[static_cast<std::size_t>(d)] = side == 0 ? -1 : 1;
-      wall[static_cast<std::size_t>(2 * d + side)] =
-          block.neighbours[static_cast<std::size_t>(neighbour_slot(o[0], o[1], o[2]))].link ==
-          Link::Boundary;
-    }
-  return wall;
-}
-
 }  // namespace
 
 bool Forest::adapt(const std::function<AdaptFlag(const Block&)>& decide,
@@ -292,7 +279,7 @@ bool Forest::adapt(std::span<const AdaptFlag> flags, std::span<BlockField* const
           break;
         case Source::Kind::Prolong:
           prolong_block(old, src.blocks[0],
-                        boundary_faces(old_blocks[static_cast<std::size_t>(src.blocks[0])]),
+                        domain_faces(old_blocks[static_cast<std::size_t>(src.blocks[0])]),
                         src.child_bits, *f, blk);
           break;
         case Source::Kind::Restrict:

@@ -12,19 +12,6 @@ namespace {
 /// Faces of a cube that are domain faces (2d + side): slopes there are one-sided.
 using DomainFaces = std::array<bool, 6>;
 
-DomainFaces domain_faces(const Block& block) {
-  DomainFaces wall{};
-  for (int d = 0; d < 3; ++d)
-    for (int side = 0; side < 2; ++side) {
-      std::array<int, 3> o{0, 0, 0};
-      o[static_cast<std::size_t>(d)] = side == 0 ? -1 : 1;
-      wall[static_cast<std::size_t>(2 * d + side)] =
-          block.neighbours[static_cast<std::size_t>(neighbour_slot(o[0], o[1], o[2]))].link ==
-          Link::Boundary;
-    }
-  return wall;
-}
-
 /// Estimate (4.11) of a cube of b^3 cells whose values `u` (offsets of
 /// `layout`) include 2 face-ghost layers beyond every face that is not a
 /// domain face: the largest |u - P(R(u))| over its cells.

@@ -114,6 +114,17 @@ struct Block {
   std::array<Neighbour, 27> neighbours{};  ///< by neighbour_slot; the centre slot is unused
 };
 
+/// Which faces of a block (2 d + side) are domain faces (no neighbour there).
+inline std::array<bool, 6> domain_faces(const Block& block) {
+  std::array<bool, 6> wall{};
+  for (int d = 0; d < 3; ++d)
+    for (int side = 0; side < 2; ++side) {
+      wall[static_cast<std::size_t>(2 * d + side)] =
+          block.neighbours[face_neighbour_slot(d, side)].link == Link::Boundary;
+    }
+  return wall;
+}
+
 class Forest {
  public:
   explicit Forest(const ForestSpec& spec);
