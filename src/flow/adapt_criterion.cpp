@@ -80,11 +80,7 @@ bool beside_finer_blocks(const Forest& forest, int first) {
   for (int c = 0; c < 8; ++c)
     for (int d = 0; d < 3; ++d)
       for (int side = 0; side < 2; ++side) {
-        std::array<int, 3> o{0, 0, 0};
-        o[static_cast<std::size_t>(d)] = side == 0 ? -1 : 1;
-        const Neighbour& nb =
-            forest.block(first + c)
-                .neighbours[static_cast<std::size_t>(neighbour_slot(o[0], o[1], o[2]))];
+        const Neighbour& nb = forest.block(first + c).neighbours[face_neighbour_slot(d, side)];
         if (nb.link != Link::Boundary && nb.jump == LevelJump::Finer) return true;
       }
   return false;
@@ -125,9 +121,9 @@ double parent_estimate(const Forest& forest, const BlockField& deep, int first,
   DomainFaces wall{};
   for (int d = 0; d < 3; ++d)
     for (int side = 0; side < 2; ++side) {
-      const int child = side << d;
+      const Block& child = forest.block(first + (side << d));
       wall[static_cast<std::size_t>(2 * d + side)] =
-          domain_faces(forest.block(first + child))[static_cast<std::size_t>(2 * d + side)];
+          child.neighbours[face_neighbour_slot(d, side)].link == Link::Boundary;
     }
   return cube_estimate(scratch.data(), P, wall);
 }

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <utility>
 
 namespace sanguis::flow {
 
@@ -161,8 +162,7 @@ void check_solids_on_grid_faces(const ConfigTable& flow, const FlowCase& c, cons
       overlaps = overlaps && hi[d] > c.forest.origin[d] && lo[d] < c.forest.origin[d] + size[d];
     }
     if (!overlaps) continue;
-    for (const char* key : {"min_m", "max_m"}) {
-      const Vec3 corner = boxes[n].get_vec3(key);
+    for (const auto& [key, corner] : {std::pair{"min_m", lo}, std::pair{"max_m", hi}}) {
       for (int d = 0; d < 3; ++d) {
         const double h = size[d] / c.cells[static_cast<std::size_t>(d)];
         const double at = (corner[d] - c.forest.origin[d]) / h;  // in cells from the origin
