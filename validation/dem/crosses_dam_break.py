@@ -297,6 +297,7 @@ def main():
     if args.reuse:
         elapsed = sum(wall_time(out) for out in runs.values())
     ok = all(c["pass"] for c in checks if c["pass"] is not None)
+    others = [g for g in sorted(CROSSES) if g not in args.gates]
     summary = {
         "name": "crosses_dam_break",
         "title": "Dam break of crosses in the experiments' box",
@@ -305,7 +306,9 @@ def main():
             "cases/dem/dam-break-crosses.toml: box 64 x 30 x 20 cm, Table 3.1 crosses poured "
             "behind the gate, settled, gate removed at once, 3 s of collapse; gates "
             + ", ".join(f"{g} cm" for g in args.gates)
-            + " of the five of §3.2.1 (the others: `--gates 8 12 20 30`, hours each)."),
+            + " of the five of §3.2.1"
+            + (f" (the others: `--gates {' '.join(map(str, others))}`, hours each)" if others else "")
+            + "."),
         "command": "/usr/bin/python3 validation/dem/crosses_dam_break.py --build BUILD"
                    + ("" if args.gates == [4] else " --gates " + " ".join(map(str, args.gates))),
         "figures": ["docs/validation/figures/crosses_dam_break.png"],
