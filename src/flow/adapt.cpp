@@ -193,11 +193,10 @@ bool Forest::adapt(std::span<const AdaptFlag> flags, std::span<BlockField* const
   if (flags.size() != blocks_.size()) {
     throw std::invalid_argument("forest: adapt needs one flag per local block");
   }
-  for (BlockField* f : fields) {
+  for (const BlockField* f : fields) {
     if (f->blocks() != local_blocks()) {
       throw std::invalid_argument("forest: adapt: a field does not match the block list");
     }
-    exchange(*f, 1);  // neighbours' cells for the prolongation slopes
   }
   for (const FaceField* uf : face_fields) {
     for (const BlockField& component : *uf) {
@@ -206,6 +205,18 @@ bool Forest::adapt(std::span<const AdaptFlag> flags, std::span<BlockField* const
       }
     }
   }
+  // No rank asks for a merge or for a split below max_level, and the blocks
+  // are already split over the ranks as adapt() splits them: nothing would
+  // change, so the forest, its tables and the fields stay as they are (a
+  // regrid at every step of a settled grid then costs only its criterion).
+  const int deepest = std::min(max_level, P8EST_QMAXLEVEL - 1);
+  bool may_change = !families_partitioned_;
+  for (std::size_t b = 0; b < blocks_.size() && !may_change; ++b) {
+    may_change = flags[b] == AdaptFlag::Coarsen ||
+                 (flags[b] == AdaptFlag::Refine && blocks_[b].level < deepest);
+  }
+  if (max(may_change ? 1.0 : 0.0) == 0.0) return false;
+  for (BlockField* f : fields) exchange(*f, 1);  // neighbours' cells for the prolongation slopes
   AdaptContext ctx;
   ctx.trees = spec_.trees;
   ctx.connectivity = p4est_->connectivity.get();
@@ -222,8 +233,7 @@ bool Forest::adapt(std::span<const AdaptFlag> flags, std::span<BlockField* const
   forest->user_pointer = &ctx;
   // Coarsen first, so that the flags still name the blocks they were given for.
   p8est_coarsen_ext(forest, 0, 0, coarsen_callback, nullptr, nullptr);
-  p8est_refine_ext(forest, 0, std::min(max_level, P8EST_QMAXLEVEL - 1), refine_callback, nullptr,
-                   nullptr);
+  p8est_refine_ext(forest, 0, deepest, refine_callback, nullptr, nullptr);
   p8est_balance_ext(forest, P8EST_CONNECT_FULL, nullptr, nullptr);
   forest->user_pointer = saved_pointer;
   build_blocks();  // the new local blocks (ghost tables follow in partition)

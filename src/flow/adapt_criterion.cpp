@@ -17,36 +17,49 @@ using DomainFaces = std::array<bool, 6>;
 /// domain face: the largest |u - P(R(u))| over its cells.
 double cube_estimate(const double* u, const BlockLayout& L, const DomainFaces& wall) {
   const int b = L.cells;
-  // R: the mean of the 8 cells of coarse cell (I,J,K); I = -1 or b/2 reads
-  // the two ghost layers beside a face.
-  auto coarse = [&](int ci, int cj, int ck) {
-    double sum = 0.0;
-    for (int dk = 0; dk < 2; ++dk)
-      for (int dj = 0; dj < 2; ++dj)
-        for (int di = 0; di < 2; ++di) sum += u[L.index(2 * ci + di, 2 * cj + dj, 2 * ck + dk)];
-    return sum / 8.0;
-  };
   const int n = b / 2;
+  // R once per coarse cell: the mean of its 8 cells, for (I,J,K) in
+  // [-1, n]^3 with at most one index outside [0, n) (I = -1 or n reads the
+  // two ghost layers beside a face; edges and corners are never read).
+  const int m = n + 2;
+  thread_local std::vector<double> coarse;
+  coarse.assign(static_cast<std::size_t>(m) * m * m, 0.0);
+  auto at = [m](int ci, int cj, int ck) {
+    return static_cast<std::size_t>(((ck + 1) * m + (cj + 1)) * m + (ci + 1));
+  };
+  for (int ck = -1; ck <= n; ++ck)
+    for (int cj = -1; cj <= n; ++cj)
+      for (int ci = -1; ci <= n; ++ci) {
+        const int outside = (ci < 0 || ci >= n) + (cj < 0 || cj >= n) + (ck < 0 || ck >= n);
+        if (outside > 1) continue;
+        double sum = 0.0;
+        for (int dk = 0; dk < 2; ++dk)
+          for (int dj = 0; dj < 2; ++dj)
+            for (int di = 0; di < 2; ++di) {
+              sum += u[L.index(2 * ci + di, 2 * cj + dj, 2 * ck + dk)];
+            }
+        coarse[at(ci, cj, ck)] = sum / 8.0;
+      }
+  // P: the coarse value plus central slopes (one-sided at domain faces).
+  const std::array<std::size_t, 3> step{1, static_cast<std::size_t>(m),
+                                        static_cast<std::size_t>(m) * m};
   double worst = 0.0;
   for (int k = 0; k < b; ++k)
     for (int j = 0; j < b; ++j)
       for (int i = 0; i < b; ++i) {
         const std::array<int, 3> cell{i >> 1, j >> 1, k >> 1};
-        const double centre = coarse(cell[0], cell[1], cell[2]);
+        const std::size_t c = at(cell[0], cell[1], cell[2]);
+        const double centre = coarse[c];
         double prolonged = centre;
         for (std::size_t d = 0; d < 3; ++d) {
-          auto shifted = [&](int by) {
-            std::array<int, 3> c = cell;
-            c[d] += by;
-            return coarse(c[0], c[1], c[2]);
-          };
+          const double above = coarse[c + step[d]], below = coarse[c - step[d]];
           double slope = 0.0;
           if (cell[d] == 0 && wall[2 * d]) {
-            slope = shifted(1) - centre;
+            slope = above - centre;
           } else if (cell[d] == n - 1 && wall[2 * d + 1]) {
-            slope = centre - shifted(-1);
+            slope = centre - below;
           } else {
-            slope = 0.5 * (shifted(1) - shifted(-1));
+            slope = 0.5 * (above - below);
           }
           const int fine = d == 0 ? i : (d == 1 ? j : k);
           prolonged += ((fine & 1) ? 0.25 : -0.25) * slope;
@@ -150,55 +163,86 @@ std::vector<AdaptFlag> wavelet_flags(const Forest& forest, std::span<BlockField*
     throw std::invalid_argument("wavelet flags: one threshold per field");
   }
   const auto blocks = static_cast<std::size_t>(forest.local_blocks());
-  std::vector<bool> refine(blocks, false), coarsen(blocks, true);
-  std::vector<BlockField> deep;  // each field with 4 ghost layers, for the parents' estimates
-  deep.reserve(fields.size());
-  for (std::size_t f = 0; f < fields.size(); ++f) {
-    const int b = fields[f]->cells();
-    if (b < 4 || fields[f]->layout().ghost < 2) {
+  if (!criterion.block_min_level.empty() && criterion.block_min_level.size() != blocks) {
+    throw std::invalid_argument("wavelet flags: block_min_level needs one level per local block");
+  }
+  for (const BlockField* f : fields) {
+    if (f->cells() < 4 || f->layout().ghost < 2) {
       throw std::invalid_argument("wavelet flags: needs blocks of >= 4 cells and 2 ghost layers");
     }
-    BlockField& copy = deep.emplace_back(forest.local_blocks(), b, 4);
-    forest.for_each_block([&](int blk) {
-      for (int k = 0; k < b; ++k)
-        for (int j = 0; j < b; ++j)
-          for (int i = 0; i < b; ++i) copy(blk, i, j, k) = (*fields[f])(blk, i, j, k);
-    });
-    forest.exchange(copy, 4, true);  // the same first 2 layers as a width-2 exchange
-    const double zeta = criterion.thresholds[f];
-    std::vector<double> e(blocks);
+  }
+  auto floor_of = [&](std::size_t blk) {
+    return criterion.block_min_level.empty()
+               ? criterion.min_level
+               : std::max(criterion.min_level, criterion.block_min_level[blk]);
+  };
+  // A block at max_level that may not coarsen either has nothing to decide.
+  std::vector<bool> pinned(blocks);
+  for (std::size_t blk = 0; blk < blocks; ++blk) {
+    const int level = forest.block(static_cast<int>(blk)).level;
+    pinned[blk] = level >= criterion.max_level && level <= floor_of(blk);
+  }
+  std::vector<bool> refine(blocks, false), coarsen(blocks, true);
+  forest.exchange(fields, 2, true);  // face ghosts: the slopes are taken along one direction
+  std::vector<double> e(blocks);
+  for (std::size_t f = 0; f < fields.size(); ++f) {
     forest.for_each_block([&](int blk) {
       e[static_cast<std::size_t>(blk)] =
-          cube_estimate(copy.block(blk), copy.layout(), domain_faces(forest.block(blk)));
+          pinned[static_cast<std::size_t>(blk)]
+              ? 0.0
+              : cube_estimate(fields[f]->block(blk), fields[f]->layout(),
+                              domain_faces(forest.block(blk)));
     });
+    const double zeta = criterion.thresholds[f];
     for (std::size_t blk = 0; blk < blocks; ++blk) {
       refine[blk] = refine[blk] || e[blk] > zeta;
       coarsen[blk] = coarsen[blk] && e[blk] < criterion.coarsen_fraction * zeta;
     }
   }
+  for (std::size_t blk = 0; blk < blocks; ++blk) {
+    if (forest.block(static_cast<int>(blk)).level <= floor_of(blk)) coarsen[blk] = false;
+  }
   // A family whose 8 blocks would all coarsen does so only if its parent's
-  // estimate stays below the coarsening threshold too (no flip-flop).
-  std::vector<double> scratch;
+  // estimate stays below the coarsening threshold too (no flip-flop). The
+  // fields with 4 ghost layers are made only when some rank has such a
+  // family (the exchange is collective).
+  std::vector<int> candidates;
   for (int first = 0; first + 8 <= forest.local_blocks(); ++first) {
     if (!is_local_family(forest, first)) continue;
-    const auto f0 = static_cast<std::size_t>(first);
-    first += 7;
     bool all = true;
-    for (std::size_t c = 0; c < 8; ++c) all = all && coarsen[f0 + c];
-    if (!all) continue;  // the forest will not merge it anyway
-    // With b = 4 the 4 ghost layers reach 2 finer blocks deep beside a finer
-    // neighbour, whose second block does not touch the family (the exchange
-    // clamps it): such a family waits until its finer neighbours have merged
-    // (the 2:1 balance refuses it before that anyway, unless they merge in
-    // the same pass).
-    bool parent_resolved =
-        fields[0]->cells() >= 8 || !beside_finer_blocks(forest, static_cast<int>(f0));
-    for (std::size_t f = 0; f < fields.size() && parent_resolved; ++f) {
-      parent_resolved = parent_estimate(forest, deep[f], static_cast<int>(f0), scratch) <
-                        criterion.coarsen_fraction * criterion.thresholds[f];
+    for (int c = 0; c < 8; ++c) all = all && coarsen[static_cast<std::size_t>(first + c)];
+    if (all) candidates.push_back(first);  // else the forest will not merge it anyway
+    first += 7;
+  }
+  if (forest.max(candidates.empty() ? 0.0 : 1.0) > 0.0) {
+    std::vector<BlockField> deep;  // each field with 4 ghost layers, for the parents' estimates
+    deep.reserve(fields.size());
+    for (const BlockField* field : fields) {
+      const int b = field->cells();
+      BlockField& copy = deep.emplace_back(forest.local_blocks(), b, 4);
+      forest.for_each_block([&](int blk) {
+        for (int k = 0; k < b; ++k)
+          for (int j = 0; j < b; ++j)
+            for (int i = 0; i < b; ++i) copy(blk, i, j, k) = (*field)(blk, i, j, k);
+      });
+      forest.exchange(copy, 4, true);
     }
-    if (!parent_resolved) {
-      for (std::size_t c = 0; c < 8; ++c) coarsen[f0 + c] = false;
+    std::vector<double> scratch;
+    for (const int first : candidates) {
+      const auto f0 = static_cast<std::size_t>(first);
+      // With b = 4 the 4 ghost layers reach 2 finer blocks deep beside a finer
+      // neighbour, whose second block does not touch the family (the exchange
+      // clamps it): such a family waits until its finer neighbours have merged
+      // (the 2:1 balance refuses it before that anyway, unless they merge in
+      // the same pass).
+      bool parent_resolved = fields[0]->cells() >= 8 || !beside_finer_blocks(forest, first);
+      for (std::size_t f = 0; f < fields.size() && parent_resolved; ++f) {
+        parent_resolved = parent_estimate(forest, deep[f], first, scratch) <
+                          criterion.coarsen_fraction * criterion.thresholds[f];
+      }
+      if (!parent_resolved) {
+        for (std::size_t c = 0; c < 8; ++c) coarsen[f0 + c] = false;
+      }
     }
   }
   std::vector<AdaptFlag> flags(blocks, AdaptFlag::Keep);
@@ -214,10 +258,9 @@ std::vector<AdaptFlag> wavelet_flags(const Forest& forest, std::span<BlockField*
     }
     if (level > criterion.max_level) {
       flags[blk] = AdaptFlag::Coarsen;
-    } else if (level < criterion.min_level ||
-               ((tagged || refine[blk]) && level < criterion.max_level)) {
+    } else if (level < floor_of(blk) || ((tagged || refine[blk]) && level < criterion.max_level)) {
       flags[blk] = AdaptFlag::Refine;
-    } else if (!tagged && !refine[blk] && coarsen[blk] && level > criterion.min_level) {
+    } else if (!tagged && !refine[blk] && coarsen[blk]) {
       flags[blk] = AdaptFlag::Coarsen;
     }
   }

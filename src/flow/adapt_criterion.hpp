@@ -36,6 +36,10 @@ struct WaveletCriterion {
   int min_level = 0;                    ///< blocks are refined up to at least this level
   int max_level = 18;                   ///< and never beyond this one
   double coarsen_fraction = 2.0 / 3.0;  ///< coarsen below this fraction of zeta
+  /// Optional, one per local block: the block is refined up to at least this
+  /// level and never coarsened below it (refinement regions). A block at
+  /// max_level that may not coarsen is not estimated at all.
+  std::vector<int> block_min_level{};
 };
 
 /// The estimate (4.11) of every local block: the largest e over its cells.

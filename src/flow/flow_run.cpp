@@ -85,17 +85,16 @@ double leaf_cells(const Forest& forest) {
 }
 
 /// [flow.adapt]: the wavelet criterion (eq. 4.11) on the three velocity
-/// components within the case's levels, then at least the regions' levels.
+/// components within the case's levels, and at least the regions' levels.
 std::vector<AdaptFlag> adapt_flags(const FlowAdaptivity& a, const Forest& forest,
                                    NavierStokes& ns) {
   const double zeta = a.velocity_threshold;
-  const WaveletCriterion criterion{{zeta, zeta, zeta}, a.min_level, a.max_level};
-  BlockField* velocity[] = {&ns.velocity()[0], &ns.velocity()[1], &ns.velocity()[2]};
-  std::vector<AdaptFlag> flags = wavelet_flags(forest, velocity, criterion);
+  WaveletCriterion criterion{{zeta, zeta, zeta}, a.min_level, a.max_level};
   const int base = forest.spec().level;
+  criterion.block_min_level.assign(static_cast<std::size_t>(forest.local_blocks()), a.min_level);
   for (int blk = 0; blk < forest.local_blocks(); ++blk) {
     const Block& block = forest.block(blk);
-    int floor = a.min_level;
+    int& floor = criterion.block_min_level[static_cast<std::size_t>(blk)];
     for (const RefinementRegion& r : a.regions) {
       bool overlaps = true;
       for (int d = 0; d < 3; ++d) {
@@ -104,14 +103,9 @@ std::vector<AdaptFlag> adapt_flags(const FlowAdaptivity& a, const Forest& forest
       }
       if (overlaps) floor = std::max(floor, base + r.refine_levels);
     }
-    AdaptFlag& flag = flags[static_cast<std::size_t>(blk)];
-    if (block.level < floor) {
-      flag = AdaptFlag::Refine;
-    } else if (block.level == floor && flag == AdaptFlag::Coarsen) {
-      flag = AdaptFlag::Keep;
-    }
   }
-  return flags;
+  BlockField* velocity[] = {&ns.velocity()[0], &ns.velocity()[1], &ns.velocity()[2]};
+  return wavelet_flags(forest, velocity, criterion);
 }
 
 }  // namespace

@@ -53,6 +53,7 @@ Forest::Forest(const ForestSpec& spec) : spec_(spec), p4est_(std::make_unique<P4
   p4est_->forest.reset(
       p8est_new_ext(comm_, p4est_->connectivity.get(), 0, spec_.level, 1, 0, nullptr, nullptr));
   p8est_partition(p4est_->forest.get(), 0, nullptr);
+  families_partitioned_ = ranks_ == 1;
   rebuild_tables();
 }
 
@@ -69,6 +70,7 @@ bool Forest::partition(std::span<BlockField* const> fields) {
                                            forest->global_first_quadrant + ranks_ + 1);
   // Families kept on one rank, so that a later adapt() may coarsen them.
   p8est_partition(forest, 1, nullptr);
+  families_partitioned_ = true;
   const bool moved = !std::equal(before.begin(), before.end(), forest->global_first_quadrant);
   if (moved && !fields.empty()) migrate_fields(before, fields);
   rebuild_tables();

@@ -237,6 +237,10 @@ class Forest {
   std::int64_t first_global_block_ = 0;
   int min_level_ = 0;
   int max_level_ = 0;
+  /// Whether the blocks are split over the ranks as partition() and adapt()
+  /// split them (families of 8 on one rank); a forest just built is split
+  /// evenly instead, unless it has one rank.
+  bool families_partitioned_ = false;
 };
 
 template <typename Body>

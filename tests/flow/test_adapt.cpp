@@ -125,6 +125,36 @@ TEST(FlowAdapt, CoarseningMergesFamiliesBack) {
   EXPECT_FALSE(forest.adapt([](const Block&) { return AdaptFlag::Keep; }, {}));
 }
 
+TEST(FlowAdapt, FlagsThatChangeNothingLeaveTheForestAndTheFieldsAsTheyAre) {
+  // A regrid of a settled grid (every step, say) must not exchange, copy or
+  // rebuild anything: Keep everywhere, and Refine only at max_level.
+  Forest forest(small_spec(false));
+  refine_where(forest, [](const Vec3& c) { return c.x < 0.5; });
+  BlockField field(forest.local_blocks(), 4);
+  fill_cells(forest, field, linear);
+  const double sentinel = -12345.0;
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) field(blk, -1, 0, 0) = sentinel;
+  const double* storage = field.block(0);
+  const std::int64_t blocks = forest.global_blocks();
+  BlockField* fields[] = {&field};
+  EXPECT_FALSE(forest.adapt(
+      [](const Block& b) { return b.level == 2 ? AdaptFlag::Refine : AdaptFlag::Keep; }, fields, {},
+      2));
+  EXPECT_EQ(forest.global_blocks(), blocks);
+  EXPECT_EQ(field.block(0), storage);  // not reallocated
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    EXPECT_EQ(field(blk, -1, 0, 0), sentinel);  // no exchange either
+  }
+  // One block asking for a split below max_level changes the forest again.
+  EXPECT_TRUE(forest.adapt(
+      [](const Block& b) {
+        return b.level == 2 && b.coord == std::array<std::int64_t, 3>{0, 0, 0} ? AdaptFlag::Refine
+                                                                               : AdaptFlag::Keep;
+      },
+      fields, {}, 3));
+  EXPECT_GT(forest.global_blocks(), blocks);
+}
+
 TEST(FlowAdapt, GhostsReproduceLinearFunctionsAcrossLevels) {
   Forest forest(small_spec(false));
   refine_where(forest, [](const Vec3& c) { return c.x < 0.5 && c.y < 0.5; });

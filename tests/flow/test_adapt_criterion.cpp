@@ -40,6 +40,45 @@ TEST(FlowAdaptCriterion, LinearFieldsHaveNoWaveletAndCoarsenToTheMinimumLevel) {
   }
 }
 
+TEST(FlowAdaptCriterion, PerBlockFloorsRefineBelowThemAndNeverCoarsenAtThem) {
+  // A front along x = 0.5 on level-2 blocks; the blocks with x < 0.25 get a
+  // floor of 3 (a refinement region), those with x > 0.75 a floor of 2.
+  const Forest forest(spec_at(2));
+  BlockField u(forest.local_blocks(), 8);
+  fill_cells(forest, u, [](const Vec3& x) { return std::tanh((x.x - 0.5) / 0.01); });
+  WaveletCriterion criterion{{1e-3}, 1, 3};
+  criterion.block_min_level.resize(static_cast<std::size_t>(forest.local_blocks()), 1);
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    const double x = block_centre(forest.block(blk)).x;
+    if (x < 0.25) criterion.block_min_level[static_cast<std::size_t>(blk)] = 3;
+    if (x > 0.75) criterion.block_min_level[static_cast<std::size_t>(blk)] = 2;
+  }
+  BlockField* fields[] = {&u};
+  const auto flags = wavelet_flags(forest, fields, criterion);
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    const double x = block_centre(forest.block(blk)).x;
+    const AdaptFlag flag = flags[static_cast<std::size_t>(blk)];
+    if (x < 0.25) {
+      EXPECT_EQ(flag, AdaptFlag::Refine);  // below its floor, although the field is flat there
+    } else if (x > 0.75) {
+      EXPECT_EQ(flag, AdaptFlag::Keep);  // flat, but at its floor
+    } else if (std::abs(x - 0.5) < 0.2) {
+      EXPECT_EQ(flag, AdaptFlag::Refine);  // the front
+    }
+  }
+  // Without floors the flat blocks on both sides would coarsen.
+  criterion.block_min_level.clear();
+  const auto free = wavelet_flags(forest, fields, criterion);
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    const double x = block_centre(forest.block(blk)).x;
+    if (x < 0.25 || x > 0.75) {
+      EXPECT_EQ(free[static_cast<std::size_t>(blk)], AdaptFlag::Coarsen);
+    }
+  }
+  criterion.block_min_level.resize(3);
+  EXPECT_THROW(wavelet_flags(forest, fields, criterion), std::invalid_argument);
+}
+
 TEST(FlowAdaptCriterion, CubicGivesTheThirdOrderWaveletExactly) {
   // u = x^3: R(u) = X^3 + 3 X h^2 / 4 per coarse cell (h the fine cell), the
   // central slope over one coarse cell 6 X^2 h + 9.5 h^3, so P(R(u)) differs
