@@ -25,7 +25,7 @@ bench-deps:
 	bash scripts/install-deps.sh --bench
 
 bench: bench-deps build
-	bash bench/dem_spheres_vs_lammps.sh
+	bash bench/run_all.sh
 
 validate-dem: build
 	/usr/bin/python3 validation/dem/run_all.py --build $(BUILD)
