@@ -356,6 +356,43 @@ void fill_from_finer(const std::array<int, 3>& o, const std::array<Range, 3>& r,
   const int b = field.cells();
   double* dst = field.block(blk);
   const BlockLayout& L = field.layout();
+  // Whether some fine cell needs the clamp: the region reaches deeper than
+  // b/2 cells towards a finer neighbour (always for b = 1, whose 2 fine
+  // cells per direction lie in 2 children).
+  bool clamps = b % 2 != 0;
+  for (std::size_t d = 0; d < 3; ++d) {
+    if (o[d] > 0) clamps = clamps || 2 * (r[d].end - 1 + r[d].shift) + 1 > b - 1;
+    if (o[d] < 0) clamps = clamps || 2 * (r[d].begin + r[d].shift) < b;
+  }
+  if (!clamps) {
+    // The 8 fine cells of a ghost cell (2c, 2c + 1 per direction, b even)
+    // then lie in one child: read them there, in the order of the general
+    // loop below (so the same bits), without the per-cell clamp.
+    for (int k = r[2].begin; k < r[2].end; ++k) {
+      const int fz = 2 * (k + r[2].shift), cz = fz >= b ? 1 : 0;
+      for (int j = r[1].begin; j < r[1].end; ++j) {
+        const int fy = 2 * (j + r[1].shift), cy = fy >= b ? 1 : 0;
+        for (int i = r[0].begin; i < r[0].end; ++i) {
+          const int fx = 2 * (i + r[0].shift), cx = fx >= b ? 1 : 0;
+          const CellReader& child = children[static_cast<std::size_t>(cx + 2 * cy + 4 * cz)];
+          const double* c000 = child.origin + (fx - cx * b) * child.stride[0] +
+                               (fy - cy * b) * child.stride[1] + (fz - cz * b) * child.stride[2];
+          const std::ptrdiff_t sx = child.stride[0], sy = child.stride[1], sz = child.stride[2];
+          double sum = 0.0;
+          sum += c000[0];
+          sum += c000[sx];
+          sum += c000[sy];
+          sum += c000[sx + sy];
+          sum += c000[sz];
+          sum += c000[sx + sz];
+          sum += c000[sy + sz];
+          sum += c000[sx + sy + sz];
+          dst[L.index(i, j, k)] = sum / 8.0;
+        }
+      }
+    }
+    return;
+  }
   auto clamp_fine = [b](int fine, int offset) {
     if (offset > 0) return std::min(fine, b - 1);  // touching children: bit 0
     if (offset < 0) return std::max(fine, b);      // touching children: bit 1
