@@ -170,11 +170,15 @@ std::vector<AdaptFlag> wavelet_flags(const Forest& forest, std::span<BlockField*
     if (f->cells() < 4 || f->layout().ghost < 2) {
       throw std::invalid_argument("wavelet flags: needs blocks of >= 4 cells and 2 ghost layers");
     }
+    if (f->layout().ghost != fields[0]->layout().ghost || f->cells() != fields[0]->cells()) {
+      throw std::invalid_argument("wavelet flags: the fields must share one block layout");
+    }
   }
   auto floor_of = [&](std::size_t blk) {
     return criterion.block_min_level.empty()
                ? criterion.min_level
-               : std::max(criterion.min_level, criterion.block_min_level[blk]);
+               : std::clamp(criterion.block_min_level[blk], criterion.min_level,
+                            std::max(criterion.min_level, criterion.max_level));
   };
   // A block at max_level that may not coarsen either has nothing to decide.
   std::vector<bool> pinned(blocks);

@@ -37,8 +37,8 @@ struct WaveletCriterion {
   int max_level = 18;                   ///< and never beyond this one
   double coarsen_fraction = 2.0 / 3.0;  ///< coarsen below this fraction of zeta
   /// Optional, one per local block: the block is refined up to at least this
-  /// level and never coarsened below it (refinement regions). A block at
-  /// max_level that may not coarsen is not estimated at all.
+  /// level (at most max_level) and never coarsened below it (refinement
+  /// regions). A block at max_level that may not coarsen is not estimated.
   std::vector<int> block_min_level{};
 };
 
@@ -49,10 +49,13 @@ struct WaveletCriterion {
 std::vector<double> wavelet_estimate(const Forest& forest, BlockField& field);
 
 /// Refine/keep/coarsen flags for Forest::adapt from the estimates of
-/// `fields` (one threshold each) and an optional tag field: a block with a
-/// tag cell > 0 is refined up to max_level and never coarsened. A local
-/// family asks to coarsen only if its parent's estimate is below
-/// coarsen_fraction * zeta too (families split across ranks never merge).
+/// `fields` (one threshold each, one block layout for all) and an optional
+/// tag field: a block with a tag cell > 0 is refined up to max_level and
+/// never coarsened. A local family asks to coarsen only if its parent's
+/// estimate is below coarsen_fraction * zeta too (families split across
+/// ranks never merge). Fills the fields' face ghosts (2 layers) from the
+/// neighbours, like wavelet_estimate. Blocks may get Coarsen while a sibling
+/// stays (the forest then merges nothing there).
 std::vector<AdaptFlag> wavelet_flags(const Forest& forest, std::span<BlockField* const> fields,
                                      const WaveletCriterion& criterion,
                                      const BlockField* finest_tag = nullptr);

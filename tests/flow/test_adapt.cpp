@@ -145,6 +145,16 @@ TEST(FlowAdapt, FlagsThatChangeNothingLeaveTheForestAndTheFieldsAsTheyAre) {
   for (int blk = 0; blk < forest.local_blocks(); ++blk) {
     EXPECT_EQ(field(blk, -1, 0, 0), sentinel);  // no exchange either
   }
+  // Coarsen on 7 of a family's 8 blocks merges nothing either.
+  int asked = 0;
+  EXPECT_FALSE(forest.adapt(
+      [&](const Block& b) {
+        return b.level == 2 && asked++ < 7 ? AdaptFlag::Coarsen : AdaptFlag::Keep;
+      },
+      fields, {}, 2));
+  ASSERT_GT(asked, 8);  // the first family's 8th block, and the others, kept
+  EXPECT_EQ(forest.global_blocks(), blocks);
+  EXPECT_EQ(field.block(0), storage);
   // One block asking for a split below max_level changes the forest again.
   EXPECT_TRUE(forest.adapt(
       [](const Block& b) {
