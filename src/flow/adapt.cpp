@@ -52,25 +52,6 @@ int coarsen_callback(p8est_t* forest, p4est_topidx_t tree, p8est_quadrant_t* fam
   return 1;
 }
 
-/// Whether blocks first..first+7 are the 8 children of one parent, in p4est's
-/// child order (x fastest), all flagged Coarsen: a family coarsen_callback merges.
-bool merging_family(const std::vector<Block>& blocks, std::span<const AdaptFlag> flags,
-                    std::size_t first) {
-  if (first + 8 > blocks.size()) return false;
-  const Block& b0 = blocks[first];
-  if (b0.level == 0 || b0.coord[0] % 2 != 0 || b0.coord[1] % 2 != 0 || b0.coord[2] % 2 != 0) {
-    return false;
-  }
-  for (std::size_t c = 0; c < 8; ++c) {
-    const Block& child = blocks[first + c];
-    if (flags[first + c] != AdaptFlag::Coarsen || child.level != b0.level) return false;
-    for (std::size_t d = 0; d < 3; ++d) {
-      if (child.coord[d] != b0.coord[d] + static_cast<std::int64_t>((c >> d) & 1)) return false;
-    }
-  }
-  return true;
-}
-
 void copy_block(const BlockField& from, int from_blk, BlockField& to, int to_blk) {
   const int b = to.cells();
   for (int k = 0; k < b; ++k)
@@ -233,7 +214,10 @@ bool Forest::adapt(std::span<const AdaptFlag> flags, std::span<BlockField* const
   bool may_change = !families_partitioned_;
   for (std::size_t b = 0; b < blocks_.size() && !may_change; ++b) {
     may_change = (flags[b] == AdaptFlag::Refine && blocks_[b].level < deepest) ||
-                 merging_family(blocks_, flags, b);
+                 (is_family(static_cast<int>(b)) &&
+                  std::all_of(flags.begin() + static_cast<std::ptrdiff_t>(b),
+                              flags.begin() + static_cast<std::ptrdiff_t>(b) + 8,
+                              [](AdaptFlag f) { return f == AdaptFlag::Coarsen; }));
   }
   if (max(may_change ? 1.0 : 0.0) == 0.0) return false;
   for (BlockField* f : fields) exchange(*f, 1);  // neighbours' cells for the prolongation slopes

@@ -69,25 +69,6 @@ double cube_estimate(const double* u, const BlockLayout& L, const DomainFaces& w
   return worst;
 }
 
-/// Whether local blocks first..first+7 are the 8 children of one parent, in
-/// p4est's child order (x fastest): the families the forest may coarsen.
-bool is_local_family(const Forest& forest, int first) {
-  if (first + 8 > forest.local_blocks()) return false;
-  const Block& b0 = forest.block(first);
-  if (b0.level == 0 || b0.coord[0] % 2 != 0 || b0.coord[1] % 2 != 0 || b0.coord[2] % 2 != 0) {
-    return false;
-  }
-  for (int c = 1; c < 8; ++c) {
-    const Block& child = forest.block(first + c);
-    if (child.level != b0.level || child.coord[0] != b0.coord[0] + (c & 1) ||
-        child.coord[1] != b0.coord[1] + ((c >> 1) & 1) ||
-        child.coord[2] != b0.coord[2] + ((c >> 2) & 1)) {
-      return false;
-    }
-  }
-  return true;
-}
-
 /// Whether a block of the family at `first` has a finer neighbour across a face.
 bool beside_finer_blocks(const Forest& forest, int first) {
   for (int c = 0; c < 8; ++c)
@@ -212,7 +193,7 @@ std::vector<AdaptFlag> wavelet_flags(const Forest& forest, std::span<BlockField*
   // family (the exchange is collective).
   std::vector<int> candidates;
   for (int first = 0; first + 8 <= forest.local_blocks(); ++first) {
-    if (!is_local_family(forest, first)) continue;
+    if (!forest.is_family(first)) continue;
     bool all = true;
     for (int c = 0; c < 8; ++c) all = all && coarsen[static_cast<std::size_t>(first + c)];
     if (all) candidates.push_back(first);  // else the forest will not merge it anyway

@@ -117,6 +117,23 @@ void Forest::migrate_fields(const std::vector<std::int64_t>& before,
   }
 }
 
+bool Forest::is_family(int first) const {
+  if (first < 0 || first + 8 > local_blocks()) return false;
+  const Block& b0 = block(first);
+  if (b0.level == 0 || b0.coord[0] % 2 != 0 || b0.coord[1] % 2 != 0 || b0.coord[2] % 2 != 0) {
+    return false;
+  }
+  for (int c = 1; c < 8; ++c) {
+    const Block& child = block(first + c);
+    if (child.level != b0.level || child.coord[0] != b0.coord[0] + (c & 1) ||
+        child.coord[1] != b0.coord[1] + ((c >> 1) & 1) ||
+        child.coord[2] != b0.coord[2] + ((c >> 2) & 1)) {
+      return false;
+    }
+  }
+  return true;
+}
+
 std::array<std::int64_t, 3> Forest::blocks_per_direction(int level) const {
   return {std::int64_t{spec_.trees[0]} << level, std::int64_t{spec_.trees[1]} << level,
           std::int64_t{spec_.trees[2]} << level};

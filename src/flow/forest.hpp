@@ -176,6 +176,9 @@ class Forest {
   [[nodiscard]] int min_level() const { return min_level_; }
   [[nodiscard]] int max_level() const { return max_level_; }
   [[nodiscard]] bool uniform() const { return min_level_ == max_level_; }
+  /// Whether local blocks first..first+7 are the 8 children of one parent, in
+  /// p4est's child order (x fastest): the families adapt() may merge.
+  [[nodiscard]] bool is_family(int first) const;
   /// Global number (p8est order over all ranks) of this rank's first block.
   [[nodiscard]] std::int64_t first_global_block() const { return first_global_block_; }
 
