@@ -24,6 +24,7 @@ struct MaterialSpec {
   std::string name;
   std::optional<double> density;
   bool used_by_particles = false;
+  bool used_by_mobile_particles = false;  // by a group that is not glued (fixed = true)
   bool used_by_obstacles = false;
   double radius_sum = 0.0;  // over particle groups, for the reference radius
   int groups = 0;
@@ -346,6 +347,7 @@ ParticleGroup parse_group(const ConfigTable& t, std::vector<MaterialSpec>& mater
   g.angular_velocity = t.get_vec3("angular_velocity_rad_s", {});
   g.velocity_noise = t.get_non_negative("velocity_noise_m_s", 0.0);
   g.fixed = t.get_bool("fixed", false);
+  if (!g.fixed) mat.used_by_mobile_particles = true;
   if (g.fixed) {
     if (g.arrangement == "pour") t.fail("fixed", "a poured group cannot be fixed");
     if (g.shape >= 0) t.fail("fixed", "only spheres can be glued (fixed = true)");
@@ -618,11 +620,15 @@ DemCase load_dem_case(const ConfigTable& cfg, const std::filesystem::path& sourc
     s.contacts.set(a, b, r.parameters);
     c.interactions.push_back(r);
   }
-  // Every pair that can touch needs parameters.
+  // Every pair that can touch needs parameters. Glued particles touch neither
+  // each other nor obstacles (the neighbour search skips those pairs), so a pair
+  // of materials used only by glued groups and obstacles needs none.
   for (std::size_t a = 0; a < materials.size(); ++a) {
     if (!materials[a].used_by_particles) continue;
     for (std::size_t b = 0; b < materials.size(); ++b) {
       if (!(materials[b].used_by_particles || materials[b].used_by_obstacles)) continue;
+      if (!materials[a].used_by_mobile_particles && !materials[b].used_by_mobile_particles)
+        continue;
       if (!s.contacts.defined(a, b)) {
         cfg.fail("interaction", "no [[interaction]] for materials ['" + materials[a].name + "', '" +
                                     materials[b].name + "']");

@@ -142,5 +142,38 @@ TEST(FixedParticles, AFixedGroupCannotBePouredOrMoving) {
   expect_error(poured, "particles[0].fixed");
 }
 
+TEST(FixedParticles, AGluedOnlyMaterialNeedsInteractionsOnlyWithMobileOnes) {
+  // The glued layer gets its own material: it meets the mobile glass beads, never
+  // itself nor the floor plane, so only the glass-base pair must be given.
+  std::string without = kRoughFloor;
+  const std::string glued_group =
+      "[[particles]]\nmaterial = \"glass\"\nradius_m = 1e-3\n"
+      "arrangement = \"lattice\"";
+  without.replace(without.find(glued_group), glued_group.size(),
+                  "[[particles]]\nmaterial = \"base\"\nradius_m = 1e-3\n"
+                  "arrangement = \"lattice\"");
+  without.insert(without.find("[[obstacle]]"),
+                 "[[material]]\nname = \"base\"\ndensity_kg_m3 = 2500.0\n");
+  try {
+    load(without);
+    ADD_FAILURE() << "expected an InputError on the glass-base pair";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.key(), "interaction");
+    EXPECT_NE(std::string(e.what()).find("['glass', 'base']"), std::string::npos) << e.what();
+  }
+
+  std::string with = without;
+  with.insert(with.find("[[obstacle]]"),
+              "[[interaction]]\nmaterials = [\"glass\", \"base\"]\nnormal_restitution = 0.3\n"
+              "tangential_restitution = 0.3\nmax_overlap_ratio = 0.01\n"
+              "max_impact_velocity_m_s = 0.5\nfriction = 0.5\n");
+  const DemCase c = load(with);  // no base-base, no base-wall pair needed
+  ASSERT_EQ(c.setup.particles.size(), 29u);
+  for (std::size_t i = 0; i < 25; ++i) EXPECT_TRUE(c.setup.particles.is_fixed(i)) << i;
+  DemSimulation sim(c.setup);
+  sim.run_until(0.05);  // the beads fall onto the layer: only defined pairs are met
+  EXPECT_GT(sim.diagnostics().mobile_particles, 0);
+}
+
 }  // namespace
 }  // namespace sanguis::dem
