@@ -247,6 +247,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   bench_cmd->add_option("--cells-per-side", bo.cells_per_side, "flow-cavity: cells per edge")
       ->capture_default_str();
+  bench_cmd->add_flag("--general-kernels", bo.general_kernels,
+                      "flow-cavity: multigrid kernels that read constant coefficients too (A/B)");
   std::string bench_case;
   bench_cmd->add_option("--case", bench_case,
                         "flow-adaptive: flow case file (default cases/flow/obstacle-wake.toml)");

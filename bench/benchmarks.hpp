@@ -19,6 +19,9 @@ struct BenchOptions {
   std::int64_t triangles = 5120;     // membrane: triangles per capsule (20 * 4^k)
   std::int64_t capsules = 100;       // membrane: number of capsules
   std::int64_t cells_per_side = 64;  // flow-cavity: cells along each edge (multiple of 8)
+  // flow-cavity: multigrid kernels that read the coefficient arrays even where they
+  // are constant (MultigridOptions::uniform_coefficient_kernels = false), for A/B runs.
+  bool general_kernels = false;
   // dem-spheres under mpirun: the processes share the system (domain decomposition).
   MPI_Comm comm = MPI_COMM_NULL;
 };

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "flow/coarse_fine.hpp"
@@ -81,6 +82,50 @@ inline double applied(const double* x, const BlockCoefficients& k, std::ptrdiff_
     ax -= inv_h2 * (hi * (x[c + s[D(d)]] - x[c]) - lo * (x[c] - x[c - s[D(d)]]));
   }
   return ax;
+}
+
+/// Red-black Gauss-Seidel on the cells of one colour (i + j + k + first even)
+/// of a block whose alpha and beta are constants: relaxed_value with
+/// implicit = 0, the same operations in the same order, without the
+/// coefficient loads (the smoother is memory-bound).
+inline void relax_uniform(double* x, const double* rhs, const BlockLayout& L, int first,
+                          double alpha, double beta, double inv_h2, double omega) {
+  const int b = L.cells;
+  const std::ptrdiff_t sy = L.stride(1), sz = L.stride(2);
+  double den = alpha + 0.0 * inv_h2;
+  for (int d = 0; d < 3; ++d) den += inv_h2 * (beta + beta);
+  for (int k = 0; k < b; ++k)
+    for (int j = 0; j < b; ++j) {
+      double* row = x + L.index(0, j, k);
+      const double* f = rhs + L.index(0, j, k);
+      for (int i = (k + j + first) & 1; i < b; i += 2) {
+        double num = f[i] + 0.0 * inv_h2 * row[i];
+        num += inv_h2 * (beta * row[i - 1] + beta * row[i + 1]);
+        num += inv_h2 * (beta * row[i - sy] + beta * row[i + sy]);
+        num += inv_h2 * (beta * row[i - sz] + beta * row[i + sz]);
+        row[i] += omega * (num / den - row[i]);
+      }
+    }
+}
+
+/// r = rhs - A x on a block with constant alpha and beta (every cell active):
+/// applied() without the coefficient loads, same operations, same order.
+inline void residual_uniform(const double* x, const double* rhs, double* r, const BlockLayout& L,
+                             double alpha, double beta, double inv_h2) {
+  const int b = L.cells;
+  const std::ptrdiff_t sy = L.stride(1), sz = L.stride(2);
+  for (int k = 0; k < b; ++k)
+    for (int j = 0; j < b; ++j) {
+      const std::ptrdiff_t row = L.index(0, j, k);
+      const double* xr = x + row;
+      for (int i = 0; i < b; ++i) {
+        double ax = alpha * xr[i];
+        ax -= inv_h2 * (beta * (xr[i + 1] - xr[i]) - beta * (xr[i] - xr[i - 1]));
+        ax -= inv_h2 * (beta * (xr[i + sy] - xr[i]) - beta * (xr[i] - xr[i - sy]));
+        ax -= inv_h2 * (beta * (xr[i + sz] - xr[i]) - beta * (xr[i] - xr[i - sz]));
+        r[row + i] = rhs[row + i] - ax;  // times active = 1 in compute_residual
+      }
+    }
 }
 
 // Restriction to the next coarser level: each coarse cell (i, j, k) of every block
@@ -194,7 +239,42 @@ void Multigrid::set_coefficients(const BlockField* alpha, const FaceField* beta)
   for (const BcKind k : kinds_) dirichlet = dirichlet || k == BcKind::Dirichlet;
   singular_ = !has_alpha_ && !dirichlet;
   compute_activity();
+  detect_uniform_coefficients();
   build_coarse_operator();
+}
+
+void Multigrid::detect_uniform_coefficients() {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  for (Level& level : levels_) {
+    const int b = level.cells;
+    double a_lo = kInf, a_hi = -kInf, b_lo = kInf, b_hi = -kInf;
+    for (int blk = 0; blk < forest_.local_blocks(); ++blk) {
+      for (int k = 0; k < b; ++k)
+        for (int j = 0; j < b; ++j)
+          for (int i = 0; i < b; ++i) {
+            a_lo = std::min(a_lo, level.alpha(blk, i, j, k));
+            a_hi = std::max(a_hi, level.alpha(blk, i, j, k));
+          }
+      for (int d = 0; d < 3; ++d) {
+        std::array<int, 3> hi{b, b, b};
+        hi[D(d)] = b + 1;  // faces 0..b along d
+        for (int k = 0; k < hi[2]; ++k)
+          for (int j = 0; j < hi[1]; ++j)
+            for (int i = 0; i < hi[0]; ++i) {
+              b_lo = std::min(b_lo, level.beta[D(d)](blk, i, j, k));
+              b_hi = std::max(b_hi, level.beta[D(d)](blk, i, j, k));
+            }
+      }
+    }
+    a_lo = -forest_.max(-a_lo);
+    a_hi = forest_.max(a_hi);
+    b_lo = -forest_.max(-b_lo);
+    b_hi = forest_.max(b_hi);
+    // beta > 0 on every face: every cell is active (relaxed_value's den > 0).
+    level.uniform = a_lo == a_hi && b_lo == b_hi && b_lo > 0.0;
+    level.uniform_alpha = a_lo;
+    level.uniform_beta = b_lo;
+  }
 }
 
 void Multigrid::compute_activity() {
@@ -388,6 +468,7 @@ void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const Sc
   const BlockLayout L = x.layout();
   const int b = L.cells;
   const std::array<std::ptrdiff_t, 3> s{L.stride(0), L.stride(1), L.stride(2)};
+  const bool uniform = lv.uniform && uniform_kernels_;
   for (int sweep = 0; sweep < sweeps; ++sweep) {
     for (int colour = 0; colour < 2; ++colour) {
       fill_ghosts(level, x, bc, true);  // the 7-point stencil reads face ghosts only
@@ -431,6 +512,11 @@ void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const Sc
               dirichlet[D(face_index(d, side))] = on;
               any = any || on;
             }
+        }
+        if (!any && uniform) {
+          relax_uniform(xb, rb, L, (parity + colour) & 1, lv.uniform_alpha, lv.uniform_beta, inv_h2,
+                        omega_);
+          return;
         }
         for (int kk = 0; kk < b; ++kk)
           for (int j = 0; j < b; ++j)
@@ -485,6 +571,10 @@ void Multigrid::compute_residual(int level, BlockField& x, const BlockField& rhs
     const double* fb = rhs.block(blk);
     const double* ab = lv.active.block(blk);
     double* rb = r.block(blk);
+    if (lv.uniform && uniform_kernels_) {
+      residual_uniform(xb, fb, rb, L, lv.uniform_alpha, lv.uniform_beta, inv_h2);
+      return;
+    }
     for (int kk = 0; kk < b; ++kk)
       for (int j = 0; j < b; ++j)
         for (int i = 0; i < b; ++i) {
@@ -572,6 +662,7 @@ MultigridReport Multigrid::solve(BlockField& x, const BlockField& rhs, const Sca
   pre_sweeps_ = options.pre_sweeps;
   post_sweeps_ = options.post_sweeps;
   omega_ = options.relaxation;
+  uniform_kernels_ = options.uniform_coefficient_kernels;
   const BlockField* source = &rhs;
   BlockField& shifted = shifted_rhs_;
   const int b = rhs.cells();

@@ -55,6 +55,11 @@ struct MultigridOptions {
   /// Also stop when |r|_2 <= absolute_tolerance (a floor above round-off for
   /// right-hand sides that are round-off themselves).
   double absolute_tolerance = 0.0;
+  /// Levels whose alpha and beta are the same everywhere (no solid cell, constant
+  /// viscosity) relax and form residuals reading x and rhs only; the same
+  /// operations in the same order, so the same bits. false: always the general
+  /// kernels (for tests and comparisons).
+  bool uniform_coefficient_kernels = true;
 };
 
 struct MultigridReport {
@@ -96,6 +101,9 @@ class Multigrid {
     FaceField beta;
     BlockField active;  ///< 1 where the cell takes part (some open face or alpha > 0), else 0
     std::array<BlockField, 6> face_flux;  ///< composite grids: fine-side fluxes by face
+    /// alpha and beta (> 0) each one value on every cell and face of every rank.
+    bool uniform = false;
+    double uniform_alpha = 0.0, uniform_beta = 0.0;
   };
   /// Ghosts from the neighbours (Forest::exchange) and the boundary; on
   /// composite grids, coarse ghosts at coarse-fine faces then carry the
@@ -117,6 +125,7 @@ class Multigrid {
   double rms(const BlockField& f) const;
   double mean(const BlockField& f) const;  ///< over the active cells of the finest level
   void compute_activity();
+  void detect_uniform_coefficients();
 
   const Forest& forest_;
   std::array<BcKind, 6> kinds_;
@@ -143,6 +152,7 @@ class Multigrid {
   int pre_sweeps_ = 2;
   int post_sweeps_ = 2;
   double omega_ = 1.0;
+  bool uniform_kernels_ = true;  ///< MultigridOptions::uniform_coefficient_kernels of the solve
 };
 
 }  // namespace sanguis::flow

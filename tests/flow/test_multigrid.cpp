@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "adapt_poisson.hpp"
 #include "poisson_problems.hpp"
 
 namespace sanguis::flow {
@@ -146,6 +147,56 @@ TEST(FlowMultigrid, MaskedCellsActAsNeumannWallsAndKeepTheConvergenceRate) {
   };
   const double e16 = run(0), e32 = run(1);
   EXPECT_GT(std::log2(e16 / e32), 1.8);
+}
+
+TEST(FlowMultigrid, UniformCoefficientKernelsGiveTheSameBitsAsTheGeneralOnes) {
+  // Constant alpha and beta (no solid, constant viscosity) relax and form
+  // residuals without reading the coefficient arrays. Same operations in the
+  // same order: every cell of the solution and every residual of the report
+  // must be bitwise the general kernels'. Dirichlet walls (blocks with a
+  // closure keep the general loop) on a uniform and on a refined forest
+  // (coarse-fine faces: matched fluxes), Poisson and Helmholtz.
+  for (const bool refined : {false, true}) {
+    for (const bool helmholtz : {false, true}) {
+      ForestSpec spec;
+      spec.level = 1;
+      Forest forest(spec);
+      if (refined) testing::refine_where(forest, testing::in_refined_octant);
+      ScalarBoundary bc;
+      bc.kind = uniform_kinds(forest, BcKind::Dirichlet);
+      for (auto& v : bc.value) v = testing::dirichlet_exact;
+      const int b = forest.block_cells();
+      BlockField alpha(forest.local_blocks(), b);
+      alpha.fill(2.5);
+      FaceField beta = make_vector_field(forest.local_blocks(), b);
+      for (auto& f : beta) f.fill(0.375);
+      Multigrid mg(forest, bc.kind);
+      if (helmholtz) mg.set_coefficients(&alpha, &beta);
+      const BlockField rhs = testing::sample(forest, testing::dirichlet_source);
+      MultigridOptions options;
+      options.tolerance = 1e-10;
+      std::array<BlockField, 2> x{BlockField(forest.local_blocks(), b),
+                                  BlockField(forest.local_blocks(), b)};
+      std::array<MultigridReport, 2> report;
+      for (int general = 0; general < 2; ++general) {
+        options.uniform_coefficient_kernels = general == 0;
+        report[general] = mg.solve(x[general], rhs, bc, options);
+      }
+      SCOPED_TRACE(std::string(refined ? "refined" : "uniform") +
+                   (helmholtz ? " Helmholtz" : " Poisson"));
+      EXPECT_TRUE(report[0].converged);
+      ASSERT_EQ(report[0].residuals.size(), report[1].residuals.size());
+      for (std::size_t c = 0; c < report[0].residuals.size(); ++c)
+        EXPECT_EQ(report[0].residuals[c], report[1].residuals[c]) << "cycle " << c;
+      std::size_t differing = 0;
+      for (int blk = 0; blk < forest.local_blocks(); ++blk)
+        for (int k = 0; k < b; ++k)
+          for (int j = 0; j < b; ++j)
+            for (int i = 0; i < b; ++i)
+              differing += x[0](blk, i, j, k) != x[1](blk, i, j, k) ? 1 : 0;
+      EXPECT_EQ(differing, 0u);
+    }
+  }
 }
 
 }  // namespace
