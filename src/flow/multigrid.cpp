@@ -85,21 +85,42 @@ inline double applied(const double* x, const BlockCoefficients& k, std::ptrdiff_
 }
 
 /// Red-black Gauss-Seidel on the cells of one colour (i + j + k + first even)
-/// of a block whose alpha and beta are constants: relaxed_value with
-/// implicit = 0, the same operations in the same order, without the
-/// coefficient loads (the smoother is memory-bound).
+/// of a block whose alpha and beta are constants and that has no matched
+/// coarse-fine face: relaxed_value, the same operations in the same order
+/// (the quadratic Dirichlet closure of the faces flagged in `dirichlet` as in
+/// smooth()), without the coefficient loads (the smoother is memory-bound).
 inline void relax_uniform(double* x, const double* rhs, const BlockLayout& L, int first,
-                          double alpha, double beta, double inv_h2, double omega) {
+                          double alpha, double beta, double inv_h2, double omega,
+                          const std::array<bool, 6>& dirichlet) {
   const int b = L.cells;
   const std::ptrdiff_t sy = L.stride(1), sz = L.stride(2);
-  double den = alpha + 0.0 * inv_h2;
-  for (int d = 0; d < 3; ++d) den += inv_h2 * (beta + beta);
+  auto diagonal = [&](double implicit) {
+    double den = alpha + implicit * inv_h2;
+    for (int d = 0; d < 3; ++d) den += inv_h2 * (beta + beta);
+    return den;
+  };
+  const double interior = diagonal(0.0);
+  const bool x_faces = dirichlet[D(face_index(0, 0))] || dirichlet[D(face_index(0, 1))];
   for (int k = 0; k < b; ++k)
     for (int j = 0; j < b; ++j) {
       double* row = x + L.index(0, j, k);
       const double* f = rhs + L.index(0, j, k);
+      const bool closure_row = x_faces || (j == 0 && dirichlet[D(face_index(1, 0))]) ||
+                               (j == b - 1 && dirichlet[D(face_index(1, 1))]) ||
+                               (k == 0 && dirichlet[D(face_index(2, 0))]) ||
+                               (k == b - 1 && dirichlet[D(face_index(2, 1))]);
       for (int i = (k + j + first) & 1; i < b; i += 2) {
-        double num = f[i] + 0.0 * inv_h2 * row[i];
+        double implicit = 0.0;
+        double den = interior;
+        if (closure_row) {
+          const std::array<int, 3> n{i, j, k};
+          for (int d = 0; d < 3; ++d) {
+            if (dirichlet[D(face_index(d, 0))] && n[D(d)] == 0) implicit += 2.0 * beta;
+            if (dirichlet[D(face_index(d, 1))] && n[D(d)] == b - 1) implicit += 2.0 * beta;
+          }
+          den = diagonal(implicit);
+        }
+        double num = f[i] + implicit * inv_h2 * row[i];
         num += inv_h2 * (beta * row[i - 1] + beta * row[i + 1]);
         num += inv_h2 * (beta * row[i - sy] + beta * row[i + sy]);
         num += inv_h2 * (beta * row[i - sz] + beta * row[i + sz]);
@@ -513,9 +534,11 @@ void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const Sc
               any = any || on;
             }
         }
-        if (!any && uniform) {
+        bool matched_any = false;
+        for (const bool m : matched) matched_any = matched_any || m;
+        if (uniform && !matched_any) {
           relax_uniform(xb, rb, L, (parity + colour) & 1, lv.uniform_alpha, lv.uniform_beta, inv_h2,
-                        omega_);
+                        omega_, dirichlet);
           return;
         }
         for (int kk = 0; kk < b; ++kk)
