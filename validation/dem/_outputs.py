@@ -46,3 +46,17 @@ def read_summary(run_dir):
     """The one row of RUN/analysis/summary.csv (written by `sanguis analyze`) as floats."""
     with open(os.path.join(run_dir, "analysis", "summary.csv"), newline="") as f:
         return {k: float(v) for k, v in next(csv.DictReader(f)).items()}
+
+
+def wall_time(run, after=-1.0):
+    """Wall-clock seconds of the run: the sum of its `done:` lines (a restarted run has
+    one per segment), or of the segments that ended after time `after` [s]."""
+    total = 0.0
+    with open(os.path.join(run, "run.log")) as f:
+        for line in f:
+            m = re.search(r"steps in (\S+) \(", line)
+            end = re.search(r"t = (\S+) s", line)
+            if line.startswith("done:") and m and end and float(end.group(1)) > after + 1e-9:
+                units = {"h": 3600, "m": 60, "s": 1}
+                total += sum(int(n) * units[u] for n, u in re.findall(r"(\d+)([hms])", m.group(1)))
+    return total

@@ -45,7 +45,7 @@ import time
 import matplotlib
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import read_summary  # noqa: E402
+from _outputs import read_summary, wall_time  # noqa: E402
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -160,20 +160,6 @@ def lajeunesse(a):
 def diagnostics(run):
     with open(os.path.join(run, "diagnostics.csv"), newline="") as f:
         return [{k: float(v) for k, v in r.items()} for r in csv.DictReader(f)]
-
-
-def wall_time(run, after=-1.0):
-    """Wall-clock seconds of the run: the sum of its `done:` lines (a restarted run has
-    one per segment), or of the segments that ended after time `after` [s]."""
-    total = 0.0
-    with open(os.path.join(run, "run.log")) as f:
-        for line in f:
-            m = re.search(r"steps in (\S+) \(", line)
-            end = re.search(r"t = (\S+) s", line)
-            if line.startswith("done:") and m and end and float(end.group(1)) > after + 1e-9:
-                units = {"h": 3600, "m": 60, "s": 1}
-                total += sum(int(n) * units[u] for n, u in re.findall(r"(\d+)([hms])", m.group(1)))
-    return total
 
 
 def velocity_curve(run):

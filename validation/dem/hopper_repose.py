@@ -30,7 +30,6 @@ import concurrent.futures
 import csv
 import json
 import os
-import re
 import subprocess
 import sys
 import time
@@ -38,7 +37,7 @@ import time
 import matplotlib
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import read_arrays, read_pvd, read_summary  # noqa: E402
+from _outputs import read_arrays, read_pvd, read_summary, wall_time  # noqa: E402
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -71,17 +70,6 @@ def run_one(exe, mu):
                     "--set", f"{PARAMETER}={mu}"], check=True, stdout=subprocess.DEVNULL)
     subprocess.run([exe, "analyze", out], check=True, stdout=subprocess.DEVNULL)
     return mu, time.time() - start
-
-
-def run_seconds(out):
-    """Wall-clock seconds of a run: its `done:` line in run.log."""
-    with open(os.path.join(out, "run.log")) as f:
-        for line in f:
-            m = re.search(r"steps in (\S+) \(", line)
-            if line.startswith("done:") and m:
-                units = {"h": 3600, "m": 60, "s": 1}
-                return sum(int(n) * units[u] for n, u in re.findall(r"(\d+)([hms])", m.group(1)))
-    return 0.0
 
 
 def final_mean_speed(out):
@@ -126,7 +114,7 @@ def main():
                   f"ETA {eta / 60:.0f} min)", flush=True)
     elapsed = time.time() - t0
     if not todo:  # all reused: the runs' own wall time, two at a time
-        elapsed = sum(run_seconds(run_dir(mu)) for mu in frictions) / 2.0
+        elapsed = sum(wall_time(run_dir(mu)) for mu in frictions) / 2.0
 
     angle = {mu: read_summary(run_dir(mu))["repose_angle_deg"] for mu in frictions}
     heap = {mu: final_heap(run_dir(mu)) for mu in frictions}
