@@ -89,9 +89,9 @@ inline double applied(const double* x, const BlockCoefficients& k, std::ptrdiff_
 /// coarse-fine face: relaxed_value, the same operations in the same order
 /// (the quadratic Dirichlet closure of the faces flagged in `dirichlet` as in
 /// smooth()), without the coefficient loads (the smoother is memory-bound).
-inline void relax_uniform(double* x, const double* rhs, const BlockLayout& L, int first,
-                          double alpha, double beta, double inv_h2, double omega,
-                          const std::array<bool, 6>& dirichlet) {
+inline void relax_constant(double* x, const double* rhs, const BlockLayout& L, int first,
+                           double alpha, double beta, double inv_h2, double omega,
+                           const std::array<bool, 6>& dirichlet) {
   const int b = L.cells;
   const std::ptrdiff_t sy = L.stride(1), sz = L.stride(2);
   auto diagonal = [&](double implicit) {
@@ -131,8 +131,8 @@ inline void relax_uniform(double* x, const double* rhs, const BlockLayout& L, in
 
 /// r = rhs - A x on a block with constant alpha and beta (every cell active):
 /// applied() without the coefficient loads, same operations, same order.
-inline void residual_uniform(const double* x, const double* rhs, double* r, const BlockLayout& L,
-                             double alpha, double beta, double inv_h2) {
+inline void residual_constant(const double* x, const double* rhs, double* r, const BlockLayout& L,
+                              double alpha, double beta, double inv_h2) {
   const int b = L.cells;
   const std::ptrdiff_t sy = L.stride(1), sz = L.stride(2);
   for (int k = 0; k < b; ++k)
@@ -144,7 +144,7 @@ inline void residual_uniform(const double* x, const double* rhs, double* r, cons
         ax -= inv_h2 * (beta * (xr[i + 1] - xr[i]) - beta * (xr[i] - xr[i - 1]));
         ax -= inv_h2 * (beta * (xr[i + sy] - xr[i]) - beta * (xr[i] - xr[i - sy]));
         ax -= inv_h2 * (beta * (xr[i + sz] - xr[i]) - beta * (xr[i] - xr[i - sz]));
-        r[row + i] = rhs[row + i] - ax;  // times active = 1 in compute_residual
+        r[row + i] = rhs[row + i] - ax;  // the general residual's factor active is 1 here
       }
     }
 }
@@ -260,41 +260,50 @@ void Multigrid::set_coefficients(const BlockField* alpha, const FaceField* beta)
   for (const BcKind k : kinds_) dirichlet = dirichlet || k == BcKind::Dirichlet;
   singular_ = !has_alpha_ && !dirichlet;
   compute_activity();
-  detect_uniform_coefficients();
+  detect_constant_coefficients();
   build_coarse_operator();
 }
 
-void Multigrid::detect_uniform_coefficients() {
+void Multigrid::detect_constant_coefficients() {
   constexpr double kInf = std::numeric_limits<double>::infinity();
   for (Level& level : levels_) {
     const int b = level.cells;
-    double a_lo = kInf, a_hi = -kInf, b_lo = kInf, b_hi = -kInf;
+    double a_lo = kInf, a_hi = -kInf, b_lo = kInf, b_hi = -kInf, active_lo = kInf;
+    double not_a_number = 0.0;  // 1 where a coefficient is NaN (min/max would skip it)
+    auto take = [&](double v, double& lo, double& hi) {
+      lo = std::min(lo, v);
+      hi = std::max(hi, v);
+      if (std::isnan(v)) not_a_number = 1.0;
+    };
     for (int blk = 0; blk < forest_.local_blocks(); ++blk) {
       for (int k = 0; k < b; ++k)
         for (int j = 0; j < b; ++j)
           for (int i = 0; i < b; ++i) {
-            a_lo = std::min(a_lo, level.alpha(blk, i, j, k));
-            a_hi = std::max(a_hi, level.alpha(blk, i, j, k));
+            take(level.alpha(blk, i, j, k), a_lo, a_hi);
+            active_lo = std::min(active_lo, level.active(blk, i, j, k));
           }
       for (int d = 0; d < 3; ++d) {
         std::array<int, 3> hi{b, b, b};
-        hi[D(d)] = b + 1;  // faces 0..b along d
+        hi[D(d)] = b + 1;  // faces 0..b along d: what the kernels read
         for (int k = 0; k < hi[2]; ++k)
           for (int j = 0; j < hi[1]; ++j)
-            for (int i = 0; i < hi[0]; ++i) {
-              b_lo = std::min(b_lo, level.beta[D(d)](blk, i, j, k));
-              b_hi = std::max(b_hi, level.beta[D(d)](blk, i, j, k));
-            }
+            for (int i = 0; i < hi[0]; ++i) take(level.beta[D(d)](blk, i, j, k), b_lo, b_hi);
       }
     }
     a_lo = -forest_.max(-a_lo);
     a_hi = forest_.max(a_hi);
     b_lo = -forest_.max(-b_lo);
     b_hi = forest_.max(b_hi);
-    // beta > 0 on every face: every cell is active (relaxed_value's den > 0).
-    level.uniform = a_lo == a_hi && b_lo == b_hi && b_lo > 0.0;
-    level.uniform_alpha = a_lo;
-    level.uniform_beta = b_lo;
+    active_lo = -forest_.max(-active_lo);
+    not_a_number = forest_.max(not_a_number);
+    // The constant kernels drop relaxed_value's den > 0 test and the residual's
+    // factor `active`: valid with alpha >= 0, beta > 0 and every cell active.
+    // One signed zero for alpha (a mix of +0 and -0 compares equal).
+    level.constant_coefficients = not_a_number == 0.0 && a_lo == a_hi && b_lo == b_hi &&
+                                  a_lo >= 0.0 && b_lo > 0.0 && active_lo == 1.0 &&
+                                  std::signbit(a_lo) == std::signbit(a_hi);
+    level.constant_alpha = a_lo;
+    level.constant_beta = b_lo;
   }
 }
 
@@ -489,7 +498,7 @@ void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const Sc
   const BlockLayout L = x.layout();
   const int b = L.cells;
   const std::array<std::ptrdiff_t, 3> s{L.stride(0), L.stride(1), L.stride(2)};
-  const bool uniform = lv.uniform && uniform_kernels_;
+  const bool constant = lv.constant_coefficients && constant_kernels_;
   for (int sweep = 0; sweep < sweeps; ++sweep) {
     for (int colour = 0; colour < 2; ++colour) {
       fill_ghosts(level, x, bc, true);  // the 7-point stencil reads face ghosts only
@@ -536,9 +545,9 @@ void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const Sc
         }
         bool matched_any = false;
         for (const bool m : matched) matched_any = matched_any || m;
-        if (uniform && !matched_any) {
-          relax_uniform(xb, rb, L, (parity + colour) & 1, lv.uniform_alpha, lv.uniform_beta, inv_h2,
-                        omega_, dirichlet);
+        if (constant && !matched_any) {
+          relax_constant(xb, rb, L, (parity + colour) & 1, lv.constant_alpha, lv.constant_beta,
+                         inv_h2, omega_, dirichlet);
           return;
         }
         for (int kk = 0; kk < b; ++kk)
@@ -594,8 +603,8 @@ void Multigrid::compute_residual(int level, BlockField& x, const BlockField& rhs
     const double* fb = rhs.block(blk);
     const double* ab = lv.active.block(blk);
     double* rb = r.block(blk);
-    if (lv.uniform && uniform_kernels_) {
-      residual_uniform(xb, fb, rb, L, lv.uniform_alpha, lv.uniform_beta, inv_h2);
+    if (lv.constant_coefficients && constant_kernels_) {
+      residual_constant(xb, fb, rb, L, lv.constant_alpha, lv.constant_beta, inv_h2);
       return;
     }
     for (int kk = 0; kk < b; ++kk)
@@ -685,7 +694,7 @@ MultigridReport Multigrid::solve(BlockField& x, const BlockField& rhs, const Sca
   pre_sweeps_ = options.pre_sweeps;
   post_sweeps_ = options.post_sweeps;
   omega_ = options.relaxation;
-  uniform_kernels_ = options.uniform_coefficient_kernels;
+  constant_kernels_ = options.constant_coefficient_kernels;
   const BlockField* source = &rhs;
   BlockField& shifted = shifted_rhs_;
   const int b = rhs.cells();

@@ -55,11 +55,13 @@ struct MultigridOptions {
   /// Also stop when |r|_2 <= absolute_tolerance (a floor above round-off for
   /// right-hand sides that are round-off themselves).
   double absolute_tolerance = 0.0;
-  /// Levels whose alpha and beta are the same everywhere (no solid cell, constant
-  /// viscosity) relax and form residuals reading x and rhs only; the same
-  /// operations in the same order, so the same bits. false: always the general
-  /// kernels (for tests and comparisons).
-  bool uniform_coefficient_kernels = true;
+  /// Levels whose alpha (>= 0) and beta (> 0) are each one value everywhere
+  /// (no solid cell, constant viscosity) relax and form residuals reading x
+  /// and rhs only: the same operations in the same order, so the same bits
+  /// (the build keeps FMA contraction off). Blocks beside a finer one keep the
+  /// general smoother (matched fluxes); the residual needs no special case.
+  /// false: always the general kernels (for tests and comparisons).
+  bool constant_coefficient_kernels = true;
 };
 
 struct MultigridReport {
@@ -90,6 +92,12 @@ class Multigrid {
   /// r = rhs - A x on the finest level (fills x's ghosts with bc).
   void residual(BlockField& x, const BlockField& rhs, const ScalarBoundary& bc, BlockField& r);
 
+  /// Whether `level` (0: finest) runs the constant-coefficient kernels when
+  /// MultigridOptions::constant_coefficient_kernels is on.
+  [[nodiscard]] bool constant_coefficients(int level) const {
+    return levels_[static_cast<std::size_t>(level)].constant_coefficients;
+  }
+
   /// True when the operator has the constants as null space (alpha = 0, no
   /// Dirichlet face): the solution is returned with zero mean.
   [[nodiscard]] bool singular() const { return singular_; }
@@ -102,8 +110,8 @@ class Multigrid {
     BlockField active;  ///< 1 where the cell takes part (some open face or alpha > 0), else 0
     std::array<BlockField, 6> face_flux;  ///< composite grids: fine-side fluxes by face
     /// alpha and beta (> 0) each one value on every cell and face of every rank.
-    bool uniform = false;
-    double uniform_alpha = 0.0, uniform_beta = 0.0;
+    bool constant_coefficients = false;
+    double constant_alpha = 0.0, constant_beta = 0.0;
   };
   /// Ghosts from the neighbours (Forest::exchange) and the boundary; on
   /// composite grids, coarse ghosts at coarse-fine faces then carry the
@@ -125,7 +133,7 @@ class Multigrid {
   double rms(const BlockField& f) const;
   double mean(const BlockField& f) const;  ///< over the active cells of the finest level
   void compute_activity();
-  void detect_uniform_coefficients();
+  void detect_constant_coefficients();
 
   const Forest& forest_;
   std::array<BcKind, 6> kinds_;
@@ -152,7 +160,7 @@ class Multigrid {
   int pre_sweeps_ = 2;
   int post_sweeps_ = 2;
   double omega_ = 1.0;
-  bool uniform_kernels_ = true;  ///< MultigridOptions::uniform_coefficient_kernels of the solve
+  bool constant_kernels_ = true;  ///< MultigridOptions::constant_coefficient_kernels of the solve
 };
 
 }  // namespace sanguis::flow

@@ -149,15 +149,19 @@ TEST(FlowMultigrid, MaskedCellsActAsNeumannWallsAndKeepTheConvergenceRate) {
   EXPECT_GT(std::log2(e16 / e32), 1.8);
 }
 
-TEST(FlowMultigrid, UniformCoefficientKernelsGiveTheSameBitsAsTheGeneralOnes) {
+TEST(FlowMultigrid, ConstantCoefficientKernelsGiveTheSameBitsAsTheGeneralOnes) {
   // Constant alpha and beta (no solid, constant viscosity) relax and form
   // residuals without reading the coefficient arrays. Same operations in the
   // same order: every cell of the solution and every residual of the report
-  // must be bitwise the general kernels'. Dirichlet walls (blocks with a
-  // closure keep the general loop) on a uniform and on a refined forest
-  // (coarse-fine faces: matched fluxes), Poisson and Helmholtz.
+  // must be bitwise the general kernels'. Dirichlet walls (their closure is
+  // computed from the constant beta) on a uniform and on a refined forest
+  // (blocks beside finer ones keep the general smoother), Poisson and
+  // Helmholtz; and beta off by one ulp on the last face of one block, which
+  // must turn the constant kernels off (detection scans faces 0..b).
+  enum class Coefficients { Poisson, Helmholtz, OneUlpOff };
   for (const bool refined : {false, true}) {
-    for (const bool helmholtz : {false, true}) {
+    for (const Coefficients kind :
+         {Coefficients::Poisson, Coefficients::Helmholtz, Coefficients::OneUlpOff}) {
       ForestSpec spec;
       spec.level = 1;
       Forest forest(spec);
@@ -170,8 +174,16 @@ TEST(FlowMultigrid, UniformCoefficientKernelsGiveTheSameBitsAsTheGeneralOnes) {
       alpha.fill(2.5);
       FaceField beta = make_vector_field(forest.local_blocks(), b);
       for (auto& f : beta) f.fill(0.375);
+      if (kind == Coefficients::OneUlpOff) beta[2](0, 3, 5, b) = std::nextafter(0.375, 1.0);
       Multigrid mg(forest, bc.kind);
-      if (helmholtz) mg.set_coefficients(&alpha, &beta);
+      if (kind != Coefficients::Poisson) mg.set_coefficients(&alpha, &beta);
+      SCOPED_TRACE(std::string(refined ? "refined" : "uniform") +
+                   std::to_string(static_cast<int>(kind)));
+      // (One ulp on one of 4 fine faces rounds away in the coarser levels' means.)
+      EXPECT_EQ(mg.constant_coefficients(0), kind != Coefficients::OneUlpOff);
+      if (kind != Coefficients::OneUlpOff) {
+        EXPECT_TRUE(mg.constant_coefficients(1));
+      }
       const BlockField rhs = testing::sample(forest, testing::dirichlet_source);
       MultigridOptions options;
       options.tolerance = 1e-10;
@@ -179,11 +191,9 @@ TEST(FlowMultigrid, UniformCoefficientKernelsGiveTheSameBitsAsTheGeneralOnes) {
                                   BlockField(forest.local_blocks(), b)};
       std::array<MultigridReport, 2> report;
       for (int general = 0; general < 2; ++general) {
-        options.uniform_coefficient_kernels = general == 0;
+        options.constant_coefficient_kernels = general == 0;
         report[general] = mg.solve(x[general], rhs, bc, options);
       }
-      SCOPED_TRACE(std::string(refined ? "refined" : "uniform") +
-                   (helmholtz ? " Helmholtz" : " Poisson"));
       EXPECT_TRUE(report[0].converged);
       ASSERT_EQ(report[0].residuals.size(), report[1].residuals.size());
       for (std::size_t c = 0; c < report[0].residuals.size(); ++c)
