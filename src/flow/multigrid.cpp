@@ -629,8 +629,11 @@ void Multigrid::vcycle(int level, BlockField& x, const BlockField& rhs, const Sc
   coarse.x.fill(0.0);
   vcycle(level + 1, coarse.x, coarse.rhs, nullptr);
   fill_ghosts(level + 1, coarse.x, nullptr, false, false);  // values, not matched fluxes
-  // Trilinear prolongation of the correction (weights 3/4, 1/4 per direction).
+  // Trilinear prolongation of the correction (weights 3/4, 1/4 per direction),
+  // from active coarse cells only. On a constant-coefficient level every cell
+  // and ghost is active (1 exactly), so the factor is skipped: same bits.
   const int b = fine.cells;
+  const bool all_active = coarse.constant_coefficients && constant_kernels_;
   forest_.for_each_block([&](int blk) {
     for (int k = 0; k < b; ++k)
       for (int j = 0; j < b; ++j)
@@ -642,8 +645,8 @@ void Multigrid::vcycle(int level, BlockField& x, const BlockField& rhs, const Sc
             for (int dj = 0; dj < 2; ++dj)
               for (int di = 0; di < 2; ++di) {
                 const int ii = ci + di * si, jj = cj + dj * sj, kk = ck + dk * sk;
-                const double w = (di ? 0.25 : 0.75) * (dj ? 0.25 : 0.75) * (dk ? 0.25 : 0.75) *
-                                 coarse.active(blk, ii, jj, kk);
+                double w = (di ? 0.25 : 0.75) * (dj ? 0.25 : 0.75) * (dk ? 0.25 : 0.75);
+                if (!all_active) w *= coarse.active(blk, ii, jj, kk);
                 value += w * coarse.x(blk, ii, jj, kk);
                 weight += w;
               }
