@@ -85,13 +85,15 @@ inline double applied(const double* x, const BlockCoefficients& k, std::ptrdiff_
 }
 
 /// Red-black Gauss-Seidel on the cells of one colour (i + j + k + first even)
-/// of a block whose alpha and beta are constants and that has no matched
-/// coarse-fine face: relaxed_value, the same operations in the same order
-/// (the quadratic Dirichlet closure of the faces flagged in `dirichlet` as in
-/// smooth()), without the coefficient loads (the smoother is memory-bound).
+/// of a block whose alpha and beta are constants: relaxed_value, the same
+/// operations in the same order, with the implicit part of smooth() (the
+/// quadratic Dirichlet closure of the faces flagged in `dirichlet`, the
+/// matched coarse-fine faces flagged in `matched`), without the coefficient
+/// loads (the smoother is memory-bound).
 inline void relax_constant(double* x, const double* rhs, const BlockLayout& L, int first,
                            double alpha, double beta, double inv_h2, double omega,
-                           const std::array<bool, 6>& dirichlet) {
+                           const std::array<bool, 6>& dirichlet,
+                           const std::array<bool, 6>& matched) {
   const int b = L.cells;
   const std::ptrdiff_t sy = L.stride(1), sz = L.stride(2);
   auto diagonal = [&](double implicit) {
@@ -99,24 +101,33 @@ inline void relax_constant(double* x, const double* rhs, const BlockLayout& L, i
     for (int d = 0; d < 3; ++d) den += inv_h2 * (beta + beta);
     return den;
   };
+  std::array<bool, 6> closed{};
+  for (std::size_t f = 0; f < 6; ++f) closed[f] = dirichlet[f] || matched[f];
   const double interior = diagonal(0.0);
-  const bool x_faces = dirichlet[D(face_index(0, 0))] || dirichlet[D(face_index(0, 1))];
+  const bool x_faces = closed[D(face_index(0, 0))] || closed[D(face_index(0, 1))];
   for (int k = 0; k < b; ++k)
     for (int j = 0; j < b; ++j) {
       double* row = x + L.index(0, j, k);
       const double* f = rhs + L.index(0, j, k);
-      const bool closure_row = x_faces || (j == 0 && dirichlet[D(face_index(1, 0))]) ||
-                               (j == b - 1 && dirichlet[D(face_index(1, 1))]) ||
-                               (k == 0 && dirichlet[D(face_index(2, 0))]) ||
-                               (k == b - 1 && dirichlet[D(face_index(2, 1))]);
+      const bool closure_row = x_faces || (j == 0 && closed[D(face_index(1, 0))]) ||
+                               (j == b - 1 && closed[D(face_index(1, 1))]) ||
+                               (k == 0 && closed[D(face_index(2, 0))]) ||
+                               (k == b - 1 && closed[D(face_index(2, 1))]);
       for (int i = (k + j + first) & 1; i < b; i += 2) {
         double implicit = 0.0;
         double den = interior;
         if (closure_row) {
           const std::array<int, 3> n{i, j, k};
           for (int d = 0; d < 3; ++d) {
-            if (dirichlet[D(face_index(d, 0))] && n[D(d)] == 0) implicit += 2.0 * beta;
-            if (dirichlet[D(face_index(d, 1))] && n[D(d)] == b - 1) implicit += 2.0 * beta;
+            const bool low = n[D(d)] == 0, high = n[D(d)] == b - 1;
+            if (dirichlet[D(face_index(d, 0))] && low) implicit += 2.0 * beta;
+            if (dirichlet[D(face_index(d, 1))] && high) implicit += 2.0 * beta;
+            if (matched[D(face_index(d, 0))] && low) {
+              implicit += (kMatchedDiagonal * fine_ghost_self_weight(n, d, 0, b) - 1.0) * beta;
+            }
+            if (matched[D(face_index(d, 1))] && high) {
+              implicit += (kMatchedDiagonal * fine_ghost_self_weight(n, d, 1, b) - 1.0) * beta;
+            }
           }
           den = diagonal(implicit);
         }
@@ -543,11 +554,9 @@ void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const Sc
               any = any || on;
             }
         }
-        bool matched_any = false;
-        for (const bool m : matched) matched_any = matched_any || m;
-        if (constant && !matched_any) {
+        if (constant) {
           relax_constant(xb, rb, L, (parity + colour) & 1, lv.constant_alpha, lv.constant_beta,
-                         inv_h2, omega_, dirichlet);
+                         inv_h2, omega_, dirichlet, matched);
           return;
         }
         for (int kk = 0; kk < b; ++kk)

@@ -58,8 +58,8 @@ struct MultigridOptions {
   /// Levels whose alpha (>= 0) and beta (> 0) are each one value everywhere
   /// (no solid cell, constant viscosity) relax and form residuals reading x
   /// and rhs only: the same operations in the same order, so the same bits
-  /// (the build keeps FMA contraction off). Blocks beside a finer one keep the
-  /// general smoother (matched fluxes); the residual needs no special case.
+  /// (the build keeps FMA contraction off), Dirichlet closures and matched
+  /// coarse-fine faces included; the residual needs no special case.
   /// false: always the general kernels (for tests and comparisons).
   bool constant_coefficient_kernels = true;
 };

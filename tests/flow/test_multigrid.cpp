@@ -155,7 +155,7 @@ TEST(FlowMultigrid, ConstantCoefficientKernelsGiveTheSameBitsAsTheGeneralOnes) {
   // same order: every cell of the solution and every residual of the report
   // must be bitwise the general kernels'. Dirichlet walls (their closure is
   // computed from the constant beta) on a uniform and on a refined forest
-  // (blocks beside finer ones keep the general smoother), Poisson and
+  // (blocks beside finer ones: the matched-face diagonal term), Poisson and
   // Helmholtz; and beta off by one ulp on the last face of one block, which
   // must turn the constant kernels off (detection scans faces 0..b).
   enum class Coefficients { Poisson, Helmholtz, OneUlpOff };
