@@ -277,16 +277,20 @@ void Multigrid::set_coefficients(const BlockField* alpha, const FaceField* beta)
 
 void Multigrid::detect_constant_coefficients() {
   constexpr double kInf = std::numeric_limits<double>::infinity();
+  const int n = forest_.local_blocks();
   for (Level& level : levels_) {
     const int b = level.cells;
-    double a_lo = kInf, a_hi = -kInf, b_lo = kInf, b_hi = -kInf, active_lo = kInf;
-    double not_a_number = 0.0;  // 1 where a coefficient is NaN (min/max would skip it)
-    auto take = [&](double v, double& lo, double& hi) {
-      lo = std::min(lo, v);
-      hi = std::max(hi, v);
-      if (std::isnan(v)) not_a_number = 1.0;
-    };
-    for (int blk = 0; blk < forest_.local_blocks(); ++blk) {
+    level.block_constant.assign(static_cast<std::size_t>(n), 0);
+    level.block_alpha.assign(static_cast<std::size_t>(n), 0.0);
+    level.block_beta.assign(static_cast<std::size_t>(n), 0.0);
+    forest_.for_each_block([&](int blk) {
+      double a_lo = kInf, a_hi = -kInf, b_lo = kInf, b_hi = -kInf, active_lo = kInf;
+      bool not_a_number = false;  // min/max would skip a NaN
+      auto take = [&](double v, double& lo, double& hi) {
+        lo = std::min(lo, v);
+        hi = std::max(hi, v);
+        not_a_number = not_a_number || std::isnan(v);
+      };
       for (int k = 0; k < b; ++k)
         for (int j = 0; j < b; ++j)
           for (int i = 0; i < b; ++i) {
@@ -300,22 +304,26 @@ void Multigrid::detect_constant_coefficients() {
           for (int j = 0; j < hi[1]; ++j)
             for (int i = 0; i < hi[0]; ++i) take(level.beta[D(d)](blk, i, j, k), b_lo, b_hi);
       }
-    }
-    a_lo = -forest_.max(-a_lo);
-    a_hi = forest_.max(a_hi);
-    b_lo = -forest_.max(-b_lo);
-    b_hi = forest_.max(b_hi);
-    active_lo = -forest_.max(-active_lo);
-    not_a_number = forest_.max(not_a_number);
-    // The constant kernels drop relaxed_value's den > 0 test and the residual's
-    // factor `active`: valid with alpha >= 0, beta > 0 and every cell active.
-    // One signed zero for alpha (a mix of +0 and -0 compares equal).
-    level.constant_coefficients = not_a_number == 0.0 && a_lo == a_hi && b_lo == b_hi &&
-                                  a_lo >= 0.0 && b_lo > 0.0 && active_lo == 1.0 &&
-                                  std::signbit(a_lo) == std::signbit(a_hi);
-    level.constant_alpha = a_lo;
-    level.constant_beta = b_lo;
+      // The constant kernels drop relaxed_value's den > 0 test and the
+      // residual's factor `active`: valid with alpha >= 0, beta > 0 and every
+      // cell active. One signed zero for alpha (+0 and -0 compare equal).
+      const auto at = static_cast<std::size_t>(blk);
+      level.block_constant[at] = !not_a_number && a_lo == a_hi && b_lo == b_hi && a_lo >= 0.0 &&
+                                 b_lo > 0.0 && active_lo == 1.0 &&
+                                 std::signbit(a_lo) == std::signbit(a_hi);
+      level.block_alpha[at] = a_lo;
+      level.block_beta[at] = b_lo;
+    });
+    double all = 1.0;
+    for (const unsigned char c : level.block_constant) all = c ? all : 0.0;
+    level.constant_coefficients = -forest_.max(-all) == 1.0;
   }
+}
+
+int Multigrid::constant_blocks(int level) const {
+  int count = 0;
+  for (const unsigned char c : levels_[D(level)].block_constant) count += c ? 1 : 0;
+  return count;
 }
 
 void Multigrid::compute_activity() {
@@ -509,7 +517,6 @@ void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const Sc
   const BlockLayout L = x.layout();
   const int b = L.cells;
   const std::array<std::ptrdiff_t, 3> s{L.stride(0), L.stride(1), L.stride(2)};
-  const bool constant = lv.constant_coefficients && constant_kernels_;
   for (int sweep = 0; sweep < sweeps; ++sweep) {
     for (int colour = 0; colour < 2; ++colour) {
       fill_ghosts(level, x, bc, true);  // the 7-point stencil reads face ghosts only
@@ -554,8 +561,9 @@ void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const Sc
               any = any || on;
             }
         }
-        if (constant) {
-          relax_constant(xb, rb, L, (parity + colour) & 1, lv.constant_alpha, lv.constant_beta,
+        const auto at = static_cast<std::size_t>(blk);
+        if (constant_kernels_ && lv.block_constant[at]) {
+          relax_constant(xb, rb, L, (parity + colour) & 1, lv.block_alpha[at], lv.block_beta[at],
                          inv_h2, omega_, dirichlet, matched);
           return;
         }
@@ -612,8 +620,9 @@ void Multigrid::compute_residual(int level, BlockField& x, const BlockField& rhs
     const double* fb = rhs.block(blk);
     const double* ab = lv.active.block(blk);
     double* rb = r.block(blk);
-    if (lv.constant_coefficients && constant_kernels_) {
-      residual_constant(xb, fb, rb, L, lv.constant_alpha, lv.constant_beta, inv_h2);
+    const auto at = static_cast<std::size_t>(blk);
+    if (constant_kernels_ && lv.block_constant[at]) {
+      residual_constant(xb, fb, rb, L, lv.block_alpha[at], lv.block_beta[at], inv_h2);
       return;
     }
     for (int kk = 0; kk < b; ++kk)

@@ -55,12 +55,11 @@ struct MultigridOptions {
   /// Also stop when |r|_2 <= absolute_tolerance (a floor above round-off for
   /// right-hand sides that are round-off themselves).
   double absolute_tolerance = 0.0;
-  /// Levels whose alpha (>= 0) and beta (> 0) are each one value everywhere
-  /// (no solid cell, constant viscosity) relax and form residuals reading x
-  /// and rhs only: the same operations in the same order, so the same bits
-  /// (the build keeps FMA contraction off), Dirichlet closures and matched
-  /// coarse-fine faces included; the residual needs no special case.
-  /// false: always the general kernels (for tests and comparisons).
+  /// Blocks whose alpha (>= 0) and beta (> 0) are each one value (no solid
+  /// cell, constant viscosity) relax and form residuals reading x and rhs only: the same operations
+  /// in the same order, so the same bits (the build keeps FMA contraction off), Dirichlet closures
+  /// and matched coarse-fine faces included; the residual needs no special case. false: always the
+  /// general kernels (for tests and comparisons).
   bool constant_coefficient_kernels = true;
 };
 
@@ -92,11 +91,14 @@ class Multigrid {
   /// r = rhs - A x on the finest level (fills x's ghosts with bc).
   void residual(BlockField& x, const BlockField& rhs, const ScalarBoundary& bc, BlockField& r);
 
-  /// Whether `level` (0: finest) runs the constant-coefficient kernels when
-  /// MultigridOptions::constant_coefficient_kernels is on.
+  /// Whether every block of `level` (0: finest), on every rank, runs the
+  /// constant-coefficient kernels when MultigridOptions::constant_coefficient_kernels
+  /// is on.
   [[nodiscard]] bool constant_coefficients(int level) const {
     return levels_[static_cast<std::size_t>(level)].constant_coefficients;
   }
+  /// How many of this rank's blocks of `level` run them.
+  [[nodiscard]] int constant_blocks(int level) const;
 
   /// True when the operator has the constants as null space (alpha = 0, no
   /// Dirichlet face): the solution is returned with zero mean.
@@ -109,9 +111,12 @@ class Multigrid {
     FaceField beta;
     BlockField active;  ///< 1 where the cell takes part (some open face or alpha > 0), else 0
     std::array<BlockField, 6> face_flux;  ///< composite grids: fine-side fluxes by face
-    /// alpha and beta (> 0) each one value on every cell and face of every rank.
+    /// Per local block: 1 where alpha (>= 0) and beta (> 0) are each one value
+    /// on the block's cells and faces 0..b and every cell is active; the values.
+    std::vector<unsigned char> block_constant;
+    std::vector<double> block_alpha, block_beta;
+    /// Every block of every rank constant (then every cell and ghost is active).
     bool constant_coefficients = false;
-    double constant_alpha = 0.0, constant_beta = 0.0;
   };
   /// Ghosts from the neighbours (Forest::exchange) and the boundary; on
   /// composite grids, coarse ghosts at coarse-fine faces then carry the

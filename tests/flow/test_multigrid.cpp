@@ -156,12 +156,13 @@ TEST(FlowMultigrid, ConstantCoefficientKernelsGiveTheSameBitsAsTheGeneralOnes) {
   // must be bitwise the general kernels'. Dirichlet walls (their closure is
   // computed from the constant beta) on a uniform and on a refined forest
   // (blocks beside finer ones: the matched-face diagonal term), Poisson and
-  // Helmholtz; and beta off by one ulp on the last face of one block, which
-  // must turn the constant kernels off (detection scans faces 0..b).
-  enum class Coefficients { Poisson, Helmholtz, OneUlpOff };
+  // Helmholtz; beta off by one ulp on the last face of one block, which must
+  // turn the constant kernels off for that block only (detection scans faces
+  // 0..b); and a solid slab (beta = 0 on its faces) in the blocks of z < 1/4.
+  enum class Coefficients { Poisson, Helmholtz, OneUlpOff, SolidSlab };
   for (const bool refined : {false, true}) {
-    for (const Coefficients kind :
-         {Coefficients::Poisson, Coefficients::Helmholtz, Coefficients::OneUlpOff}) {
+    for (const Coefficients kind : {Coefficients::Poisson, Coefficients::Helmholtz,
+                                    Coefficients::OneUlpOff, Coefficients::SolidSlab}) {
       ForestSpec spec;
       spec.level = 1;
       Forest forest(spec);
@@ -175,14 +176,39 @@ TEST(FlowMultigrid, ConstantCoefficientKernelsGiveTheSameBitsAsTheGeneralOnes) {
       FaceField beta = make_vector_field(forest.local_blocks(), b);
       for (auto& f : beta) f.fill(0.375);
       if (kind == Coefficients::OneUlpOff) beta[2](0, 3, 5, b) = std::nextafter(0.375, 1.0);
+      int slab_blocks = 0;
+      if (kind == Coefficients::SolidSlab) {
+        for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+          if (testing::cell_centre(forest, blk, 0, 0, 0).z >= 0.25) continue;
+          ++slab_blocks;
+          for (auto& f : beta)
+            for (int k = 0; k <= b; ++k)
+              for (int j = 0; j <= b; ++j)
+                for (int i = 0; i <= b; ++i)
+                  if (testing::cell_centre(forest, blk, i, j, k).z < 0.1) f(blk, i, j, k) = 0.0;
+        }
+      }
       Multigrid mg(forest, bc.kind);
-      if (kind != Coefficients::Poisson) mg.set_coefficients(&alpha, &beta);
+      if (kind == Coefficients::SolidSlab) {
+        mg.set_coefficients(nullptr, &beta);  // Poisson: solid cells inactive
+      } else if (kind != Coefficients::Poisson) {
+        mg.set_coefficients(&alpha, &beta);
+      }
       SCOPED_TRACE(std::string(refined ? "refined" : "uniform") +
                    std::to_string(static_cast<int>(kind)));
-      // (One ulp on one of 4 fine faces rounds away in the coarser levels' means.)
-      EXPECT_EQ(mg.constant_coefficients(0), kind != Coefficients::OneUlpOff);
-      if (kind != Coefficients::OneUlpOff) {
+      const bool all = kind == Coefficients::Poisson || kind == Coefficients::Helmholtz;
+      EXPECT_EQ(mg.constant_coefficients(0), all);
+      const int n = forest.local_blocks();
+      if (all) {
         EXPECT_TRUE(mg.constant_coefficients(1));
+        EXPECT_EQ(mg.constant_blocks(0), n);
+      }
+      if (kind == Coefficients::OneUlpOff) {
+        EXPECT_EQ(mg.constant_blocks(0), n - 1);
+      }
+      if (kind == Coefficients::SolidSlab) {
+        EXPECT_GT(slab_blocks, 0);
+        EXPECT_EQ(mg.constant_blocks(0), n - slab_blocks);
       }
       const BlockField rhs = testing::sample(forest, testing::dirichlet_source);
       MultigridOptions options;
