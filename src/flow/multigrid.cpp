@@ -84,6 +84,34 @@ inline double applied(const double* x, const BlockCoefficients& k, std::ptrdiff_
   return ax;
 }
 
+/// The part of cell n's ghost values that moves with the cell itself (the
+/// `implicit` of relaxed_value): 2 beta per Dirichlet face (quadratic closure
+/// ghost = (8 g - 6 x0 + x1)/3) and (kMatchedDiagonal w - 1) beta per matched
+/// coarse-fine face. A matched ghost moves with the cell as 1 - 2 w
+/// (fine_ghost_self_weight): exactly, its face has 2 w beta on the diagonal
+/// (kMatchedDiagonal w beta is used, see there). Treating the ghost as fixed
+/// relative to the cell (beta removed from the diagonal, as first written)
+/// makes Gauss-Seidel diverge at coarse cells with finer blocks across two or
+/// three faces (concave refined regions). beta_lo(d), beta_hi(d): the cell's
+/// lower and upper face coefficients along d.
+template <typename Low, typename High>
+double closure_implicit(const std::array<int, 3>& n, int b, const std::array<bool, 6>& dirichlet,
+                        const std::array<bool, 6>& matched, Low beta_lo, High beta_hi) {
+  double implicit = 0.0;
+  for (int d = 0; d < 3; ++d) {
+    const bool low = n[D(d)] == 0, high = n[D(d)] == b - 1;
+    if (dirichlet[D(face_index(d, 0))] && low) implicit += 2.0 * beta_lo(d);
+    if (dirichlet[D(face_index(d, 1))] && high) implicit += 2.0 * beta_hi(d);
+    if (matched[D(face_index(d, 0))] && low) {
+      implicit += (kMatchedDiagonal * fine_ghost_self_weight(n, d, 0, b) - 1.0) * beta_lo(d);
+    }
+    if (matched[D(face_index(d, 1))] && high) {
+      implicit += (kMatchedDiagonal * fine_ghost_self_weight(n, d, 1, b) - 1.0) * beta_hi(d);
+    }
+  }
+  return implicit;
+}
+
 /// Red-black Gauss-Seidel on the cells of one colour (i + j + k + first even)
 /// of a block whose alpha and beta are constants: relaxed_value, the same
 /// operations in the same order, with the implicit part of smooth() (the
@@ -117,18 +145,8 @@ inline void relax_constant(double* x, const double* rhs, const BlockLayout& L, i
         double implicit = 0.0;
         double den = interior;
         if (closure_row) {
-          const std::array<int, 3> n{i, j, k};
-          for (int d = 0; d < 3; ++d) {
-            const bool low = n[D(d)] == 0, high = n[D(d)] == b - 1;
-            if (dirichlet[D(face_index(d, 0))] && low) implicit += 2.0 * beta;
-            if (dirichlet[D(face_index(d, 1))] && high) implicit += 2.0 * beta;
-            if (matched[D(face_index(d, 0))] && low) {
-              implicit += (kMatchedDiagonal * fine_ghost_self_weight(n, d, 0, b) - 1.0) * beta;
-            }
-            if (matched[D(face_index(d, 1))] && high) {
-              implicit += (kMatchedDiagonal * fine_ghost_self_weight(n, d, 1, b) - 1.0) * beta;
-            }
-          }
+          const auto constant = [beta](int) { return beta; };
+          implicit = closure_implicit({i, j, k}, b, dirichlet, matched, constant, constant);
           den = diagonal(implicit);
         }
         double num = f[i] + implicit * inv_h2 * row[i];
@@ -571,32 +589,11 @@ void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const Sc
           for (int j = 0; j < b; ++j)
             for (int i = ((kk + j + parity + colour) & 1); i < b; i += 2) {
               const std::ptrdiff_t c = L.index(i, j, kk);
-              double implicit = 0.0;
-              if (any) {
-                const std::array<int, 3> n{i, j, kk};
-                for (int d = 0; d < 3; ++d) {
-                  if (dirichlet[D(face_index(d, 0))] && n[D(d)] == 0)
-                    implicit += 2.0 * k.beta[D(d)][c];
-                  if (dirichlet[D(face_index(d, 1))] && n[D(d)] == b - 1) {
-                    implicit += 2.0 * k.beta[D(d)][c + s[D(d)]];
-                  }
-                  // A matched ghost moves with the cell as 1 - 2 w
-                  // (fine_ghost_self_weight): exactly, its face has 2 w beta
-                  // on the diagonal (kMatchedDiagonal w beta is used, see
-                  // there). Treating the ghost as fixed relative to the cell
-                  // (beta removed from the diagonal, as first written) makes
-                  // Gauss-Seidel diverge at coarse cells with finer blocks
-                  // across two or three faces (concave refined regions).
-                  if (matched[D(face_index(d, 0))] && n[D(d)] == 0) {
-                    implicit += (kMatchedDiagonal * fine_ghost_self_weight(n, d, 0, b) - 1.0) *
-                                k.beta[D(d)][c];
-                  }
-                  if (matched[D(face_index(d, 1))] && n[D(d)] == b - 1) {
-                    implicit += (kMatchedDiagonal * fine_ghost_self_weight(n, d, 1, b) - 1.0) *
-                                k.beta[D(d)][c + s[D(d)]];
-                  }
-                }
-              }
+              const double implicit = any ? closure_implicit(
+                                                {i, j, kk}, b, dirichlet, matched,
+                                                [&](int d) { return k.beta[D(d)][c]; },
+                                                [&](int d) { return k.beta[D(d)][c + s[D(d)]]; })
+                                          : 0.0;
               xb[c] += omega_ * (relaxed_value(xb, rb[c], k, c, s, inv_h2, implicit) - xb[c]);
             }
       });
