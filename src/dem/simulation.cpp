@@ -1,5 +1,6 @@
 #include "dem/simulation.hpp"
 #include "dem/slab_cuts.hpp"
+#include "dem/sphere_pair_kernel.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -209,40 +210,27 @@ void DemSimulation::compute_forces() {
   const Domain& domain = setup_.domain;
   const bool periodic = domain.periodic[0] || domain.periodic[1] || domain.periodic[2];
 
-  // Sphere-sphere contact k (eq. 2.5-2.13 through evaluate_contact).
-  const auto pair_outcome = [&](std::size_t k) __attribute__((always_inline)) {
+  // Sphere-sphere contacts, a batch at a time (sphere_pair_kernel.hpp).
+  const SpherePairInputs sphere_pairs{x,
+                                      v,
+                                      w,
+                                      rad,
+                                      mat,
+                                      setup_.contacts.data(),
+                                      setup_.contacts.materials(),
+                                      pairs_.first.data(),
+                                      pairs_.second.data(),
+                                      pairs_.history.data(),
+                                      &domain,
+                                      periodic,
+                                      dt};
+  const auto lane_outcome = [](const SpherePairLanes& b, int l) __attribute__((always_inline)) {
     ContactOutcome out;
-    const std::uint32_t i = pairs_.first[k];
-    const std::uint32_t j = pairs_.second[k];
-    ContactHistory& h = pairs_.history[k];
-    Vec3 d = x[j] - x[i];
-    if (periodic) d = domain.near_image(d);
-    const double sum_r = rad[i] + rad[j];
-    const double dist2 = norm2(d);
-    if (dist2 > sum_r * sum_r) {
-      if (h.normal.x != 0.0 || h.normal.y != 0.0 || h.normal.z != 0.0) h = ContactHistory{};
-      return out;
-    }
-    const double dist = std::sqrt(dist2);
-    const Vec3 normal = dist > 0.0 ? (1.0 / dist) * d : Vec3{0.0, 0.0, 1.0};
-    ContactKinematics c;
-    c.normal = normal;
-    c.overlap = sum_r - dist;
-    // Lever arms from the centres to the contact point (midpoint of the overlap):
-    // C - x_i = a_i n and C - x_j = -a_j n, so both moments share n x F.
-    const double a_i = rad[i] - 0.5 * c.overlap;
-    const double a_j = rad[j] - 0.5 * c.overlap;
-    c.relative_velocity = (v[i] - v[j]) + cross(a_i * w[i] + a_j * w[j], normal);
-    c.relative_angular_velocity = w[i] - w[j];
-    c.reduced_radius = rad[i] * rad[j] / sum_r;
-    const ContactResponse r = evaluate_contact(
-        setup_.contacts.get(static_cast<std::size_t>(mat[i]), static_cast<std::size_t>(mat[j])), c,
-        h, dt);
-    const Vec3 moment = cross(normal, r.force);
-    out.force = r.force;
-    out.torque_first = a_i * moment + r.rolling_torque;
-    out.torque_second = a_j * moment - r.rolling_torque;
-    out.overlap_ratio = c.overlap / std::min(rad[i], rad[j]);
+    if (b.touching[l] == 0.0) return out;
+    out.force = {b.fx[l], b.fy[l], b.fz[l]};
+    out.torque_first = {b.t1x[l], b.t1y[l], b.t1z[l]};
+    out.torque_second = {b.t2x[l], b.t2y[l], b.t2z[l]};
+    out.overlap_ratio = b.ratio[l];
     out.touching = true;
     return out;
   };
@@ -393,8 +381,14 @@ void DemSimulation::compute_forces() {
       deep += o.deep;
       worst = std::max(worst, o.overlap_ratio);
     };
-    for (std::size_t k = 0; k < n_pairs; ++k)
-      add_pair(pair_outcome(k), pairs_.first[k], pairs_.second[k]);
+    SpherePairLanes lanes;
+    for (std::size_t k0 = 0; k0 < n_pairs; k0 += SpherePairLanes::kLanes) {
+      const int n = static_cast<int>(std::min<std::size_t>(SpherePairLanes::kLanes, n_pairs - k0));
+      const auto index = [k0](int l) { return k0 + static_cast<std::size_t>(l); };
+      evaluate_sphere_pairs(sphere_pairs, index, n, lanes, [&](int l, std::size_t k) {
+        add_pair(lane_outcome(lanes, l), pairs_.first[k], pairs_.second[k]);
+      });
+    }
     for (std::size_t k = 0; k < n_body_pairs; ++k) {
       add_pair(body_pair_outcome(k), body_pairs_.first[k], body_pairs_.second[k]);
     }
@@ -463,10 +457,19 @@ void DemSimulation::compute_forces() {
           deep += o.deep;
           worst = std::max(worst, o.overlap_ratio);
         };
-        for (const std::uint32_t k : block_pairs_.of(bu)) {
-          const ContactOutcome o = pair_outcome(k);
-          tally(o, touching_pairs);
-          pair_step(o, pairs_.first[k], pairs_.second[k], pair_touching_[k], pair_buffer_[k]);
+        const std::span<const std::uint32_t> block = block_pairs_.of(bu);
+        SpherePairLanes lanes;
+        for (std::size_t e0 = 0; e0 < block.size(); e0 += SpherePairLanes::kLanes) {
+          const int n =
+              static_cast<int>(std::min<std::size_t>(SpherePairLanes::kLanes, block.size() - e0));
+          const auto index = [&block, e0](int l) {
+            return std::size_t{block[e0 + static_cast<std::size_t>(l)]};
+          };
+          evaluate_sphere_pairs(sphere_pairs, index, n, lanes, [&](int l, std::size_t k) {
+            const ContactOutcome o = lane_outcome(lanes, l);
+            tally(o, touching_pairs);
+            pair_step(o, pairs_.first[k], pairs_.second[k], pair_touching_[k], pair_buffer_[k]);
+          });
         }
         for (const std::uint32_t k : block_body_pairs_.of(bu)) {
           const ContactOutcome o = body_pair_outcome(k);
@@ -763,7 +766,8 @@ void DemSimulation::build_blocks() {
   const std::vector<std::size_t> cut = equal_weight_cuts(work, blocks);
   std::vector<std::uint32_t> block_of_bin(kBins);
   for (std::size_t b = 0; b < blocks; ++b) {
-    for (std::size_t k = cut[b]; k < cut[b + 1]; ++k) block_of_bin[k] = static_cast<std::uint32_t>(b);
+    for (std::size_t k = cut[b]; k < cut[b + 1]; ++k)
+      block_of_bin[k] = static_cast<std::uint32_t>(b);
   }
   std::vector<std::uint32_t> block(n);
   for (std::size_t i = 0; i < n; ++i) block[i] = block_of_bin[bin[i]];

@@ -35,6 +35,8 @@ class ContactTable {
   const ContactParameters& get(std::size_t a, std::size_t b) const { return table_[a * n_ + b]; }
   bool defined(std::size_t a, std::size_t b) const { return defined_[a * n_ + b]; }
   std::size_t materials() const { return n_; }
+  // Row-major materials x materials array (get(a, b) is data()[a * materials() + b]).
+  const ContactParameters* data() const { return table_.data(); }
 
  private:
   std::size_t n_ = 0;
