@@ -41,6 +41,16 @@ struct ContactResponse {
   double normal_force = 0.0;  // |Fn| [N]
 };
 
+// What one contact contributes to its two bodies (no second body for walls).
+struct ContactOutcome {
+  Vec3 force;          // on the first body (the second gets -force)
+  Vec3 torque_first;   // total torque on the first body
+  Vec3 torque_second;  // total torque on the second body
+  double overlap_ratio = 0.0;
+  bool touching = false;
+  bool deep = false;  // element contact deeper than the crusts
+};
+
 // Rotates a vector lying in the previous tangent plane into the current one by the
 // smallest rotation that takes the old normal onto the new normal (q_rot of eq. 2.8).
 [[gnu::always_inline]] inline Vec3 rotate_into_new_plane(const Vec3& v, const Vec3& old_normal,

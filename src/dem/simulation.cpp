@@ -224,16 +224,6 @@ void DemSimulation::compute_forces() {
                                       &domain,
                                       periodic,
                                       dt};
-  const auto lane_outcome = [](const SpherePairLanes& b, int l) __attribute__((always_inline)) {
-    ContactOutcome out;
-    if (b.touching[l] == 0.0) return out;
-    out.force = {b.fx[l], b.fy[l], b.fz[l]};
-    out.torque_first = {b.t1x[l], b.t1y[l], b.t1z[l]};
-    out.torque_second = {b.t2x[l], b.t2y[l], b.t2z[l]};
-    out.overlap_ratio = b.ratio[l];
-    out.touching = true;
-    return out;
-  };
 
   // Sphere-obstacle contact k.
   const auto wall_outcome = [&](std::size_t k) __attribute__((always_inline)) {
@@ -382,13 +372,11 @@ void DemSimulation::compute_forces() {
       worst = std::max(worst, o.overlap_ratio);
     };
     SpherePairLanes lanes;
-    for (std::size_t k0 = 0; k0 < n_pairs; k0 += SpherePairLanes::kLanes) {
-      const int n = static_cast<int>(std::min<std::size_t>(SpherePairLanes::kLanes, n_pairs - k0));
-      const auto index = [k0](int l) { return k0 + static_cast<std::size_t>(l); };
-      evaluate_sphere_pairs(sphere_pairs, index, n, lanes, [&](int l, std::size_t k) {
-        add_pair(lane_outcome(lanes, l), pairs_.first[k], pairs_.second[k]);
-      });
-    }
+    evaluate_sphere_pairs(
+        sphere_pairs, [](std::size_t e) { return e; }, n_pairs, lanes,
+        [&](std::size_t k, const ContactOutcome& o) {
+          add_pair(o, pairs_.first[k], pairs_.second[k]);
+        });
     for (std::size_t k = 0; k < n_body_pairs; ++k) {
       add_pair(body_pair_outcome(k), body_pairs_.first[k], body_pairs_.second[k]);
     }
@@ -459,18 +447,13 @@ void DemSimulation::compute_forces() {
         };
         const std::span<const std::uint32_t> block = block_pairs_.of(bu);
         SpherePairLanes lanes;
-        for (std::size_t e0 = 0; e0 < block.size(); e0 += SpherePairLanes::kLanes) {
-          const int n =
-              static_cast<int>(std::min<std::size_t>(SpherePairLanes::kLanes, block.size() - e0));
-          const auto index = [&block, e0](int l) {
-            return std::size_t{block[e0 + static_cast<std::size_t>(l)]};
-          };
-          evaluate_sphere_pairs(sphere_pairs, index, n, lanes, [&](int l, std::size_t k) {
-            const ContactOutcome o = lane_outcome(lanes, l);
-            tally(o, touching_pairs);
-            pair_step(o, pairs_.first[k], pairs_.second[k], pair_touching_[k], pair_buffer_[k]);
-          });
-        }
+        evaluate_sphere_pairs(
+            sphere_pairs, [&block](std::size_t e) { return std::size_t{block[e]}; }, block.size(),
+            lanes,
+            [&](std::size_t k, const ContactOutcome& o) {
+              tally(o, touching_pairs);
+              pair_step(o, pairs_.first[k], pairs_.second[k], pair_touching_[k], pair_buffer_[k]);
+            });
         for (const std::uint32_t k : block_body_pairs_.of(bu)) {
           const ContactOutcome o = body_pair_outcome(k);
           tally(o, touching_pairs);

@@ -44,16 +44,6 @@ class ContactTable {
   std::vector<bool> defined_;
 };
 
-// What one contact contributes to its two bodies (no second body for walls).
-struct ContactOutcome {
-  Vec3 force;          // on the first body (the second gets -force)
-  Vec3 torque_first;   // total torque on the first body
-  Vec3 torque_second;  // total torque on the second body
-  double overlap_ratio = 0.0;
-  bool touching = false;
-  bool deep = false;  // element contact deeper than the crusts
-};
-
 // Particles poured into a box-shaped region at a given rate during the run: each is
 // placed at a random position (seeded) where its bounding sphere overlaps nothing; when
 // the region is full the insertion waits for room.

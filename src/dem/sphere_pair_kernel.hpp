@@ -226,10 +226,11 @@ void evaluate_sphere_lanes(SpherePairLanes& b, int n, double dt) {
   }
 }
 
-// One contact at a time, into lane l: the same operations as the three passes, with the
-// branches taken rather than computed on both sides.
-[[gnu::always_inline]] inline void evaluate_sphere_pair(const SpherePairInputs& in, std::size_t k,
-                                                        SpherePairLanes& b, int l) {
+// One contact at a time: the same operations as the three passes, with the branches
+// taken rather than computed on both sides. Updates the memory of contact k.
+[[gnu::always_inline]] inline ContactOutcome evaluate_sphere_pair(const SpherePairInputs& in,
+                                                                  std::size_t k) {
+  ContactOutcome out;
   const std::uint32_t i = in.first[k], j = in.second[k];
   ContactHistory& h = in.history[k];
   Vec3 d = in.position[j] - in.position[i];
@@ -238,11 +239,9 @@ void evaluate_sphere_lanes(SpherePairLanes& b, int n, double dt) {
   const double sum_r = ri + rj;
   const double dist2 = norm2(d);
   if (dist2 > sum_r * sum_r) {
-    b.touching[l] = 0.0;
     if (h.normal.x != 0.0 || h.normal.y != 0.0 || h.normal.z != 0.0) h = ContactHistory{};
-    return;
+    return out;
   }
-  b.touching[l] = 1.0;
   const double dist = std::sqrt(dist2);
   const Vec3 normal = dist > 0.0 ? (1.0 / dist) * d : Vec3{0.0, 0.0, 1.0};
   ContactKinematics c;
@@ -259,22 +258,28 @@ void evaluate_sphere_lanes(SpherePairLanes& b, int n, double dt) {
                                         static_cast<std::size_t>(in.material[j])];
   const ContactResponse r = evaluate_contact(p, c, h, in.dt);
   const Vec3 moment = cross(normal, r.force);
-  const Vec3 t1 = a_i * moment + r.rolling_torque;
-  const Vec3 t2 = a_j * moment - r.rolling_torque;
-  b.fx[l] = r.force.x;
-  b.fy[l] = r.force.y;
-  b.fz[l] = r.force.z;
-  b.t1x[l] = t1.x;
-  b.t1y[l] = t1.y;
-  b.t1z[l] = t1.z;
-  b.t2x[l] = t2.x;
-  b.t2y[l] = t2.y;
-  b.t2z[l] = t2.z;
-  b.ratio[l] = c.overlap / std::min(ri, rj);
+  out.force = r.force;
+  out.torque_first = a_i * moment + r.rolling_torque;
+  out.torque_second = a_j * moment - r.rolling_torque;
+  out.overlap_ratio = c.overlap / std::min(ri, rj);
+  out.touching = true;
+  return out;
+}
+
+// Lane l of a batch as a contact outcome.
+[[gnu::always_inline]] inline ContactOutcome lane_outcome(const SpherePairLanes& b, int l) {
+  ContactOutcome out;
+  if (b.touching[l] == 0.0) return out;
+  out.force = {b.fx[l], b.fy[l], b.fz[l]};
+  out.torque_first = {b.t1x[l], b.t1y[l], b.t1z[l]};
+  out.torque_second = {b.t2x[l], b.t2y[l], b.t2z[l]};
+  out.overlap_ratio = b.ratio[l];
+  out.touching = true;
+  return out;
 }
 
 // The three passes on contacts index(0) .. index(n - 1), n <= kLanes; the third hands
-// each lane to use(l, k) once its memory is stored (in lane order).
+// each outcome to use(k, outcome) once the memory of contact k is stored, in order.
 template <class Index, class Use>
 [[gnu::always_inline]] inline void evaluate_sphere_pairs_batched(const SpherePairInputs& in,
                                                                  Index index, int n,
@@ -294,41 +299,49 @@ template <class Index, class Use>
   for (int l = 0; l < n; ++l) {
     const std::size_t k = index(l);
     store_sphere_history(b, l, in.history[k]);
-    use(l, k);
+    use(k, lane_outcome(b, l));
   }
 }
 
 template <class Index, class Use>
 [[gnu::always_inline]] inline void evaluate_sphere_pairs_one_by_one(const SpherePairInputs& in,
-                                                                    Index index, int n,
-                                                                    SpherePairLanes& b, Use use) {
+                                                                    Index index, int n, Use use) {
   for (int l = 0; l < n; ++l) {
     const std::size_t k = index(l);
-    evaluate_sphere_pair(in, k, b, l);
-    use(l, k);
+    use(k, evaluate_sphere_pair(in, k));
   }
 }
 
-// Batches pay where a vector register holds four doubles or more (measured on the
-// dem-spheres benchmark, AMD EPYC: one contact at a time 8.9e6 particle-steps/s in the
-// default x86-64 build; batches 8.1e6 there, with SSE2's two doubles per register, but
-// 1.09e7 with AVX2 and 1.2e7 with AVX-512). The build chooses; the results are the same.
+// Batches pay where a vector register holds four doubles or more (dem-spheres benchmark,
+// AMD EPYC, particle-steps/s: one contact at a time 8.9e6 in the baseline x86-64 build,
+// batches 8.1e6 there with SSE2's two doubles per register, but 1.1e7 with AVX2 and 1.4e7
+// with AVX-512; docs/performance.md). The build chooses; the results are the same bits.
 #if defined(__AVX2__) || defined(__AVX512F__)
 inline constexpr bool kBatchedSpherePairs = true;
 #else
 inline constexpr bool kBatchedSpherePairs = false;
 #endif
 
-// Contacts index(0) .. index(n - 1) (n <= kLanes) into the lanes of `b` (touching, force,
-// torques, overlap ratio), their memories updated; use(l, k) is called for each lane l, in
-// order, with its contact k, once lane l is complete.
+// Contacts index(0) .. index(count - 1), their memories updated; use(k, outcome) is called
+// for each, in that order, once contact k is complete. `b` is working space.
 template <class Index, class Use>
 [[gnu::always_inline]] inline void evaluate_sphere_pairs(const SpherePairInputs& in, Index index,
-                                                         int n, SpherePairLanes& b, Use use) {
+                                                         std::size_t count, SpherePairLanes& b,
+                                                         Use use) {
   if constexpr (kBatchedSpherePairs) {
-    evaluate_sphere_pairs_batched(in, index, n, b, use);
+    constexpr auto lanes = static_cast<std::size_t>(SpherePairLanes::kLanes);
+    for (std::size_t e0 = 0; e0 < count; e0 += lanes) {
+      const int n = static_cast<int>(std::min(lanes, count - e0));
+      const auto batch_index = [&index, e0](int l) {
+        return index(e0 + static_cast<std::size_t>(l));
+      };
+      evaluate_sphere_pairs_batched(in, batch_index, n, b, use);
+    }
   } else {
-    evaluate_sphere_pairs_one_by_one(in, index, n, b, use);
+    for (std::size_t e = 0; e < count; ++e) {
+      const std::size_t k = index(e);
+      use(k, evaluate_sphere_pair(in, k));
+    }
   }
 }
 

@@ -107,7 +107,7 @@ void compare_paths(int materials, bool rolling, std::size_t pairs, bool shuffled
   if (shuffled) std::shuffle(order.begin(), order.end(), rng);
 
   std::size_t touching = 0, sliding = 0, continuing = 0;
-  SpherePairLanes lanes, ref;
+  SpherePairLanes lanes;
   for (int step = 0; step < 4; ++step) {
     for (std::size_t e0 = 0; e0 < pairs; e0 += SpherePairLanes::kLanes) {
       const int n = static_cast<int>(std::min<std::size_t>(SpherePairLanes::kLanes, pairs - e0));
@@ -116,32 +116,37 @@ void compare_paths(int materials, bool rolling, std::size_t pairs, bool shuffled
       };
       for (int l = 0; l < n; ++l) continuing += batched[index(l)].normal == Vec3{} ? 0 : 1;
       std::vector<std::size_t> used, used_ref;
-      evaluate_sphere_pairs_batched(inputs(batched), index, n, lanes, [&](int l, std::size_t k) {
-        used.push_back(k);
-        EXPECT_EQ(k, index(l));
-      });
-      evaluate_sphere_pairs_one_by_one(inputs(scalar), index, n, ref,
-                                       [&](int, std::size_t k) { used_ref.push_back(k); });
-      ASSERT_EQ(used, used_ref);  // every lane handed over once, in order
+      std::vector<ContactOutcome> outcomes, outcomes_ref;
+      evaluate_sphere_pairs_batched(inputs(batched), index, n, lanes,
+                                    [&](std::size_t k, const ContactOutcome& o) {
+                                      used.push_back(k);
+                                      outcomes.push_back(o);
+                                    });
+      evaluate_sphere_pairs_one_by_one(inputs(scalar), index, n,
+                                       [&](std::size_t k, const ContactOutcome& o) {
+                                         used_ref.push_back(k);
+                                         outcomes_ref.push_back(o);
+                                       });
       ASSERT_EQ(used.size(), static_cast<std::size_t>(n));
+      ASSERT_EQ(used, used_ref);  // every contact handed over once, in batch order
       for (int l = 0; l < n; ++l) {
         const std::size_t k = index(l);
-        ASSERT_EQ(lanes.touching[l], ref.touching[l]) << "contact " << k;
-        if (ref.touching[l] != 0.0) {
+        EXPECT_EQ(used[static_cast<std::size_t>(l)], k);
+        const ContactOutcome& o = outcomes[static_cast<std::size_t>(l)];
+        const ContactOutcome& ref = outcomes_ref[static_cast<std::size_t>(l)];
+        ASSERT_EQ(o.touching, ref.touching) << "contact " << k;
+        if (ref.touching) {
           ++touching;
-          const Vec3 f{lanes.fx[l], lanes.fy[l], lanes.fz[l]};
-          expect_same_bits(f, {ref.fx[l], ref.fy[l], ref.fz[l]}, "force", k);
-          expect_same_bits({lanes.t1x[l], lanes.t1y[l], lanes.t1z[l]},
-                           {ref.t1x[l], ref.t1y[l], ref.t1z[l]}, "first torque", k);
-          expect_same_bits({lanes.t2x[l], lanes.t2y[l], lanes.t2z[l]},
-                           {ref.t2x[l], ref.t2y[l], ref.t2z[l]}, "second torque", k);
-          EXPECT_EQ(lanes.ratio[l], ref.ratio[l]) << "contact " << k;
+          expect_same_bits(o.force, ref.force, "force", k);
+          expect_same_bits(o.torque_first, ref.torque_first, "first torque", k);
+          expect_same_bits(o.torque_second, ref.torque_second, "second torque", k);
+          EXPECT_EQ(o.overlap_ratio, ref.overlap_ratio) << "contact " << k;
           // Sliding: the tangential force is at the Coulomb bound.
           const ContactParameters& p = table[static_cast<std::size_t>(
               s.material[s.first[k]] * materials + s.material[s.second[k]])];
           const Vec3& n_k = scalar[k].normal;
-          const double fn = -dot(f, n_k);
-          const Vec3 ft = f + fn * n_k;
+          const double fn = -dot(o.force, n_k);
+          const Vec3 ft = o.force + fn * n_k;
           if (fn > 0.0 && norm(ft) >= 0.999 * p.friction * fn) ++sliding;
         }
         expect_same_bits(batched[k].tangential_displacement, scalar[k].tangential_displacement,
