@@ -56,6 +56,16 @@ struct SpherePairLanes {
   bool rolling = false;                 // some lane has rolling resistance
 };
 
+// Lane l of three component arrays, as a vector.
+[[gnu::always_inline]] inline void put_lane(double* x, double* y, double* z, int l, const Vec3& v) {
+  x[l] = v.x;
+  y[l] = v.y;
+  z[l] = v.z;
+}
+[[gnu::always_inline]] inline Vec3 lane(const double* x, const double* y, const double* z, int l) {
+  return {x[l], y[l], z[l]};
+}
+
 // Read-only view of what the sphere-sphere law needs; `history` is read and written.
 struct SpherePairInputs {
   const Vec3* position;
@@ -72,6 +82,35 @@ struct SpherePairInputs {
   bool periodic;
   double dt;
 };
+
+// Kinematics of two spheres of radii ri, rj whose centres are d apart (d = x_j - x_i,
+// dist2 = |d|^2, within ri + rj), with v_i - v_j = dv and spins wi, wj; a_i and a_j are
+// the lever arms from the centres to the contact point.
+struct SpherePairGeometry {
+  ContactKinematics kinematics;
+  double a_i = 0.0, a_j = 0.0;
+};
+
+[[gnu::always_inline]] inline SpherePairGeometry sphere_pair_geometry(const Vec3& d, double dist2,
+                                                                      double ri, double rj,
+                                                                      const Vec3& dv,
+                                                                      const Vec3& wi,
+                                                                      const Vec3& wj) {
+  SpherePairGeometry g;
+  ContactKinematics& c = g.kinematics;
+  const double sum_r = ri + rj;
+  const double dist = std::sqrt(dist2);
+  c.normal = dist > 0.0 ? (1.0 / dist) * d : Vec3{0.0, 0.0, 1.0};
+  c.overlap = sum_r - dist;
+  // Lever arms from the centres to the contact point (midpoint of the overlap):
+  // C - x_i = a_i n and C - x_j = -a_j n, so both moments share n x F.
+  g.a_i = ri - 0.5 * c.overlap;
+  g.a_j = rj - 0.5 * c.overlap;
+  c.relative_velocity = dv + cross(g.a_i * wi + g.a_j * wj, c.normal);
+  c.relative_angular_velocity = wi - wj;
+  c.reduced_radius = ri * rj / sum_r;
+  return g;
+}
 
 // Pass (1): contact index(l) into lane l, for l < n.
 template <class Index>
@@ -91,37 +130,23 @@ template <class Index>
     const std::uint32_t i = in.first[k], j = in.second[k];
     Vec3 d = in.position[j] - in.position[i];
     if (in.periodic) d = in.domain->near_image(d);
-    b.dx[l] = d.x;
-    b.dy[l] = d.y;
-    b.dz[l] = d.z;
+    put_lane(b.dx, b.dy, b.dz, l, d);
     b.ri[l] = in.radius[i];
     b.rj[l] = in.radius[j];
     const Vec3 dv = in.velocity[i] - in.velocity[j];
-    b.dvx[l] = dv.x;
-    b.dvy[l] = dv.y;
-    b.dvz[l] = dv.z;
+    put_lane(b.dvx, b.dvy, b.dvz, l, dv);
     const Vec3& wi = in.angular_velocity[i];
     const Vec3& wj = in.angular_velocity[j];
-    b.wix[l] = wi.x;
-    b.wiy[l] = wi.y;
-    b.wiz[l] = wi.z;
-    b.wjx[l] = wj.x;
-    b.wjy[l] = wj.y;
-    b.wjz[l] = wj.z;
+    put_lane(b.wix, b.wiy, b.wiz, l, wi);
+    put_lane(b.wjx, b.wjy, b.wjz, l, wj);
     const std::size_t pair = pair_of(i, j);
     b.pair[l] = pair;
     b.uniform = b.uniform && pair == first_pair;
     b.mu_r[l] = in.table[pair].rolling_friction;  // read per lane (evaluate_sphere_lanes)
     const ContactHistory& h = in.history[k];
-    b.tx[l] = h.tangential_displacement.x;
-    b.ty[l] = h.tangential_displacement.y;
-    b.tz[l] = h.tangential_displacement.z;
-    b.mx[l] = h.rolling_spring_torque.x;
-    b.my[l] = h.rolling_spring_torque.y;
-    b.mz[l] = h.rolling_spring_torque.z;
-    b.nx[l] = h.normal.x;
-    b.ny[l] = h.normal.y;
-    b.nz[l] = h.normal.z;
+    put_lane(b.tx, b.ty, b.tz, l, h.tangential_displacement);
+    put_lane(b.mx, b.my, b.mz, l, h.rolling_spring_torque);
+    put_lane(b.nx, b.ny, b.nz, l, h.normal);
   }
   // The parameters: lane 0 only when they are uniform (evaluate_sphere_lanes reads no other).
   for (int l = 0; l < (b.uniform ? std::min(n, 1) : n); ++l) {
@@ -151,25 +176,17 @@ void evaluate_sphere_lanes(SpherePairLanes& b, int n, double dt) {
   };
 #pragma GCC ivdep
   for (int l = 0; l < n; ++l) {
-    const Vec3 d{b.dx[l], b.dy[l], b.dz[l]};
+    const Vec3 d = lane(b.dx, b.dy, b.dz, l);
     const double ri = b.ri[l], rj = b.rj[l];
     const double sum_r = ri + rj;
     const double dist2 = norm2(d);
     b.touching[l] = dist2 > sum_r * sum_r ? 0.0 : 1.0;
-    const double dist = std::sqrt(dist2);
-    const Vec3 normal = dist > 0.0 ? (1.0 / dist) * d : Vec3{0.0, 0.0, 1.0};
-    ContactKinematics c;
-    c.normal = normal;
-    c.overlap = sum_r - dist;
-    // Lever arms from the centres to the contact point (midpoint of the overlap):
-    // C - x_i = a_i n and C - x_j = -a_j n, so both moments share n x F.
-    const double a_i = ri - 0.5 * c.overlap;
-    const double a_j = rj - 0.5 * c.overlap;
-    const Vec3 wi{b.wix[l], b.wiy[l], b.wiz[l]};
-    const Vec3 wj{b.wjx[l], b.wjy[l], b.wjz[l]};
-    c.relative_velocity = Vec3{b.dvx[l], b.dvy[l], b.dvz[l]} + cross(a_i * wi + a_j * wj, normal);
-    c.relative_angular_velocity = wi - wj;
-    c.reduced_radius = ri * rj / sum_r;
+    const SpherePairGeometry g =
+        sphere_pair_geometry(d, dist2, ri, rj, lane(b.dvx, b.dvy, b.dvz, l),
+                             lane(b.wix, b.wiy, b.wiz, l), lane(b.wjx, b.wjy, b.wjz, l));
+    const ContactKinematics& c = g.kinematics;
+    const Vec3& normal = c.normal;
+    const double a_i = g.a_i, a_j = g.a_j;
     ContactParameters p;
     p.normal_stiffness = param(b.kn, l);
     p.normal_damping = param(b.eta_n, l);
@@ -184,32 +201,20 @@ void evaluate_sphere_lanes(SpherePairLanes& b, int n, double dt) {
       p.rolling_friction = b.mu_r[l];
     }
     ContactHistory h;
-    h.tangential_displacement = {b.tx[l], b.ty[l], b.tz[l]};
-    h.rolling_spring_torque = {b.mx[l], b.my[l], b.mz[l]};
-    h.normal = {b.nx[l], b.ny[l], b.nz[l]};
+    h.tangential_displacement = lane(b.tx, b.ty, b.tz, l);
+    h.rolling_spring_torque = lane(b.mx, b.my, b.mz, l);
+    h.normal = lane(b.nx, b.ny, b.nz, l);
     const ContactResponse r = evaluate_contact(p, c, h, dt);
     const Vec3 moment = cross(normal, r.force);
     const Vec3 t1 = a_i * moment + r.rolling_torque;
     const Vec3 t2 = a_j * moment - r.rolling_torque;
-    b.fx[l] = r.force.x;
-    b.fy[l] = r.force.y;
-    b.fz[l] = r.force.z;
-    b.t1x[l] = t1.x;
-    b.t1y[l] = t1.y;
-    b.t1z[l] = t1.z;
-    b.t2x[l] = t2.x;
-    b.t2y[l] = t2.y;
-    b.t2z[l] = t2.z;
+    put_lane(b.fx, b.fy, b.fz, l, r.force);
+    put_lane(b.t1x, b.t1y, b.t1z, l, t1);
+    put_lane(b.t2x, b.t2y, b.t2z, l, t2);
     b.ratio[l] = c.overlap / std::min(ri, rj);
-    b.tx[l] = h.tangential_displacement.x;
-    b.ty[l] = h.tangential_displacement.y;
-    b.tz[l] = h.tangential_displacement.z;
-    b.mx[l] = h.rolling_spring_torque.x;
-    b.my[l] = h.rolling_spring_torque.y;
-    b.mz[l] = h.rolling_spring_torque.z;
-    b.nx[l] = h.normal.x;
-    b.ny[l] = h.normal.y;
-    b.nz[l] = h.normal.z;
+    put_lane(b.tx, b.ty, b.tz, l, h.tangential_displacement);
+    put_lane(b.mx, b.my, b.mz, l, h.rolling_spring_torque);
+    put_lane(b.nx, b.ny, b.nz, l, h.normal);
   }
 }
 
@@ -218,9 +223,9 @@ void evaluate_sphere_lanes(SpherePairLanes& b, int n, double dt) {
 [[gnu::always_inline]] inline void store_sphere_history(const SpherePairLanes& b, int l,
                                                         ContactHistory& h) {
   if (b.touching[l] != 0.0) {
-    h.tangential_displacement = {b.tx[l], b.ty[l], b.tz[l]};
-    h.rolling_spring_torque = {b.mx[l], b.my[l], b.mz[l]};
-    h.normal = {b.nx[l], b.ny[l], b.nz[l]};
+    h.tangential_displacement = lane(b.tx, b.ty, b.tz, l);
+    h.rolling_spring_torque = lane(b.mx, b.my, b.mz, l);
+    h.normal = lane(b.nx, b.ny, b.nz, l);
   } else if (h.normal.x != 0.0 || h.normal.y != 0.0 || h.normal.z != 0.0) {
     h = ContactHistory{};
   }
@@ -242,18 +247,12 @@ void evaluate_sphere_lanes(SpherePairLanes& b, int n, double dt) {
     if (h.normal.x != 0.0 || h.normal.y != 0.0 || h.normal.z != 0.0) h = ContactHistory{};
     return out;
   }
-  const double dist = std::sqrt(dist2);
-  const Vec3 normal = dist > 0.0 ? (1.0 / dist) * d : Vec3{0.0, 0.0, 1.0};
-  ContactKinematics c;
-  c.normal = normal;
-  c.overlap = sum_r - dist;
-  const double a_i = ri - 0.5 * c.overlap;
-  const double a_j = rj - 0.5 * c.overlap;
-  const Vec3* v = in.velocity;
-  const Vec3* w = in.angular_velocity;
-  c.relative_velocity = (v[i] - v[j]) + cross(a_i * w[i] + a_j * w[j], normal);
-  c.relative_angular_velocity = w[i] - w[j];
-  c.reduced_radius = ri * rj / sum_r;
+  const SpherePairGeometry g =
+      sphere_pair_geometry(d, dist2, ri, rj, in.velocity[i] - in.velocity[j],
+                           in.angular_velocity[i], in.angular_velocity[j]);
+  const ContactKinematics& c = g.kinematics;
+  const Vec3& normal = c.normal;
+  const double a_i = g.a_i, a_j = g.a_j;
   const ContactParameters& p = in.table[static_cast<std::size_t>(in.material[i]) * in.materials +
                                         static_cast<std::size_t>(in.material[j])];
   const ContactResponse r = evaluate_contact(p, c, h, in.dt);
@@ -270,9 +269,9 @@ void evaluate_sphere_lanes(SpherePairLanes& b, int n, double dt) {
 [[gnu::always_inline]] inline ContactOutcome lane_outcome(const SpherePairLanes& b, int l) {
   ContactOutcome out;
   if (b.touching[l] == 0.0) return out;
-  out.force = {b.fx[l], b.fy[l], b.fz[l]};
-  out.torque_first = {b.t1x[l], b.t1y[l], b.t1z[l]};
-  out.torque_second = {b.t2x[l], b.t2y[l], b.t2z[l]};
+  out.force = lane(b.fx, b.fy, b.fz, l);
+  out.torque_first = lane(b.t1x, b.t1y, b.t1z, l);
+  out.torque_second = lane(b.t2x, b.t2y, b.t2z, l);
   out.overlap_ratio = b.ratio[l];
   out.touching = true;
   return out;
