@@ -313,7 +313,7 @@ template <class Index, class Use>
 
 // Batches pay where a vector register holds four doubles or more (dem-spheres benchmark,
 // AMD EPYC, particle-steps/s: one contact at a time 8.9e6 in the baseline x86-64 build,
-// batches 8.1e6 there with SSE2's two doubles per register, but 1.1e7 with AVX2 and 1.4e7
+// batches 8.1e6 there with SSE2's two doubles per register, but 1.2e7 with AVX2 and 1.4e7
 // with AVX-512; docs/performance.md). The build chooses; the results are the same bits.
 #if defined(__AVX2__) || defined(__AVX512F__)
 inline constexpr bool kBatchedSpherePairs = true;
