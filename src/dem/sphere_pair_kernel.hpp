@@ -174,7 +174,9 @@ void evaluate_sphere_lanes(SpherePairLanes& b, int n, double dt) {
   const auto param = [](const double* lanes, int l) __attribute__((always_inline)) {
     return kUniform ? lanes[0] : lanes[l];
   };
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC ivdep
+#endif
   for (int l = 0; l < n; ++l) {
     const Vec3 d = lane(b.dx, b.dy, b.dz, l);
     const double ri = b.ri[l], rj = b.rj[l];
