@@ -304,11 +304,13 @@ template <class Index, class Use>
   }
 }
 
+// Contacts index(0) .. index(count - 1), one at a time, each handed to use(k, outcome).
 template <class Index, class Use>
 [[gnu::always_inline]] inline void evaluate_sphere_pairs_one_by_one(const SpherePairInputs& in,
-                                                                    Index index, int n, Use use) {
-  for (int l = 0; l < n; ++l) {
-    const std::size_t k = index(l);
+                                                                    Index index, std::size_t count,
+                                                                    Use use) {
+  for (std::size_t e = 0; e < count; ++e) {
+    const std::size_t k = index(e);
     use(k, evaluate_sphere_pair(in, k));
   }
 }
@@ -339,10 +341,7 @@ template <class Index, class Use>
       evaluate_sphere_pairs_batched(in, batch_index, n, b, use);
     }
   } else {
-    for (std::size_t e = 0; e < count; ++e) {
-      const std::size_t k = index(e);
-      use(k, evaluate_sphere_pair(in, k));
-    }
+    evaluate_sphere_pairs_one_by_one(in, index, count, use);
   }
 }
 

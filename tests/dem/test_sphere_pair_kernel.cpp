@@ -165,11 +165,13 @@ void compare_paths(const Case& cs) {
                                       used.push_back(k);
                                       outcomes.push_back(o);
                                     });
-      evaluate_sphere_pairs_one_by_one(inputs(scalar), index, n,
-                                       [&](std::size_t k, const ContactOutcome& o) {
-                                         used_ref.push_back(k);
-                                         outcomes_ref.push_back(o);
-                                       });
+      evaluate_sphere_pairs_one_by_one(
+          inputs(scalar), [&index](std::size_t e) { return index(static_cast<int>(e)); },
+          static_cast<std::size_t>(n),
+          [&](std::size_t k, const ContactOutcome& o) {
+            used_ref.push_back(k);
+            outcomes_ref.push_back(o);
+          });
       ASSERT_EQ(used.size(), static_cast<std::size_t>(n));
       ASSERT_EQ(used, used_ref);  // every contact handed over once, in batch order
       for (int l = 0; l < n; ++l) {
@@ -283,8 +285,7 @@ TEST(SpherePairKernel, TheDispatcherCutsAnyCountIntoBatchesInOrder) {
           outcomes.push_back(o);
         });
     evaluate_sphere_pairs_one_by_one(
-        inputs(reference), [](int e) { return pairs - 1 - static_cast<std::size_t>(e); },
-        static_cast<int>(pairs),
+        inputs(reference), [](std::size_t e) { return pairs - 1 - e; }, pairs,
         [&](std::size_t k, const ContactOutcome& o) {
           used_ref.push_back(k);
           outcomes_ref.push_back(o);
