@@ -5,6 +5,7 @@
 #include <fstream>
 #include <set>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "core/error.hpp"
@@ -48,7 +49,7 @@ io::HexMesh flow_mesh(NavierStokes& ns) {
             velocity.values.push_back(ns.velocity()[static_cast<std::size_t>(c)](blk, i, j, k));
           pressure.values.push_back(ns.pressure()(blk, i, j, k));
           vort.values.push_back(vorticity(blk, i, j, k));
-          viscosity.values.push_back(ns.viscosity()(blk, i, j, k));
+          viscosity.values.push_back(std::as_const(ns).viscosity()(blk, i, j, k));
           level.values.push_back(block.level);
           rank.values.push_back(forest.rank());
           block_id.values.push_back(blk);

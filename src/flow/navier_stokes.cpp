@@ -305,6 +305,7 @@ void NavierStokes::set_body_force(const std::function<Vec3(const Vec3&)>& f) {
 }
 
 void NavierStokes::set_viscosity(const std::function<double(const Vec3&)>& mu) {
+  if (&mu != &viscosity_function_) viscosity_function_ = mu;
   const int b = forest_.block_cells();
   forest_.for_each_block([&](int blk) {
     const Block& block = forest_.block(blk);
@@ -623,6 +624,56 @@ void NavierStokes::advect_scalar(BlockField& c, double dt) {
   });
 }
 
+template <typename BlockFluxes, typename UpperFlux, typename Update>
+void NavierStokes::update_from_face_fluxes(BlockFluxes&& block_fluxes, UpperFlux&& upper_flux,
+                                           Update&& update) {
+  const BlockLayout L = u_[0].layout();
+  if (!composite_) {
+    forest_.for_each_block([&](int blk) {
+      // Face fluxes of one block, per direction: scratch kept per thread.
+      thread_local std::array<std::vector<double>, 3> flux;
+      for (int d = 0; d < 3; ++d) {
+        flux[D(d)].resize(static_cast<std::size_t>(L.size()));
+        block_fluxes(blk, d, flux[D(d)].data());
+      }
+      update(blk, std::array<const double*, 3>{flux[0].data(), flux[1].data(), flux[2].data()});
+    });
+    return;
+  }
+  // Composite grids: each face's flux is computed once and used by both
+  // cells beside it (conservation to round-off, §4.3.1). Two blocks of one
+  // level would otherwise each evaluate their shared face with their own
+  // ghosts, which differ where a coarser block lies beyond an edge (face
+  // velocities interpolated as if they were cells): the upper block's face 0
+  // wins and reaches the lower block's slot b by the exchange. At coarse-fine
+  // faces the fine faces win: the coarse face takes the mean of the 4.
+  forest_.for_each_block([&](int blk) {
+    for (int d = 0; d < 3; ++d) block_fluxes(blk, d, face_flux_[D(d)].block(blk));
+  });
+  send_faces(forest_, interface_, LevelJump::Coarser,
+             [&](int blk, int d, std::ptrdiff_t f) { return face_flux_[D(d)].block(blk)[f]; });
+  BlockField* fluxes[] = {&face_flux_[0], &face_flux_[1], &face_flux_[2]};
+  forest_.exchange(fluxes, 1, true);
+  forest_.for_each_block([&](int blk) {
+    const Block& block = forest_.block(blk);
+    for (int d = 0; d < 3; ++d) {
+      double* fl = face_flux_[D(d)].block(blk);
+      const Neighbour& upper = block.neighbours[face_neighbour_slot(d, 1)];
+      // The exchange only brings a same-level neighbour's face 0; a domain
+      // boundary or a coarser neighbour leaves slot b to this block.
+      if (upper.link == Link::Boundary || upper.jump == LevelJump::Coarser) {
+        for_face_layer(L, d, 1,
+                       [&](std::ptrdiff_t, std::ptrdiff_t f) { fl[f] = upper_flux(blk, d, f); });
+      }
+    }
+    for_received_faces(
+        forest_, interface_, blk, LevelJump::Finer,
+        [&](int d, std::ptrdiff_t face, double mean) { face_flux_[D(d)].block(blk)[face] = mean; });
+    update(blk, std::array<const double*, 3>{face_flux_[0].block(blk), face_flux_[1].block(blk),
+                                             face_flux_[2].block(blk)});
+  });
+}
+
 void NavierStokes::advect_field(const BlockField& field, const BlockField* source,
                                 const std::array<BcKind, 6>& kinds, BlockField& out, double dt) {
   const int b = forest_.block_cells();
@@ -679,52 +730,14 @@ void NavierStokes::advect_field(const BlockField& field, const BlockField* sourc
       o[c] = f[c] - dt * div / h;
     });
   };
-  if (!composite_) {
-    forest_.for_each_block([&](int blk) {
-      // Face fluxes of one block, per direction: scratch kept per thread.
-      thread_local std::array<std::vector<double>, 3> flux;
-      for (int d = 0; d < 3; ++d) {
-        flux[D(d)].resize(static_cast<std::size_t>(L.size()));
-        block_fluxes(blk, d, flux[D(d)].data());
-      }
-      update(blk, {flux[0].data(), flux[1].data(), flux[2].data()});
-    });
-    return;
-  }
-  // Composite grids: each face's flux is computed once and used by both
-  // cells beside it (conservation to round-off, §4.3.1). Two blocks of one
-  // level would otherwise each evaluate their shared face with their own
-  // ghosts, which differ where a coarser block lies beyond an edge (face
-  // velocities interpolated as if they were cells): the lower block's face 0
-  // wins and reaches the upper block's slot b by the exchange. At coarse-fine
-  // faces the fine faces win: the coarse face takes the mean of the 4.
-  forest_.for_each_block([&](int blk) {
-    for (int d = 0; d < 3; ++d) block_fluxes(blk, d, face_flux_[D(d)].block(blk));
-  });
-  send_faces(forest_, interface_, LevelJump::Coarser,
-             [&](int blk, int d, std::ptrdiff_t f) { return face_flux_[D(d)].block(blk)[f]; });
-  BlockField* fluxes[] = {&face_flux_[0], &face_flux_[1], &face_flux_[2]};
-  forest_.exchange(fluxes, 1, true);
-  forest_.for_each_block([&](int blk) {
-    const Block& block = forest_.block(blk);
-    for (int d = 0; d < 3; ++d) {
-      double* fl = face_flux_[D(d)].block(blk);
-      const Neighbour& upper = block.neighbours[face_neighbour_slot(d, 1)];
-      // The exchange only brings a same-level neighbour's face 0; a domain
-      // boundary or a coarser neighbour leaves slot b to this block.
-      if (upper.link == Link::Boundary || upper.jump == LevelJump::Coarser) {
-        const bool dirichlet_hi =
-            upper.link == Link::Boundary && kinds[D(face_index(d, 1))] == BcKind::Dirichlet;
-        for_face_layer(L, d, 1, [&](std::ptrdiff_t, std::ptrdiff_t f) {
-          fl[f] = face_flux(blk, d, f, b, false, dirichlet_hi);
-        });
-      }
-    }
-    for_received_faces(
-        forest_, interface_, blk, LevelJump::Finer,
-        [&](int d, std::ptrdiff_t face, double mean) { face_flux_[D(d)].block(blk)[face] = mean; });
-    update(blk, {face_flux_[0].block(blk), face_flux_[1].block(blk), face_flux_[2].block(blk)});
-  });
+  update_from_face_fluxes(
+      block_fluxes,
+      [&](int blk, int d, std::ptrdiff_t f) {
+        const bool dirichlet_hi = on_boundary(forest_.block(blk), d, 1) &&
+                                  kinds[D(face_index(d, 1))] == BcKind::Dirichlet;
+        return face_flux(blk, d, f, b, false, dirichlet_hi);
+      },
+      update);
 }
 
 void NavierStokes::update_viscous_coefficients(double dt) {
@@ -738,12 +751,6 @@ void NavierStokes::update_viscous_coefficients(double dt) {
       });
     }
     variable_viscosity_ = forest_.max(hi) > -forest_.max(-lo);
-    // The explicit grad u^T stress is not flux-matched at coarse-fine faces.
-    if (variable_viscosity_ && composite_) {
-      throw std::invalid_argument(
-          "navier-stokes: variable viscosity on a forest with several levels is not available "
-          "yet");
-    }
   }
   const int n = forest_.local_blocks();
   const int b = forest_.block_cells();
@@ -784,74 +791,84 @@ void NavierStokes::update_viscous_coefficients(double dt) {
   viscosity_changed_ = false;
 }
 
-void NavierStokes::add_transpose_stress(double dt) {
-  // eq. 4.1: the part div(mu grad u^T) of the viscous stress, explicit with
-  // u^n (its ghosts are still filled), added to u*: for component i,
-  // (1/h) sum_j [mu (du_j/dx_i)] over the j-faces of the cell. It vanishes
-  // for uniform mu (then div(grad u^T) = grad div u = 0) and is skipped there.
+void NavierStokes::add_viscous_fluxes(double laplacian, bool transpose, double factor,
+                                      VectorField& out) {
+  // For component i the flux through a d-face is
+  //   mu_f [laplacian du_i/dx_d + transpose du_d/dx_i]
+  // with mu_f the harmonic mean of the two cells; out_i += factor div(flux) in
+  // every cell. On composite grids the coarse face takes the fine faces'
+  // mean like every other flux (momentum conserved across coarse-fine faces).
+  // The velocity's ghosts and mu's (width 1) must be filled.
   const int b = forest_.block_cells();
   const BlockLayout L = u_[0].layout();
-  const double factor = dt / fluid_.density;
-  forest_.for_each_block([&](int blk) {
-    const double h = forest_.block(blk).length / b;
-    const double* mu = mu_.block(blk);
-    for (int i = 0; i < 3; ++i) {
-      const std::ptrdiff_t si = L.stride(i);
-      double* out = scratch_[D(i)].block(blk);
+  for (int i = 0; i < 3; ++i) {
+    const std::ptrdiff_t si = L.stride(i);
+    // Flux of component i through the d-face f of a block.
+    auto flux = [&](int blk, int d, std::ptrdiff_t f) {
+      const double h = forest_.block(blk).length / b;
+      const std::ptrdiff_t sd = L.stride(d);
+      const double* mu = mu_.block(blk);
+      double gradient = 0.0;
+      if (laplacian != 0.0) {
+        const double* ui = u_[D(i)].block(blk);
+        gradient += laplacian * (ui[f] - ui[f - sd]) / h;
+      }
+      if (transpose) {
+        const double* ud = u_[D(d)].block(blk);
+        gradient +=
+            i == d ? (ud[f] - ud[f - sd]) / h
+                   : ((ud[f + si] - ud[f - si]) + (ud[f - sd + si] - ud[f - sd - si])) / (4.0 * h);
+      }
+      return open_[D(d)].block(blk)[f] * face_viscosity(mu[f], mu[f - sd]) * gradient;
+    };
+    auto block_fluxes = [&](int blk, int d, double* fl) {
+      for_each_face(b, d, [&](int x, int y, int z) {
+        const std::ptrdiff_t f = L.index(x, y, z);
+        fl[f] = flux(blk, d, f);
+      });
+    };
+    auto update = [&](int blk, const std::array<const double*, 3>& fl) {
+      const double h = forest_.block(blk).length / b;
+      const double* mu = mu_.block(blk);
+      const double* ui = u_[D(i)].block(blk);
+      const double* solid = solid_.block(blk);
+      double* o = out[D(i)].block(blk);
       for_each_cell(b, [&](int x, int y, int z) {
         const std::ptrdiff_t c = L.index(x, y, z);
-        double sum = 0.0;
-        for (int j = 0; j < 3; ++j) {
-          const std::ptrdiff_t sj = L.stride(j);
-          const double* uj = u_[D(j)].block(blk);
-          const double* open = open_[D(j)].block(blk);
-          // du_j/dx_i on the lower (at c) and upper (at c + sj) j-faces.
-          auto gradient = [&](std::ptrdiff_t f) {
-            if (i == j) return (uj[f] - uj[f - sj]) / h;
-            return ((uj[f + si] - uj[f - si]) + (uj[f - sj + si] - uj[f - sj - si])) / (4.0 * h);
-          };
-          sum += open[c + sj] * face_viscosity(mu[c + sj], mu[c]) * gradient(c + sj) -
-                 open[c] * face_viscosity(mu[c], mu[c - sj]) * gradient(c);
+        double sum = 0.0, walls = 0.0;
+        for (int d = 0; d < 3; ++d) {
+          const std::ptrdiff_t sd = L.stride(d);
+          sum += fl[D(d)][c + sd] - fl[D(d)][c];
+          walls += (1.0 - open_[D(d)].block(blk)[c]) + (1.0 - open_[D(d)].block(blk)[c + sd]);
         }
-        out[c] += factor * sum / h;
+        // No-slip faces of solid neighbours: the wall flux 2 mu (0 - u_i)/h.
+        if (solid[c] == 0.0) sum -= laplacian * walls * 2.0 * mu[c] * ui[c] / h;
+        o[c] += factor * sum / h;
       });
-    }
-  });
+    };
+    update_from_face_fluxes(block_fluxes, flux, update);
+  }
+}
+
+VectorField NavierStokes::viscous_force_density() {
+  fill_velocity_ghosts(u_);
+  fill_scalar_neumann(mu_, 1);
+  VectorField force = make_vector_field(forest_.local_blocks(), forest_.block_cells());
+  add_viscous_fluxes(1.0, true, 1.0, force);
+  return force;
 }
 
 void NavierStokes::viscous_step(double dt, StepReport& report) {
   const int b = forest_.block_cells();
-  const BlockLayout L = u_[0].layout();
   const double theta = options_.viscous_theta;
-  // The explicit part (1 - theta) dt/rho div(mu grad u^n) uses u^n, whose
-  // ghosts are still filled: add it to u* first.
-  if (theta < 1.0) {
-    fill_scalar_neumann(mu_, 1);
-    forest_.for_each_block([&](int blk) {
-      const double h = forest_.block(blk).length / b;
-      const double* mu = mu_.block(blk);
-      for (int comp = 0; comp < 3; ++comp) {
-        const double* u = u_[D(comp)].block(blk);
-        double* out = scratch_[D(comp)].block(blk);
-        for_each_cell(b, [&](int i, int j, int k) {
-          const std::ptrdiff_t c = L.index(i, j, k);
-          double lap = 0.0;
-          for (int d = 0; d < 3; ++d) {
-            const std::ptrdiff_t s = L.stride(d);
-            const double open_lo = open_[D(d)].block(blk)[c];
-            const double open_hi = open_[D(d)].block(blk)[c + s];
-            lap += open_hi * face_viscosity(mu[c + s], mu[c]) * (u[c + s] - u[c]) -
-                   open_lo * face_viscosity(mu[c], mu[c - s]) * (u[c] - u[c - s]);
-            // No-slip faces of solid neighbours: 2 mu (0 - u)/h.
-            if (solid_.block(blk)[c] == 0.0) lap -= (2.0 - open_lo - open_hi) * 2.0 * mu[c] * u[c];
-          }
-          out[c] += (1.0 - theta) * dt / fluid_.density * lap / (h * h);
-        });
-      }
-    });
-  }
   update_viscous_coefficients(dt);
-  if (variable_viscosity_) add_transpose_stress(dt);
+  // The explicit parts of the viscous term of eq. 4.1, with u^n (its ghosts
+  // are still filled), added to u*: (1 - theta) div(mu grad u) for
+  // Crank-Nicolson, and div(mu grad u^T), which vanishes for uniform mu
+  // (div(grad u^T) = grad div u = 0) and is skipped there.
+  if (theta < 1.0 || variable_viscosity_) {
+    add_viscous_fluxes(1.0 - theta, variable_viscosity_, dt / fluid_.density, scratch_);
+  }
   for (int comp = 0; comp < 3; ++comp) {
     BlockField& rhs = scratch_[D(comp)];
     BlockField& u = u_[D(comp)];
@@ -1076,10 +1093,6 @@ RegridReport NavierStokes::regrid(Forest& forest, std::span<const AdaptFlag> fla
         "navier-stokes: with solid cells, regrid needs max_level (below 18 and not below the "
         "forest's finest level): the blocks near solids are kept at that level");
   }
-  if (variable_viscosity_) {
-    throw std::invalid_argument(
-        "navier-stokes: variable viscosity on an adapting forest is not available yet");
-  }
   RegridReport report;
   report.blocks_before = forest.global_blocks();
   // phi_ and the scratch fields are rebuilt from p and u at every step.
@@ -1110,6 +1123,7 @@ RegridReport NavierStokes::regrid(Forest& forest, std::span<const AdaptFlag> fla
   viscous_dt_ = -1.0;
   viscosity_changed_ = true;
   if (body_force_) set_body_force(body_force_);
+  if (viscosity_function_) set_viscosity(viscosity_function_);
   if (has_solids_) {
     sample_solid();
     clear_solid_cells(u_);

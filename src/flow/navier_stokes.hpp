@@ -37,8 +37,10 @@
 // level jumps: every block whose cells, or the 2 cells beyond its faces, edges
 // and corners, hold a solid cell is at the finest level (regrid keeps it so), so
 // a coarse-fine face never has a closed face or a wall closure within reach of
-// its stencils. Not available there yet: variable viscosity (the explicit
-// grad u^T stress is not flux-matched).
+// its stencils. Variable viscosity works there too: the implicit part goes
+// through the composite multigrid (flux matching with the fine faces' mu),
+// the explicit parts (grad u^T, and the Crank-Nicolson half) are face fluxes
+// matched like the advective ones.
 
 #include <array>
 #include <cstdint>
@@ -111,7 +113,8 @@ class NavierStokes {
   void set_velocity(const std::function<Vec3(const Vec3&)>& u, double time = 0.0);
   /// Body force density f_b(x) (N/m^3), sampled on faces (again after each regrid).
   void set_body_force(const std::function<Vec3(const Vec3&)>& f);
-  /// Dynamic viscosity mu(x) (Pa s) per cell.
+  /// Dynamic viscosity mu(x) (Pa s) per cell, sampled at cell centres (again
+  /// after each regrid, so that a jump stays sharp on the new cells).
   void set_viscosity(const std::function<double(const Vec3&)>& mu);
 
   /// Solid cells (cell masks aligned with the grid): solid(x) at cell
@@ -152,7 +155,8 @@ class NavierStokes {
   /// so that uf is divergence-free to the projection tolerance, as after a
   /// step. With solid cells, blocks near them are refined to `max_level`
   /// and never coarsened (max_level must then be given), and the mask is
-  /// sampled again. Not with variable viscosity (refused).
+  /// sampled again. A viscosity given by set_viscosity is sampled again too;
+  /// one written through viscosity() is carried like the velocity.
   RegridReport regrid(Forest& forest, std::span<const AdaptFlag> flags,
                       std::span<BlockField* const> scalars = {}, int max_level = kForestMaxLevel);
 
@@ -165,7 +169,12 @@ class NavierStokes {
   [[nodiscard]] BlockField& pressure() { return p_; }
   [[nodiscard]] const BlockField& pressure() const { return p_; }
   [[nodiscard]] const BlockField& viscosity() const { return mu_; }
-  [[nodiscard]] BlockField& viscosity() { return mu_; }
+  /// Writable viscosity field (the coupling sets it from a phase indicator):
+  /// taking it marks the viscous coefficients for rebuilding at the next step.
+  [[nodiscard]] BlockField& viscosity() {
+    viscosity_changed_ = true;
+    return mu_;
+  }
   [[nodiscard]] const VectorField& pressure_gradient() const { return g_; }
   [[nodiscard]] VectorField& pressure_gradient() { return g_; }
   [[nodiscard]] const Fluid& fluid() const { return fluid_; }
@@ -174,6 +183,11 @@ class NavierStokes {
 
   /// Largest |div uf| over all cells (1/s): zero to the projection tolerance.
   [[nodiscard]] double max_divergence() const;
+  /// The viscous force density div(mu (grad u + grad u^T)) (N/m^3) of the
+  /// current velocity at cell centres, from the face fluxes the step's
+  /// explicit part uses: on any forest its volume integral is the flux
+  /// through the domain boundary (zero when periodic) to round-off.
+  [[nodiscard]] VectorField viscous_force_density();
   /// |curl u| at cell centres (1/s), central differences.
   [[nodiscard]] BlockField vorticity_magnitude();
   /// Advects a passive scalar by dt with the current face velocity uf (the
@@ -204,7 +218,18 @@ class NavierStokes {
   void fill_scalar_neumann(BlockField& f, int width);
   void update_viscous_coefficients(double dt);
   void close_solid_faces(FaceField& uf) const;
-  void add_transpose_stress(double dt);
+  /// out += factor div(mu (laplacian grad u + transpose grad u^T)) from face
+  /// fluxes (matched at coarse-fine faces), no-slip solid faces included in
+  /// the first part; u's ghosts and mu's (width 1) must be filled.
+  void add_viscous_fluxes(double laplacian, bool transpose, double factor, VectorField& out);
+  /// Calls update(blk, fluxes) for every block with the fluxes of all its
+  /// faces along the 3 directions: block_fluxes(blk, d, out) writes the faces
+  /// 0..b of a block; on composite grids each shared face is evaluated once,
+  /// upper_flux(blk, d, f) gives a face of layer b where the upper neighbour
+  /// is the boundary or coarser, and coarse faces at coarse-fine faces take
+  /// the mean of the 4 fine ones (conservation to round-off).
+  template <typename BlockFluxes, typename UpperFlux, typename Update>
+  void update_from_face_fluxes(BlockFluxes&& block_fluxes, UpperFlux&& upper_flux, Update&& update);
   void clear_solid_cells(VectorField& u) const;
   /// solid_, open_ and the pressure coefficients from solid_function_.
   void sample_solid();
@@ -244,7 +269,8 @@ class NavierStokes {
   std::optional<Multigrid> pressure_mg_;  ///< rebuilt when the forest adapts
   std::optional<Multigrid> viscous_mg_;
   std::function<Vec3(const Vec3&)> body_force_;  ///< as given, to sample again after a regrid
-  double viscous_dt_ = -1.0;                     ///< dt the viscous coefficients were built for
+  std::function<double(const Vec3&)> viscosity_function_;  ///< likewise, for set_viscosity
+  double viscous_dt_ = -1.0;  ///< dt the viscous coefficients were built for
   bool viscosity_changed_ = true;
   bool has_solids_ = false;
   std::function<bool(const Vec3&)> solid_function_;  ///< as given, to sample again after a regrid
@@ -257,7 +283,7 @@ class NavierStokes {
   /// Composite grids: per block face, the fine faces' values travelling to
   /// the coarse block (face layer of the fine block, see send_faces).
   std::array<BlockField, 6> interface_;
-  FaceField face_flux_;  ///< composite grids: advective fluxes of all faces
+  FaceField face_flux_;  ///< composite grids: advective or viscous fluxes of all faces
 };
 
 }  // namespace sanguis::flow
