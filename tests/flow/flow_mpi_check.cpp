@@ -275,8 +275,10 @@ int check_refined_navier_stokes() {
 
 /// Navier-Stokes on a forest that adapts during the run (a tracer blob in a
 /// sheared stream, the wavelet criterion on the tracer every 2 steps, as in
-/// test_navier_stokes_adaptive, and a small solid cube whose blocks are kept
-/// finest): 2 ranks against 1, blocks refined and coarsened on both and data
+/// test_navier_stokes_adaptive, a small solid cube whose blocks are kept
+/// finest, and a viscosity jump (ratio 10) across x = 0.52, sampled again
+/// at each regrid, so that the matched grad u^T fluxes cross ranks): 2 ranks
+/// against 1, blocks refined and coarsened on both and data
 /// moved between ranks by the repartitions.
 int check_adaptive_navier_stokes() {
   struct Result {
@@ -296,6 +298,7 @@ int check_adaptive_navier_stokes() {
     options.pressure.tolerance = 1e-10;
     options.viscous.tolerance = 1e-10;
     NavierStokes ns(forest, bcs, Fluid{1.0, 1e-3}, options);
+    ns.set_viscosity([](const sanguis::Vec3& x) { return x.x < 0.52 ? 1e-3 : 1e-2; });
     ns.set_solid([](const sanguis::Vec3& x) {
       return x.x > 0.625 && x.x < 0.75 && x.y > 0.625 && x.y < 0.75 && x.z > 0.625 && x.z < 0.75;
     });
@@ -342,7 +345,8 @@ int check_adaptive_navier_stokes() {
   const auto& session = MpiSession::ensure();
   if (session.rank() == 0) {
     std::printf(
-        "adaptive Navier-Stokes (tracer blob, solid cube, regrid every 2 steps), 8 steps: %d "
+        "adaptive Navier-Stokes (tracer blob, solid cube, viscosity jump, regrid every 2 steps), 8 "
+        "steps: %d "
         "ranks vs 1: %lld / %lld blocks, max difference of u, p, the tracer and the force on the "
         "cube %.3e (max |value| %.3f; force x %.6f)\n",
         session.size(), static_cast<long long>(shared.blocks), static_cast<long long>(alone.blocks),
