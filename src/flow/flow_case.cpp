@@ -254,6 +254,17 @@ FlowCase load_flow_case(const ConfigTable& cfg, const std::filesystem::path& sou
     }
     c.solid_boxes.push_back({lo, hi});
   }
+  for (const ConfigTable& region : flow.table_array("viscosity_region")) {
+    FlowCase::ViscosityRegion r;
+    r.min = region.get_vec3("min_m");
+    r.max = region.get_vec3("max_m");
+    for (int d = 0; d < 3; ++d) {
+      if (!(r.max[d] > r.min[d])) region.fail("max_m", "must be above min_m in x, y and z");
+    }
+    r.viscosity = region.get_double("viscosity_Pa_s");
+    if (!(r.viscosity > 0.0)) region.fail("viscosity_Pa_s", "must be > 0");
+    c.viscosity_regions.push_back(r);
+  }
 
   const auto time = flow.find_table("time");
   if (time) {
@@ -293,6 +304,17 @@ FlowCase load_flow_case(const ConfigTable& cfg, const std::filesystem::path& sou
   return c;
 }
 
+double viscosity_at(const FlowCase& c, const Vec3& x) {
+  double mu = c.fluid.viscosity;
+  for (const auto& r : c.viscosity_regions) {
+    if (x.x > r.min.x && x.x < r.max.x && x.y > r.min.y && x.y < r.max.y && x.z > r.min.z &&
+        x.z < r.max.z) {
+      mu = r.viscosity;
+    }
+  }
+  return mu;
+}
+
 std::string describe(const FlowCase& c) {
   std::ostringstream s;
   s.precision(10);
@@ -314,6 +336,10 @@ std::string describe(const FlowCase& c) {
   for (const auto& box : c.solid_boxes) {
     s << "solid box (" << box[0].x << ", " << box[0].y << ", " << box[0].z << ") - (" << box[1].x
       << ", " << box[1].y << ", " << box[1].z << ") m\n";
+  }
+  for (const auto& r : c.viscosity_regions) {
+    s << "viscosity " << r.viscosity << " Pa s in (" << r.min.x << ", " << r.min.y << ", "
+      << r.min.z << ") - (" << r.max.x << ", " << r.max.y << ", " << r.max.z << ") m\n";
   }
   s << "time: end " << c.end_time << " s, cfl " << c.options.cfl << ", max step "
     << c.options.dt_max << " s, viscous theta " << c.options.viscous_theta << "\n"

@@ -44,6 +44,14 @@ struct FlowCase {
   Vec3 body_force{};        ///< uniform body force density (N/m^3)
   /// Solid boxes [min, max] (m): cells whose centre lies inside are solid.
   std::vector<std::array<Vec3, 2>> solid_boxes;
+  /// A box [min, max] (m) of another fluid viscosity.
+  struct ViscosityRegion {
+    Vec3 min, max;
+    double viscosity = 0.0;  ///< (Pa s)
+  };
+  /// Cells whose centre lies inside a region take its viscosity (the last
+  /// region holding it wins), the others the fluid's.
+  std::vector<ViscosityRegion> viscosity_regions;
   double output_interval = 0.0;      ///< (s)
   bool vtk = true;                   ///< write ParaView files
   double checkpoint_interval = 0.0;  ///< (s), 0: only at the end
@@ -55,6 +63,9 @@ bool is_flow_case(const ConfigTable& cfg);
 
 /// Reads and checks a flow case; throws InputError naming file and key.
 FlowCase load_flow_case(const ConfigTable& cfg, const std::filesystem::path& source);
+
+/// The viscosity at x: the last region holding x, else the fluid's.
+double viscosity_at(const FlowCase& c, const Vec3& x);
 
 /// The resolved parameters, one per line (for run.log).
 std::string describe(const FlowCase& c);

@@ -139,6 +139,9 @@ FlowRunSummary run_flow_case(const FlowCase& c, const FlowRunOptions& options,
     });
   }
   ns.set_body_force([&](const Vec3&) { return c.body_force; });
+  // Sampled at cell centres, again after each regrid (a checkpoint's values replace it on restart).
+  if (!c.viscosity_regions.empty())
+    ns.set_viscosity([&](const Vec3& x) { return viscosity_at(c, x); });
   std::int64_t steps = 0, frames = 0;
   double regrid_seconds = 0.0;
   const auto regrid = [&]() {
