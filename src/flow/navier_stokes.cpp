@@ -306,6 +306,7 @@ void NavierStokes::set_body_force(const std::function<Vec3(const Vec3&)>& f) {
 
 void NavierStokes::set_viscosity(const std::function<double(const Vec3&)>& mu) {
   if (&mu != &viscosity_function_) viscosity_function_ = mu;
+  if (!mu) return;  // forget the function, keep the values
   const int b = forest_.block_cells();
   forest_.for_each_block([&](int blk) {
     const Block& block = forest_.block(blk);
@@ -740,9 +741,8 @@ void NavierStokes::advect_field(const BlockField& field, const BlockField* sourc
       update);
 }
 
-void NavierStokes::update_viscous_coefficients(double dt) {
-  if (dt == viscous_dt_ && !viscosity_changed_) return;
-  if (viscosity_changed_) {
+void NavierStokes::fill_viscosity_ghosts() {
+  if (viscosity_changed_) {  // on every rank: the writers of mu mark it on all of them
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
     for (int blk = 0; blk < forest_.local_blocks(); ++blk) {
       for_each_cell(forest_.block_cells(), [&](int i, int j, int k) {
@@ -750,11 +750,38 @@ void NavierStokes::update_viscous_coefficients(double dt) {
         hi = std::max(hi, mu_(blk, i, j, k));
       });
     }
-    variable_viscosity_ = forest_.max(hi) > -forest_.max(-lo);
+    viscosity_range_ = {-forest_.max(-lo), forest_.max(hi)};
+    variable_viscosity_ = viscosity_range_[1] > viscosity_range_[0];
   }
+  fill_scalar_neumann(mu_, 1);
+  if (!composite_ || !variable_viscosity_) return;
+  // Ghosts across coarse-fine faces are quadratic interpolants of the coarse
+  // cells: next to a jump they overshoot (a 1 : 5 jump gives a negative
+  // ghost, hence a negative harmonic face viscosity, anti-diffusion and a
+  // multigrid operator that is no longer definite). Clamped to the field's
+  // range they stay positive; same-level and boundary ghosts are copies and
+  // already in it.
+  const int b = forest_.block_cells();
+  const BlockLayout L = mu_.layout();
+  const double lo = viscosity_range_[0], hi = viscosity_range_[1];
+  forest_.for_each_block([&](int blk) {
+    double* mu = mu_.block(blk);
+    for (int k = -1; k <= b; ++k)
+      for (int j = -1; j <= b; ++j)
+        for (int i = -1; i <= b; ++i) {
+          double& m = mu[L.index(i, j, k)];
+          m = std::clamp(m, lo, hi);
+        }
+  });
+}
+
+void NavierStokes::update_viscous_coefficients(double dt) {
+  const bool rebuild = dt != viscous_dt_ || viscosity_changed_;
+  // Every step: the explicit viscous fluxes read the ghosts too.
+  fill_viscosity_ghosts();
+  if (!rebuild) return;
   const int n = forest_.local_blocks();
   const int b = forest_.block_cells();
-  fill_scalar_neumann(mu_, 1);
   BlockField alpha(n, b);
   alpha.fill(1.0);
   FaceField beta = make_vector_field(n, b);
@@ -791,10 +818,10 @@ void NavierStokes::update_viscous_coefficients(double dt) {
   viscosity_changed_ = false;
 }
 
-void NavierStokes::add_viscous_fluxes(double laplacian, bool transpose, double factor,
+void NavierStokes::add_viscous_fluxes(double laplacian_weight, bool transpose, double factor,
                                       VectorField& out) {
   // For component i the flux through a d-face is
-  //   mu_f [laplacian du_i/dx_d + transpose du_d/dx_i]
+  //   mu_f [laplacian_weight du_i/dx_d + du_d/dx_i (if transpose)]
   // with mu_f the harmonic mean of the two cells; out_i += factor div(flux) in
   // every cell. On composite grids the coarse face takes the fine faces'
   // mean like every other flux (momentum conserved across coarse-fine faces).
@@ -809,9 +836,9 @@ void NavierStokes::add_viscous_fluxes(double laplacian, bool transpose, double f
       const std::ptrdiff_t sd = L.stride(d);
       const double* mu = mu_.block(blk);
       double gradient = 0.0;
-      if (laplacian != 0.0) {
+      if (laplacian_weight != 0.0) {
         const double* ui = u_[D(i)].block(blk);
-        gradient += laplacian * (ui[f] - ui[f - sd]) / h;
+        gradient += laplacian_weight * (ui[f] - ui[f - sd]) / h;
       }
       if (transpose) {
         const double* ud = u_[D(d)].block(blk);
@@ -842,7 +869,7 @@ void NavierStokes::add_viscous_fluxes(double laplacian, bool transpose, double f
           walls += (1.0 - open_[D(d)].block(blk)[c]) + (1.0 - open_[D(d)].block(blk)[c + sd]);
         }
         // No-slip faces of solid neighbours: the wall flux 2 mu (0 - u_i)/h.
-        if (solid[c] == 0.0) sum -= laplacian * walls * 2.0 * mu[c] * ui[c] / h;
+        if (solid[c] == 0.0) sum -= laplacian_weight * walls * 2.0 * mu[c] * ui[c] / h;
         o[c] += factor * sum / h;
       });
     };
@@ -852,7 +879,7 @@ void NavierStokes::add_viscous_fluxes(double laplacian, bool transpose, double f
 
 VectorField NavierStokes::viscous_force_density() {
   fill_velocity_ghosts(u_);
-  fill_scalar_neumann(mu_, 1);
+  fill_viscosity_ghosts();
   VectorField force = make_vector_field(forest_.local_blocks(), forest_.block_cells());
   add_viscous_fluxes(1.0, true, 1.0, force);
   return force;

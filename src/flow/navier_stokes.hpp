@@ -113,8 +113,11 @@ class NavierStokes {
   void set_velocity(const std::function<Vec3(const Vec3&)>& u, double time = 0.0);
   /// Body force density f_b(x) (N/m^3), sampled on faces (again after each regrid).
   void set_body_force(const std::function<Vec3(const Vec3&)>& f);
-  /// Dynamic viscosity mu(x) (Pa s) per cell, sampled at cell centres (again
-  /// after each regrid, so that a jump stays sharp on the new cells).
+  /// Dynamic viscosity mu(x) (Pa s) per cell, sampled at cell centres. The
+  /// function is kept and sampled again after each regrid (so that a jump
+  /// stays sharp on the new cells): it must stay valid, be safe to call from
+  /// several threads and not throw. An empty function forgets it and keeps
+  /// the values (then they are carried by regrids like the velocity).
   void set_viscosity(const std::function<double(const Vec3&)>& mu);
 
   /// Solid cells (cell masks aligned with the grid): solid(x) at cell
@@ -155,8 +158,10 @@ class NavierStokes {
   /// so that uf is divergence-free to the projection tolerance, as after a
   /// step. With solid cells, blocks near them are refined to `max_level`
   /// and never coarsened (max_level must then be given), and the mask is
-  /// sampled again. A viscosity given by set_viscosity is sampled again too;
-  /// one written through viscosity() is carried like the velocity.
+  /// sampled again. A viscosity function given to set_viscosity is sampled
+  /// again too (values written through viscosity() are then overwritten:
+  /// set_viscosity({}) forgets the function); otherwise mu is carried like
+  /// the velocity.
   RegridReport regrid(Forest& forest, std::span<const AdaptFlag> flags,
                       std::span<BlockField* const> scalars = {}, int max_level = kForestMaxLevel);
 
@@ -169,8 +174,9 @@ class NavierStokes {
   [[nodiscard]] BlockField& pressure() { return p_; }
   [[nodiscard]] const BlockField& pressure() const { return p_; }
   [[nodiscard]] const BlockField& viscosity() const { return mu_; }
-  /// Writable viscosity field (the coupling sets it from a phase indicator):
-  /// taking it marks the viscous coefficients for rebuilding at the next step.
+  /// Writable viscosity field (e.g. set from a phase indicator): taking it
+  /// marks the viscous coefficients for rebuilding at the next step, so take
+  /// it again after each write, on every rank (the rebuild is collective).
   [[nodiscard]] BlockField& viscosity() {
     viscosity_changed_ = true;
     return mu_;
@@ -184,9 +190,11 @@ class NavierStokes {
   /// Largest |div uf| over all cells (1/s): zero to the projection tolerance.
   [[nodiscard]] double max_divergence() const;
   /// The viscous force density div(mu (grad u + grad u^T)) (N/m^3) of the
-  /// current velocity at cell centres, from the face fluxes the step's
-  /// explicit part uses: on any forest its volume integral is the flux
-  /// through the domain boundary (zero when periodic) to round-off.
+  /// current velocity at cell centres (grad u^T included even for uniform
+  /// mu), from the face fluxes the step's explicit part uses: on any forest,
+  /// without solid cells (whose no-slip closure is a cell term), its volume
+  /// integral is the flux through the domain boundary (zero when periodic)
+  /// to round-off.
   [[nodiscard]] VectorField viscous_force_density();
   /// |curl u| at cell centres (1/s), central differences.
   [[nodiscard]] BlockField vorticity_magnitude();
@@ -218,10 +226,14 @@ class NavierStokes {
   void fill_scalar_neumann(BlockField& f, int width);
   void update_viscous_coefficients(double dt);
   void close_solid_faces(FaceField& uf) const;
-  /// out += factor div(mu (laplacian grad u + transpose grad u^T)) from face
-  /// fluxes (matched at coarse-fine faces), no-slip solid faces included in
-  /// the first part; u's ghosts and mu's (width 1) must be filled.
-  void add_viscous_fluxes(double laplacian, bool transpose, double factor, VectorField& out);
+  /// out += factor div(mu (laplacian_weight grad u + [transpose] grad u^T))
+  /// from face fluxes (matched at coarse-fine faces), plus the no-slip
+  /// closure of solid faces in the first part (a cell term, not a flux);
+  /// u's ghosts and mu's (width 1) must be filled.
+  void add_viscous_fluxes(double laplacian_weight, bool transpose, double factor, VectorField& out);
+  /// mu's ghost layer (width 1), clamped to the field's range on composite
+  /// grids; the range and variable_viscosity_ first if mu changed.
+  void fill_viscosity_ghosts();
   /// Calls update(blk, fluxes) for every block with the fluxes of all its
   /// faces along the 3 directions: block_fluxes(blk, d, out) writes the faces
   /// 0..b of a block; on composite grids each shared face is evaluated once,
@@ -274,8 +286,9 @@ class NavierStokes {
   bool viscosity_changed_ = true;
   bool has_solids_ = false;
   std::function<bool(const Vec3&)> solid_function_;  ///< as given, to sample again after a regrid
-  bool variable_viscosity_ = false;  ///< mu not uniform: the grad u^T stress is added
-  BlockField solid_;                 ///< 1 in solid cells, 0 in fluid cells
+  bool variable_viscosity_ = false;          ///< mu not uniform: the grad u^T stress is added
+  std::array<double, 2> viscosity_range_{};  ///< min and max of mu over all ranks
+  BlockField solid_;                         ///< 1 in solid cells, 0 in fluid cells
   FaceField
       open_;  ///< 1 on faces between two fluid cells (or fluid and the domain boundary), else 0
   MultigridReport pressure_report_;
