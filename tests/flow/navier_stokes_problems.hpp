@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cmath>
+#include <numbers>
 
 #include "flow/navier_stokes.hpp"
 
@@ -19,6 +20,24 @@ inline std::array<FlowBoundary, 6> all_periodic() {
 inline double rough(const Vec3& x, int seed) {
   const double v = std::sin(12.9898 * x.x + 78.233 * x.y + 37.719 * x.z + 4.1 * seed) * 43758.5453;
   return 2.0 * (v - std::floor(v)) - 1.0;
+}
+
+/// The 2D Taylor-Green vortex of the unit square (wave number 2 pi), kinematic
+/// viscosity nu, at time t: an exact solution of the Navier-Stokes equations.
+inline Vec3 taylor_green_velocity(const Vec3& x, double nu, double t) {
+  constexpr double kTwoPi = 2.0 * std::numbers::pi;
+  const double decay = std::exp(-2.0 * kTwoPi * kTwoPi * nu * t);
+  return Vec3{std::sin(kTwoPi * x.x) * std::cos(kTwoPi * x.y) * decay,
+              -std::cos(kTwoPi * x.x) * std::sin(kTwoPi * x.y) * decay, 0.0};
+}
+
+/// Periodic Taylor-Green options: Crank-Nicolson, solver tolerances 1e-10.
+inline NavierStokesOptions taylor_green_options() {
+  NavierStokesOptions options;
+  options.viscous_theta = 0.5;
+  options.pressure.tolerance = 1e-10;
+  options.viscous.tolerance = 1e-10;
+  return options;
 }
 
 /// Volume integral sum(c V) of a cell field over all cells (all ranks).

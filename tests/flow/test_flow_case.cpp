@@ -69,6 +69,19 @@ void expect_input_error(const std::string& text, const std::string& fragment) {
   }
 }
 
+/// Runs a case quietly into a fresh temporary folder (removed first).
+std::filesystem::path run_in_temp(const FlowCase& c, const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / name;
+  std::filesystem::remove_all(dir);
+  FlowRunOptions options;
+  options.output_dir = dir;
+  options.quiet = true;
+  std::ostringstream console;
+  const auto summary = run_flow_case(c, options, console);
+  EXPECT_NEAR(summary.simulated_time, c.end_time, 1e-12);
+  return dir;
+}
+
 std::string read_bytes(const std::filesystem::path& p) {
   std::ifstream in(p, std::ios::binary);
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
@@ -117,14 +130,7 @@ max_m = [0.25, 0.6, 0.5]
   EXPECT_DOUBLE_EQ(c.solid_boxes[0][1].y, 0.6);
   expect_input_error(replaced(text, "max_m = [0.25, 0.6, 0.5]", "max_m = [0.25, 0.3, 0.5]"),
                      "flow.solid[0].max_m");
-  const auto dir = std::filesystem::temp_directory_path() / "sanguis_flow_solid_test";
-  std::filesystem::remove_all(dir);
-  FlowRunOptions options;
-  options.output_dir = dir;
-  options.quiet = true;
-  std::ostringstream console;
-  const auto summary = run_flow_case(c, options, console);
-  EXPECT_NEAR(summary.simulated_time, 0.04, 1e-12);
+  const auto dir = run_in_temp(c, "sanguis_flow_solid_test");
   const std::string log = read_bytes(dir / "run.log");
   EXPECT_NE(log.find("solid box"), std::string::npos);
   std::filesystem::remove_all(dir);
@@ -156,13 +162,7 @@ viscosity_Pa_s = 4.0
                      "flow.viscosity_region[0].max_m");
   expect_input_error(replaced(text, "viscosity_Pa_s = 4.0", "viscosity = 4.0"),
                      "flow.viscosity_region[0].viscosity");
-  const auto dir = std::filesystem::temp_directory_path() / "sanguis_flow_viscosity_test";
-  std::filesystem::remove_all(dir);
-  FlowRunOptions options;
-  options.output_dir = dir;
-  options.quiet = true;
-  std::ostringstream console;
-  run_flow_case(c, options, console);
+  const auto dir = run_in_temp(c, "sanguis_flow_viscosity_test");
   EXPECT_NE(read_bytes(dir / "run.log").find("viscosity 4 Pa s in"), std::string::npos);
   const std::string csv = read_bytes(dir / "diagnostics.csv");
   const std::string last = csv.substr(csv.rfind('\n', csv.size() - 2) + 1);

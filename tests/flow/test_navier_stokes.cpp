@@ -38,16 +38,8 @@ double taylor_green_error(int cells, double nu, double t_end) {
   spec.tree_length = 1.0 / (cells / 8);
   spec.periodic = {true, true, true};
   const Forest forest(spec);
-  NavierStokesOptions options;
-  options.viscous_theta = 0.5;
-  options.pressure.tolerance = 1e-10;
-  options.viscous.tolerance = 1e-10;
-  NavierStokes ns(forest, all_periodic(), Fluid{1.0, nu}, options);
-  auto exact = [nu](const Vec3& x, double t) {
-    const double decay = std::exp(-8.0 * kPi * kPi * nu * t);
-    return Vec3{std::sin(2 * kPi * x.x) * std::cos(2 * kPi * x.y) * decay,
-                -std::cos(2 * kPi * x.x) * std::sin(2 * kPi * x.y) * decay, 0.0};
-  };
+  NavierStokes ns(forest, all_periodic(), Fluid{1.0, nu}, testing::taylor_green_options());
+  auto exact = [nu](const Vec3& x, double t) { return testing::taylor_green_velocity(x, nu, t); };
   ns.set_velocity([&](const Vec3& x) { return exact(x, 0.0); });
   const double h = 1.0 / cells;
   const int steps = static_cast<int>(std::lround(t_end / (0.25 * h)));

@@ -47,6 +47,10 @@ GATE_TIME = 2.4
 DURATION = 0.5
 KT = [1e1, 3e2, 1e5]        # N/m
 GAMMA = [1e0, 1e3, 1e5]     # 1/s
+# A finer 3 x 3 around the Table 3.1 point: the coarse grid found it the one collapsing
+# point whose top barely moved, so where it sits against region 3 needs the neighbours.
+LOCAL_KT = [1e2, 3e2, 1e3]
+LOCAL_GAMMA = [3e2, 1e3, 3e3]
 QUICK = [(3e2, 1e3), (1e5, 1e5)]
 TABLE_31 = (3e2, 1e3)
 
@@ -100,6 +104,8 @@ def main():
         subprocess.run([exe, "run", CASE, "--output", POUR, "--quiet", "--threads", "1",
                         "--set", f"simulation.end_time_s={GATE_TIME}"], check=True)
     grid = QUICK if args.quick else [(kt, g) for kt in KT for g in GAMMA]
+    if not args.quick:
+        grid += [(kt, g) for kt in LOCAL_KT for g in LOCAL_GAMMA if (kt, g) not in grid]
     t0 = time.time()
     pending = [] if args.reuse else list(grid)
     running = []
@@ -137,8 +143,8 @@ def main():
                "thesis": "region 2 (top-driven, as the experiments)", "tolerance": "same region",
                "pass": table[TABLE_31]["region"] == 2}]
     if not args.quick:
-        regions = sorted({r["region"] for r in results})
-        checks.append({"quantity": "regions present on the grid", "measured": str(regions),
+        regions = sorted({r["region"] for r in results if r["kt"] in KT and r["gamma"] in GAMMA})
+        checks.append({"quantity": "regions present on the 3 x 3 grid", "measured": str(regions),
                        "thesis": "1, 2 and 3 (Fig. 3.17)", "tolerance": "at least two",
                        "pass": len(regions) >= 2})
 
