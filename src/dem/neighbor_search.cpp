@@ -37,36 +37,44 @@ double NeighborSearch::obstacle_travel(const Obstacle& o, double t0, double t1) 
 }
 
 bool NeighborSearch::needs_rebuild(const ParticleStore& particles,
-                                   const std::vector<Obstacle>& obstacles, double time) const {
+                                   const std::vector<Obstacle>& obstacles, double time,
+                                   int threads) const {
   for (const Obstacle& o : obstacles) {
     if (!o.motion.is_static() && o.active(time) &&
         obstacle_travel(o, reference_time_, time) > 0.5 * skin_) {
       return true;
     }
   }
-  return needs_rebuild(particles);
+  return needs_rebuild(particles, threads);
 }
 
-bool NeighborSearch::needs_rebuild(const ParticleStore& particles) const {
+bool NeighborSearch::needs_rebuild(const ParticleStore& particles, int threads) const {
   const std::size_t n = particles.size();
   if (reference_.size() != n) return true;
   const double limit = 0.5 * skin_;
   const double limit2 = limit * limit;
   const Vec3* x = particles.position.data();
   const Vec3* r = reference_.data();
-  bool stale = false;
-  for (std::size_t i = 0; i < n; ++i) stale |= norm2(x[i] - r[i]) > limit2;
-  if (stale || reference_orientation_.empty()) return stale;  // empty: no bodies at last build
+  const bool bodies = !reference_orientation_.empty();  // empty: no bodies at last build
   // A rotating body moves its surface points by up to R_bound * angle more.
-  for (std::size_t i = 0; i < n; ++i) {
-    if (particles.spherical[i]) continue;
+  const auto moved_too_far = [&](std::size_t i) {
+    if (!bodies || particles.spherical[i]) return norm2(x[i] - r[i]) > limit2;
     const Quaternion& q = particles.orientation[i];
     const Quaternion& q0 = reference_orientation_[i];
     const double c = std::min(1.0, std::abs(q.w * q0.w + q.x * q0.x + q.y * q0.y + q.z * q0.z));
-    const double angle = 2.0 * std::acos(c);
-    if (norm(x[i] - r[i]) + particles.radius[i] * angle > limit) return true;
+    return norm(x[i] - r[i]) + particles.radius[i] * 2.0 * std::acos(c) > limit;
+  };
+  bool stale = false;
+  if (threads > 1) {
+    const auto count = static_cast<std::ptrdiff_t>(n);
+#pragma omp parallel for schedule(static) num_threads(threads) reduction(|| : stale)
+    for (std::ptrdiff_t i = 0; i < count; ++i) {
+      stale = stale || moved_too_far(static_cast<std::size_t>(i));
+    }
+  } else {
+    for (std::size_t i = 0; i < n; ++i) stale |= moved_too_far(i);
   }
-  return false;
+  return stale;
 }
 
 bool NeighborSearch::has_bodies(const ParticleStore& particles) {

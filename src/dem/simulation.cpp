@@ -84,7 +84,7 @@ void DemSimulation::step() {
   integrator_.advance(p, setup_.gravity, dt);
   ++step_;
   if (exchange_ == nullptr) {
-    if (search_.needs_rebuild(p, setup_.obstacles, time())) rebuild_lists();
+    if (search_.needs_rebuild(p, setup_.obstacles, time(), threads_)) rebuild_lists();
     compute_forces();
     integrator_.finish(p, setup_.gravity, dt);
     if (step_ % 64 == 0) check_state();
@@ -93,7 +93,7 @@ void DemSimulation::step() {
   // Ghosts first take their owners' drifted state, so every process sees the same
   // displacements and all rebuild at the step a single process would.
   exchange_->refresh_ghosts(*this);
-  if (exchange_->any(search_.needs_rebuild(p, setup_.obstacles, time()))) {
+  if (exchange_->any(search_.needs_rebuild(p, setup_.obstacles, time(), threads_))) {
     exchange_->redistribute(*this);
   }
   // A blow-up seen by one process stops them all (none may wait in a collective).

@@ -1,0 +1,192 @@
+#!/usr/bin/python3
+"""The 4 cm dam break of crosses with the tangential parameters recalibrated (thesis
+§3.4.3 calibrated kt and gamma_t by trial and error; issue #4).
+
+crosses_tangential_map finds the Table 3.1 point (kt 3e2 N/m, gamma_t 1e3 1/s) on this
+model's boundary between a slow, partial top-driven collapse and a standing column, and
+a substantial collapse only with both about 3x lower (kt 1e2, gamma_t 3e2). This case
+pours the 1300 crosses of cases/dem/dam-break-crosses.toml (4 cm gate, Table 3.1) once,
+then follows the 3 s collapse twice from the same packing: with Table 3.1 and with
+kt = 1e2 N/m, gamma_t = 3e2 1/s (both interactions).
+
+Check (the tolerance of crosses_dam_break): the recalibrated run-out within 35 % of the
+thesis' reference for a >= 4, the spheres of Lajeunesse et al. (2005), 1.9 a^(2/3); the
+Table 3.1 continuation is reported next to it, and the mean speed against t / tau_c of
+both is drawn with the thesis' Fig. 3.9 bands.
+
+Writes validation/dem/results/crosses_recalibrated.json and
+docs/validation/figures/crosses_recalibrated.png. `--reuse`: analyse the runs on disk.
+Usage: /usr/bin/python3 validation/dem/crosses_recalibrated.py [--build build]
+           [--threads T] [--reuse]
+"""
+import argparse
+import json
+import os
+import shutil
+import subprocess
+import sys
+import time
+
+import matplotlib
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from _outputs import read_summary, wall_time  # noqa: E402
+from crosses_dam_break import diagnostics, lajeunesse, opening_time, velocity_curve  # noqa: E402
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+CASE = os.path.join(ROOT, "cases", "dem", "dam-break-crosses.toml")
+RESULTS = os.path.join(ROOT, "validation", "dem", "results")
+RUNS = os.path.join(RESULTS, "runs", "crosses_calibration")
+FIGURE = os.path.join(ROOT, "docs", "validation", "figures", "crosses_recalibrated.png")
+OPENING_S = 5.0  # the case's gate removal; the pour is in and at rest by then
+# run folder -> (label, kt [N/m], gamma_t [1/s]); None: the case's Table 3.1 values
+RUNS_OF = {"table31": ("Table 3.1 (kt 3e2, γt 1e3)", None, None),
+           "kt100_g300": ("recalibrated (kt 1e2, γt 3e2)", 1e2, 3e2)}
+RECALIBRATED = "kt100_g300"
+
+
+def tangential(kt, gamma):
+    if kt is None:
+        return []
+    out = []
+    for i in (0, 1):
+        out += ["--set", f"interaction[{i}].tangential_stiffness_N_m={kt}",
+                "--set", f"interaction[{i}].tangential_damping_rate_1_s={gamma}"]
+    return out
+
+
+def run_all(exe, threads):
+    pour = os.path.join(RUNS, "pour")
+    if not os.path.exists(os.path.join(pour, "checkpoint.bin")):
+        subprocess.run([exe, "run", CASE, "--output", pour, "--quiet", "--threads", str(threads),
+                        "--set", f"simulation.end_time_s={OPENING_S}"], check=True)
+    running = []
+    for name, (_, kt, gamma) in RUNS_OF.items():
+        out = os.path.join(RUNS, name)
+        shutil.rmtree(out, ignore_errors=True)
+        shutil.copytree(pour, out)
+        cmd = [exe, "run", CASE, "--output", out, "--restart", "--quiet", "--threads", "1"]
+        running.append(subprocess.Popen(cmd + tangential(kt, gamma)))  # one core each
+    for proc in running:
+        if proc.wait() != 0:
+            sys.exit("a continuation failed")
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--build", default="build")
+    ap.add_argument("--threads", type=int, default=2, help="threads of the pour")
+    ap.add_argument("--reuse", action="store_true", help="analyse the runs already on disk")
+    ap.add_argument("--quick", action="store_true", help="same as the default")
+    args = ap.parse_args()
+    exe = os.path.join(ROOT, args.build, "app", "sanguis")
+    t0 = time.time()
+    if not args.reuse:
+        run_all(exe, args.threads)
+    results = {}
+    for name in RUNS_OF:
+        out = os.path.join(RUNS, name)
+        subprocess.run([exe, "analyze", out], check=True, stdout=subprocess.DEVNULL)
+        results[name] = read_summary(out)
+
+    rec = results[RECALIBRATED]
+    a = rec["aspect_ratio_H0_over_L0"]
+    ref = lajeunesse(a)
+    checks = [{"quantity": f"(L∞−L0)/L0, recalibrated, a = {a:.2f}",
+               "measured": round(rec["runout_ratio"], 3),
+               "thesis": f"{ref:.2f} (Lajeunesse, a ≳ 4, §3.3)", "tolerance": "±35 %",
+               "pass": abs(rec["runout_ratio"] / ref - 1) <= 0.35}]
+    base = results["table31"]
+    checks.append({"quantity": f"(L∞−L0)/L0, Table 3.1, same packing, a = "
+                               f"{base['aspect_ratio_H0_over_L0']:.2f}",
+                   "measured": round(base["runout_ratio"], 3),
+                   "thesis": f"{lajeunesse(base['aspect_ratio_H0_over_L0']):.2f}",
+                   "tolerance": "reported", "pass": None})
+    pour = os.path.join(RUNS, "pour")
+    before = diagnostics(pour)[-1]
+    checks.append({"quantity": "sanity: mean speed at the opening [m/s]",
+                   "measured": f"{before['mean_velocity_m_s']:.2g}", "thesis": "—",
+                   "tolerance": "< 1e-3", "pass": before["mean_velocity_m_s"] < 1e-3})
+    rows = []
+    for name, (label, _, _) in RUNS_OF.items():
+        s = results[name]
+        out = os.path.join(RUNS, name)
+        rows.append([label, f"{100 * s['L0_m']:.1f}", f"{100 * s['H0_m']:.1f}",
+                     f"{s['aspect_ratio_H0_over_L0']:.2f}", f"{s['runout_ratio']:.2f}",
+                     f"{lajeunesse(s['aspect_ratio_H0_over_L0']):.2f}",
+                     f"{s['height_ratio_H0_over_Hinf']:.2f}",
+                     f"{s['peak_mean_speed_over_sqrt_gH0']:.3f}",
+                     f"{s['peak_time_over_tau_c']:.1f}",
+                     ["stable", "fractured", "collapsed"][int(s["regime"])],
+                     f"{wall_time(out, opening_time(out)) / 3600:.2f}"])
+
+    os.makedirs(os.path.dirname(FIGURE), exist_ok=True)
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.2))
+    a_line = [0.3 * 1.05 ** k for k in range(70)]
+    a1.loglog(a_line, [lajeunesse(x) for x in a_line], "k--", label="Lajeunesse et al. (spheres)")
+    for name, (label, _, _) in RUNS_OF.items():
+        s = results[name]
+        l0, r = s["L0_m"], s["runout_ratio"]
+        lo, hi = (s["Linf_20pc_m"] - l0) / l0, (s["Linf_1pc_m"] - l0) / l0
+        a1.errorbar([s["aspect_ratio_H0_over_L0"]], [r],
+                    yerr=[[max(0.0, r - lo)], [max(0.0, hi - r)]], fmt="o", capsize=3, label=label)
+        t, v = velocity_curve(os.path.join(RUNS, name))
+        a2.plot(t, v, label=label)
+    a1.set_xlabel(r"$a = H_0/L_0$")
+    a1.set_ylabel(r"$(L_\infty - L_0)/L_0$")
+    a1.legend(fontsize=8)
+    a2.fill_between([3.0, 5.0], 0.34, 0.39, color="0.85", label="thesis, 1000 crosses (narrow)")
+    a2.fill_between([2.0, 3.0], 0.18, 0.22, color="0.65", label="thesis, 3000 crosses (wide)")
+    a2.axhline(0.05, color="k", lw=0.8, ls=":")
+    a2.set_xlabel(r"$t/\tau_c$")
+    a2.set_ylabel(r"mean speed / $\sqrt{g H_0}$")
+    a2.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(FIGURE, dpi=130)
+
+    elapsed = time.time() - t0
+    if args.reuse:
+        elapsed = wall_time(pour) + sum(wall_time(os.path.join(RUNS, n), OPENING_S)
+                                        for n in RUNS_OF)
+    ok = all(c["pass"] for c in checks if c["pass"] is not None)
+    summary = {
+        "name": "crosses_recalibrated",
+        "title": "Dam break of crosses with kt and γt recalibrated",
+        "thesis": "§3.4.3 (calibration of kt, γt), Fig. 3.7, 3.9",
+        "description": (
+            "The 4 cm gate of cases/dem/dam-break-crosses.toml (1300 crosses, Table 3.1) "
+            "poured once; the 3 s collapse followed from the same packing with Table 3.1 "
+            "and with kt = 1e2 N/m, γt = 3e2 1/s, where the tangential map of this model "
+            "first shows a substantial collapse."),
+        "command": "/usr/bin/python3 validation/dem/crosses_recalibrated.py --build BUILD",
+        "figures": ["docs/validation/figures/crosses_recalibrated.png"],
+        "checks": checks,
+        "tables": [{"caption": "Per run (`sanguis analyze`).",
+                    "header": ["tangential parameters", "L0 [cm]", "H0 [cm]", "a", "(L∞−L0)/L0",
+                               "Lajeunesse", "H0/H∞", "peak v/√(gH0)", "peak t/τc", "regime",
+                               "collapse wall time, 1 thread [h]"],
+                    "rows": rows}],
+        "notes": ["The thesis calibrated kt and γt by trial and error against its experiments "
+                  "(§3.4.3) and found its physical band at kt 3e2, γt 1e3. The same procedure "
+                  "on this model lands about 3x lower in both. What shifts the band is not "
+                  "known; candidates are the contact details that differ from Grains3D "
+                  "(rounded crusts around shrunk cores where Grains3D keeps sharp boxes and "
+                  "maps the shrunk shapes' closest points back, app. A.2.3) and the packing "
+                  "(touching neighbours 6.8-7.5 per cross here against 8.2 in Table B.1). "
+                  "`sanguis calibrate` can fit the two parameters against a measured run-out."],
+        "run_time_s": round(elapsed, 1),
+        "date": time.strftime("%Y-%m-%d %H:%M"),
+        "quick": bool(args.quick),
+        "pass": bool(ok),
+    }
+    with open(os.path.join(RESULTS, "crosses_recalibrated.json"), "w") as f:
+        json.dump(summary, f, indent=1)
+    print(f"{'PASS' if ok else 'FAIL'}: {elapsed / 3600:.2f} h")
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
