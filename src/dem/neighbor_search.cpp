@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "core/parallel.hpp"
+
 namespace sanguis::dem {
 
 NeighborSearch::NeighborSearch(const Domain& domain, double skin, double max_radius)
@@ -56,7 +58,8 @@ bool NeighborSearch::needs_rebuild(const ParticleStore& particles, int threads) 
   const Vec3* x = particles.position.data();
   const Vec3* r = reference_.data();
   const bool bodies = !reference_orientation_.empty();  // empty: no bodies at last build
-  // A rotating body moves its surface points by up to R_bound * angle more.
+  // Spheres: the plain distance test (a loop the compiler vectorizes). A rotating body
+  // moves its surface points by up to R_bound * angle more.
   const auto moved_too_far = [&](std::size_t i) {
     if (!bodies || particles.spherical[i]) return norm2(x[i] - r[i]) > limit2;
     const Quaternion& q = particles.orientation[i];
@@ -64,17 +67,10 @@ bool NeighborSearch::needs_rebuild(const ParticleStore& particles, int threads) 
     const double c = std::min(1.0, std::abs(q.w * q0.w + q.x * q0.x + q.y * q0.y + q.z * q0.z));
     return norm(x[i] - r[i]) + particles.radius[i] * 2.0 * std::acos(c) > limit;
   };
-  bool stale = false;
-  if (threads > 1) {
-    const auto count = static_cast<std::ptrdiff_t>(n);
-#pragma omp parallel for schedule(static) num_threads(threads) reduction(|| : stale)
-    for (std::ptrdiff_t i = 0; i < count; ++i) {
-      stale = stale || moved_too_far(static_cast<std::size_t>(i));
-    }
-  } else {
-    for (std::size_t i = 0; i < n; ++i) stale |= moved_too_far(i);
+  if (!bodies) {
+    return parallel_any(n, threads, [&](std::size_t i) { return norm2(x[i] - r[i]) > limit2; });
   }
-  return stale;
+  return parallel_any(n, threads, moved_too_far);
 }
 
 bool NeighborSearch::has_bodies(const ParticleStore& particles) {
