@@ -3,8 +3,10 @@ binary base64, UInt64 headers, Float64 / Int64 arrays) as numpy arrays, and the
 summary row of `sanguis analyze`. Not a general VTK reader."""
 import base64
 import csv
+import json
 import os
 import re
+import time
 import xml.etree.ElementTree as ET
 
 import numpy as np
@@ -60,3 +62,12 @@ def wall_time(run, after=-1.0):
                 units = {"h": 3600, "m": 60, "s": 1}
                 total += sum(int(n) * units[u] for n, u in re.findall(r"(\d+)([hms])", m.group(1)))
     return total
+
+
+def write_summary(summary, results_dir, elapsed, quick, ok):
+    """Completes a case's summary (run time, date, quick, pass) and writes it as
+    RESULTS/<name>.json, the file run_all.py reads for the report."""
+    summary.update({"run_time_s": round(elapsed, 1), "date": time.strftime("%Y-%m-%d %H:%M"),
+                    "quick": bool(quick), "pass": bool(ok)})
+    with open(os.path.join(results_dir, summary["name"] + ".json"), "w") as f:
+        json.dump(summary, f, indent=1)

@@ -20,7 +20,6 @@ Usage: /usr/bin/python3 validation/dem/crosses_recalibrated.py [--build build]
            [--threads T] [--reuse]
 """
 import argparse
-import json
 import os
 import shutil
 import subprocess
@@ -30,7 +29,7 @@ import time
 import matplotlib
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import read_summary, wall_time  # noqa: E402
+from _outputs import read_summary, wall_time, write_summary  # noqa: E402
 from crosses_dam_break import diagnostics, lajeunesse, opening_time, velocity_curve  # noqa: E402
 
 matplotlib.use("Agg")
@@ -186,13 +185,8 @@ def main():
                   "`sanguis calibrate` can fit the two parameters against a measured run-out.",
                   "Wall times: the pour on 2 threads; the two collapses side by side, one "
                   "thread each, on the 2-core VM (with a build running for part of them)."],
-        "run_time_s": round(elapsed, 1),
-        "date": time.strftime("%Y-%m-%d %H:%M"),
-        "quick": bool(args.quick),
-        "pass": bool(ok),
     }
-    with open(os.path.join(RESULTS, "crosses_recalibrated.json"), "w") as f:
-        json.dump(summary, f, indent=1)
+    write_summary(summary, RESULTS, elapsed, args.quick, ok)
     print(f"{'PASS' if ok else 'FAIL'}: {elapsed / 3600:.2f} h")
     return 0 if ok else 1
 

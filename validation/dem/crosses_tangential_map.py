@@ -35,7 +35,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import read_arrays, read_pvd, read_summary  # noqa: E402
+from _outputs import read_arrays, read_pvd, read_summary, write_summary  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 CASE = os.path.join(ROOT, "cases", "dem", "dam-break-crosses-memory.toml")
@@ -209,13 +209,8 @@ def main():
                   "thesis found its physical band at kt 3e2, γt 1e3: this model is stickier by "
                   "a factor of about 3 in kt and γt, which is also why the 4 cm dam break "
                   "(crosses_dam_break) runs out about half as far as the thesis."],
-        "run_time_s": round(elapsed, 1),
-        "date": time.strftime("%Y-%m-%d %H:%M"),
-        "quick": bool(args.quick),
-        "pass": bool(ok),
     }
-    with open(os.path.join(RESULTS, "crosses_tangential_map.json"), "w") as f:
-        json.dump(summary, f, indent=1)
+    write_summary(summary, RESULTS, elapsed, args.quick, ok)
     print(f"{'PASS' if ok else 'FAIL'}: {len(results)} runs, {elapsed:.0f} s")
     return 0 if ok else 1
 
