@@ -776,10 +776,11 @@ void NavierStokes::fill_viscosity_ghosts() {
 }
 
 void NavierStokes::update_viscous_coefficients(double dt) {
-  const bool rebuild = dt != viscous_dt_ || viscosity_changed_;
-  // Every step: the explicit viscous fluxes read the ghosts too.
+  // mu's ghosts stay valid until mu changes (every writer marks it, see
+  // viscosity()): the explicit viscous fluxes read them at every step, but
+  // they are refilled only with the coefficients.
+  if (dt == viscous_dt_ && !viscosity_changed_) return;
   fill_viscosity_ghosts();
-  if (!rebuild) return;
   const int n = forest_.local_blocks();
   const int b = forest_.block_cells();
   BlockField alpha(n, b);

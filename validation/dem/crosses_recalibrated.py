@@ -30,14 +30,13 @@ import matplotlib
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from _outputs import read_summary, wall_time, write_summary  # noqa: E402
-from crosses_dam_break import diagnostics, lajeunesse, opening_time, velocity_curve  # noqa: E402
+from crosses_dam_break import (CASE, RESULTS, ROOT, diagnostics, lajeunesse,  # noqa: E402
+                               opening_time, velocity_curve)
+from crosses_tangential_map import tangential_settings  # noqa: E402
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-CASE = os.path.join(ROOT, "cases", "dem", "dam-break-crosses.toml")
-RESULTS = os.path.join(ROOT, "validation", "dem", "results")
 RUNS = os.path.join(RESULTS, "runs", "crosses_calibration")
 FIGURE = os.path.join(ROOT, "docs", "validation", "figures", "crosses_recalibrated.png")
 OPENING_S = 5.0  # the case's gate removal; the pour is in and at rest by then
@@ -45,16 +44,6 @@ OPENING_S = 5.0  # the case's gate removal; the pour is in and at rest by then
 RUNS_OF = {"table31": ("Table 3.1 (kt 3e2, γt 1e3)", None, None),
            "kt100_g300": ("recalibrated (kt 1e2, γt 3e2)", 1e2, 3e2)}
 RECALIBRATED = "kt100_g300"
-
-
-def tangential(kt, gamma):
-    if kt is None:
-        return []
-    out = []
-    for i in (0, 1):
-        out += ["--set", f"interaction[{i}].tangential_stiffness_N_m={kt}",
-                "--set", f"interaction[{i}].tangential_damping_rate_1_s={gamma}"]
-    return out
 
 
 def run_all(exe, threads):
@@ -68,7 +57,8 @@ def run_all(exe, threads):
         shutil.rmtree(out, ignore_errors=True)
         shutil.copytree(pour, out)
         cmd = [exe, "run", CASE, "--output", out, "--restart", "--quiet", "--threads", "1"]
-        running.append(subprocess.Popen(cmd + tangential(kt, gamma)))  # one core each
+        extra = [] if kt is None else tangential_settings(kt, gamma)
+        running.append(subprocess.Popen(cmd + extra))  # one core each
     for proc in running:
         if proc.wait() != 0:
             sys.exit("a continuation failed")

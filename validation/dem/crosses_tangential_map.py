@@ -55,12 +55,17 @@ QUICK = [(3e2, 1e3), (1e5, 1e5)]
 TABLE_31 = (3e2, 1e3)
 
 
-def settings(kt, gamma):
+def tangential_settings(kt, gamma):
+    """`sanguis run` options giving both interactions the tangential kt and gamma_t."""
     out = []
     for i in (0, 1):
         out += ["--set", f"interaction[{i}].tangential_stiffness_N_m={kt}",
                 "--set", f"interaction[{i}].tangential_damping_rate_1_s={gamma}"]
-    return out + ["--set", f"simulation.end_time_s={GATE_TIME + DURATION}"]
+    return out
+
+
+def settings(kt, gamma):
+    return tangential_settings(kt, gamma) + ["--set", f"simulation.end_time_s={GATE_TIME + DURATION}"]
 
 
 def by_id(path):
