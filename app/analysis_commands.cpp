@@ -48,11 +48,13 @@ struct EnsembleArgs {
 };
 
 struct CalibrateArgs {
-  std::string case_file, output, parameter, measure;
+  std::string case_file, output, measure, from;
+  std::vector<std::string> parameters;  // each gets the same value
   std::vector<double> values;
   double target = NAN, target_std = 0.0;
-  int seeds = 2, first_seed = 1, jobs = 0;
+  int seeds = 0, first_seed = 1, jobs = 0;  // seeds 0: 2, or 1 with --from
   std::vector<std::string> overrides;
+  bool reuse = false;
 };
 
 AnalysisOptions analysis_options(const AnalyzeArgs& a) {
@@ -136,7 +138,24 @@ int run_analyze(const AnalyzeArgs& args) {
 struct Job {
   std::vector<std::string> argv;
   fs::path log;
+  fs::path start_from;   // not empty: the run folder starts as a copy of this one
+  fs::path done_record;  // not empty: written with the command line once the run succeeded
 };
+
+std::string command_line(const std::vector<std::string>& argv) {
+  std::string line;
+  for (std::size_t k = 1; k < argv.size(); ++k) line += (k > 1 ? " " : "") + argv[k];
+  return line;
+}
+
+// A job whose record says it already ran with exactly this command line.
+bool already_done(const Job& job) {
+  if (job.done_record.empty() || !fs::exists(job.done_record)) return false;
+  std::ifstream in(job.done_record);
+  std::string line;
+  std::getline(in, line);
+  return line == command_line(job.argv);
+}
 
 // Runs the jobs as child processes of this executable, at most `parallel` at a
 // time; each writes its console output to its log. Throws if any failed.
@@ -152,7 +171,13 @@ void run_jobs(const char* self, const std::vector<Job>& jobs, int parallel) {
     const std::size_t k = running.at(pid);
     running.erase(pid);
     ++done;
-    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) failures.push_back(jobs[k].log.string());
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+      failures.push_back(jobs[k].log.string());
+    } else if (!jobs[k].done_record.empty()) {
+      io::write_file_atomically(jobs[k].done_record, [&](std::ostream& out) {
+        out << command_line(jobs[k].argv) << "\n";
+      });
+    }
     char status_text[64];
     std::snprintf(status_text, sizeof status_text, "%zu / %zu runs", done, jobs.size());
     progress.update(static_cast<double>(done) / static_cast<double>(jobs.size()), status_text, 0.0);
@@ -160,6 +185,14 @@ void run_jobs(const char* self, const std::vector<Job>& jobs, int parallel) {
   while (next < jobs.size() || !running.empty()) {
     if (next < jobs.size() && static_cast<int>(running.size()) < parallel) {
       const Job& job = jobs[next];
+      if (!job.done_record.empty()) fs::remove(job.done_record);
+      if (!job.start_from.empty()) {
+        const fs::path run = job.log.parent_path();
+        fs::remove_all(run);
+        fs::create_directories(run.parent_path());
+        fs::copy(job.start_from, run, fs::copy_options::recursive);
+        if (!job.done_record.empty()) fs::remove(job.done_record);  // the source's own
+      }
       fs::create_directories(job.log.parent_path());
       posix_spawn_file_actions_t actions;
       posix_spawn_file_actions_init(&actions);
@@ -222,6 +255,7 @@ int run_ensemble(const char* self, const EnsembleArgs& args) {
   }
   std::printf("sanguis ensemble: %d runs of %s, %d at a time, into %s\n", args.seeds,
               args.case_file.c_str(), default_jobs(args.jobs), root.string().c_str());
+  std::fflush(stdout);  // the header before the children's progress
   run_jobs(self, jobs, default_jobs(args.jobs));
   std::vector<RunAnalysis> all;
   for (const fs::path& run : runs) {
@@ -292,7 +326,8 @@ double summary_value(const RunAnalysis& a, const std::string& name) {
   throw InputError("", "--measure", "unknown measure '" + name + "'; one of:" + known);
 }
 
-int run_calibrate(const char* self, const CalibrateArgs& args) {
+// The checks of `calibrate`'s options that need no run.
+void check_calibrate_args(const CalibrateArgs& args) {
   (void)summary_value(RunAnalysis{}, args.measure);  // an unknown measure fails before any run
   if (args.values.size() < 2) throw InputError("", "--values", "give at least two values");
   for (std::size_t k = 1; k < args.values.size(); ++k) {
@@ -300,27 +335,64 @@ int run_calibrate(const char* self, const CalibrateArgs& args) {
       throw InputError("", "--values", "values must increase");
     }
   }
+  if (!args.from.empty()) {
+    if (!fs::exists(fs::path(args.from) / "checkpoint.bin")) {
+      throw InputError(args.from, "--from",
+                       "no checkpoint.bin in this folder: give the output folder of a "
+                       "`sanguis run` of the same case");
+    }
+    if (args.seeds > 1) {
+      throw InputError("", "--seeds",
+                       "runs continued from one --from state are identical whatever the seed; "
+                       "give --seeds 1 (or leave it out)");
+    }
+  }
+}
+
+int run_calibrate(const char* self, const CalibrateArgs& args) {
+  check_calibrate_args(args);
+  const int seeds = args.seeds > 0 ? args.seeds : (args.from.empty() ? 2 : 1);
   const fs::path root = args.output.empty()
                             ? fs::path("output") / (case_name(args.case_file) + "-calibrate")
                             : fs::path(args.output);
   std::vector<Job> jobs;
   std::vector<std::vector<fs::path>> runs(args.values.size());
+  std::size_t reused = 0;
   for (std::size_t i = 0; i < args.values.size(); ++i) {
     std::ostringstream value;
     value.precision(17);
     value << args.values[i];
     std::vector<std::string> overrides = args.overrides;
-    overrides.push_back(args.parameter + "=" + value.str());
-    for (int k = 0; k < args.seeds; ++k) {
+    for (const std::string& key : args.parameters) overrides.push_back(key + "=" + value.str());
+    for (int k = 0; k < seeds; ++k) {
       const int seed = args.first_seed + k;
       runs[i].push_back(root / ("value_" + std::to_string(i)) / ("seed_" + std::to_string(seed)));
-      jobs.push_back(run_job(self, args.case_file, runs[i].back(), seed, overrides));
+      Job job = run_job(self, args.case_file, runs[i].back(), seed, overrides);
+      if (!args.from.empty()) {
+        job.argv.erase(job.argv.begin() + 8, job.argv.begin() + 10);  // no --seed
+        job.argv.insert(job.argv.begin() + 5, "--restart");
+        job.start_from = args.from;
+      }
+      job.done_record = runs[i].back() / "calibration_run.txt";
+      if (args.reuse && already_done(job)) {
+        ++reused;
+      } else {
+        jobs.push_back(std::move(job));
+      }
     }
   }
-  std::printf("sanguis calibrate: %s over %zu values x %d seeds = %zu runs, %d at a time\n",
-              args.parameter.c_str(), args.values.size(), args.seeds, jobs.size(),
-              default_jobs(args.jobs));
-  run_jobs(self, jobs, default_jobs(args.jobs));
+  std::string keys;  // "a, b" on the console, "a+b" in the CSV
+  for (const std::string& key : args.parameters) keys += (keys.empty() ? "" : ", ") + key;
+  std::string csv_keys;
+  for (const std::string& key : args.parameters) csv_keys += (csv_keys.empty() ? "" : "+") + key;
+  std::printf(
+      "sanguis calibrate: %s over %zu values x %d seeds = %zu runs (%zu reused), %d at a "
+      "time%s\n",
+      keys.c_str(), args.values.size(), seeds, jobs.size() + reused, reused,
+      default_jobs(args.jobs),
+      args.from.empty() ? "" : (", each continued from " + args.from).c_str());
+  std::fflush(stdout);  // the header before the children's progress
+  if (!jobs.empty()) run_jobs(self, jobs, default_jobs(args.jobs));
 
   std::vector<double> mean(args.values.size()), sem(args.values.size()), sd(args.values.size());
   std::vector<std::vector<double>> samples(args.values.size());
@@ -364,15 +436,15 @@ int run_calibrate(const char* self, const CalibrateArgs& args) {
   io::write_file_atomically(root / "calibration_result.csv", [&](std::ostream& out) {
     out.precision(10);
     out << "parameter,measure,target,target_std,estimate,estimate_std,bracketed,slope\n"
-        << args.parameter << "," << args.measure << "," << args.target << "," << args.target_std
-        << "," << fit.value << "," << fit.std << "," << (fit.bracketed ? 1 : 0) << "," << fit.slope
+        << csv_keys << "," << args.measure << "," << args.target << "," << args.target_std << ","
+        << fit.value << "," << fit.std << "," << (fit.bracketed ? 1 : 0) << "," << fit.slope
         << "\n";
   });
   for (std::size_t i = 0; i < args.values.size(); ++i) {
-    std::printf("  %s = %-10.4g %s = %.4g +- %.2g\n", args.parameter.c_str(), args.values[i],
+    std::printf("  %s = %-10.4g %s = %.4g +- %.2g\n", keys.c_str(), args.values[i],
                 args.measure.c_str(), mean[i], sd[i]);
   }
-  std::printf("%s = %.4g +- %.2g for %s = %.4g%s\n", args.parameter.c_str(), fit.value, fit.std,
+  std::printf("%s = %.4g +- %.2g for %s = %.4g%s\n", keys.c_str(), fit.value, fit.std,
               args.measure.c_str(), args.target,
               fit.bracketed ? "" : "  (WARNING: target outside the measured range, extrapolated)");
   std::printf("written: %s\n", (root / "calibration_result.csv").string().c_str());
@@ -424,9 +496,11 @@ std::function<bool()> add_analysis_commands(CLI::App& app) {
   ca->add_option("case", calibrate->case_file, "case file (TOML)")
       ->required()
       ->check(CLI::ExistingFile);
-  ca->add_option("--parameter", calibrate->parameter,
-                 "case key to vary, e.g. interaction[0].friction")
-      ->required();
+  ca->add_option("--parameter", calibrate->parameters,
+                 "case key to vary, e.g. interaction[0].friction; several (a,b or repeated): "
+                 "all take the same value")
+      ->required()
+      ->delimiter(',');
   ca->add_option("--values", calibrate->values, "increasing values to try (a,b,c or a b c)")
       ->required()
       ->delimiter(',');
@@ -436,14 +510,20 @@ std::function<bool()> add_analysis_commands(CLI::App& app) {
   ca->add_option("--target", calibrate->target, "target value of the measure")->required();
   ca->add_option("--target-std", calibrate->target_std, "uncertainty of the target")
       ->capture_default_str();
-  ca->add_option("--seeds", calibrate->seeds, "runs per value")
-      ->capture_default_str()
+  ca->add_option("--seeds", calibrate->seeds, "runs per value (default 2; 1 with --from)")
       ->check(CLI::PositiveNumber);
   ca->add_option("--first-seed", calibrate->first_seed, "seed of the first run")
       ->capture_default_str();
   ca->add_option("--jobs,-j", calibrate->jobs, "runs at a time (default: the cores)");
   ca->add_option("--output,-o", calibrate->output, "folder (default output/<case>-calibrate)");
   ca->add_option("--set", calibrate->overrides, "override KEY=VALUE in every run");
+  ca->add_option("--from", calibrate->from,
+                 "continue every run from this run folder's checkpoint (a common prepared "
+                 "packing) instead of starting the case afresh")
+      ->check(CLI::ExistingDirectory);
+  ca->add_flag("--reuse", calibrate->reuse,
+               "keep the runs that already finished with the same command line "
+               "(VALUE_i/SEED_k/calibration_run.txt) instead of running them again");
 
   // Not the resolved path: /proc/self/exe still starts this executable when its
   // file was replaced (a rebuild) while a long study runs.

@@ -15,16 +15,21 @@ namespace sanguis::bench {
 
 namespace {
 
-flow::ForestSpec cavity_forest(std::int64_t cells_per_side, int threads) {
-  if (cells_per_side < 8 || cells_per_side % 8 != 0) {
-    throw std::invalid_argument("flow-cavity: --cells-per-side must be a multiple of 8, got " +
+flow::ForestSpec cavity_forest(std::int64_t cells_per_side, int block_cells, int threads) {
+  if (block_cells < 2 || (block_cells & (block_cells - 1)) != 0) {
+    throw std::invalid_argument("flow-cavity: --block-cells must be a power of two >= 2, got " +
+                                std::to_string(block_cells));
+  }
+  if (cells_per_side < block_cells || cells_per_side % block_cells != 0) {
+    throw std::invalid_argument("flow-cavity: --cells-per-side must be a multiple of " +
+                                std::to_string(block_cells) + ", got " +
                                 std::to_string(cells_per_side));
   }
   flow::ForestSpec spec;
-  const int trees = static_cast<int>(cells_per_side / 8);
+  const int trees = static_cast<int>(cells_per_side / block_cells);
   spec.trees = {trees, trees, trees};
   spec.tree_length = 1.0 / trees;
-  spec.block_cells = 8;
+  spec.block_cells = block_cells;
   spec.threads = threads;
   return spec;
 }
@@ -71,7 +76,7 @@ std::array<flow::FlowBoundary, 6> cavity_boundaries(double lid_velocity) {
 }
 
 std::string run_flow_cavity(const BenchOptions& o) {
-  const flow::Forest forest(cavity_forest(o.cells_per_side, o.threads));
+  const flow::Forest forest(cavity_forest(o.cells_per_side, o.block_cells, o.threads));
   flow::NavierStokesOptions options;
   options.dt_max = 0.01;
   options.pressure.tolerance = 1e-3;
@@ -120,8 +125,8 @@ std::string run_flow_cavity(const BenchOptions& o) {
   json.precision(6);
   json << "{\"benchmark\":\"flow-cavity\",\"code\":\"sanguis\",\"cells\":"
        << static_cast<std::int64_t>(cells) << ",\"steps\":" << o.steps
-       << ",\"threads\":" << o.threads << ",\"ranks\":" << forest.ranks()
-       << ",\"seconds\":" << seconds
+       << ",\"block_cells\":" << o.block_cells << ",\"threads\":" << o.threads
+       << ",\"ranks\":" << forest.ranks() << ",\"seconds\":" << seconds
        << ",\"cell_updates_per_s\":" << cells * static_cast<double>(o.steps) / seconds
        << ",\"vcycles_per_step\":" << static_cast<double>(cycles) / static_cast<double>(o.steps)
        << ",\"multigrid_s_per_vcycle_per_cell\":"
@@ -129,8 +134,8 @@ std::string run_flow_cavity(const BenchOptions& o) {
        << ",\"multigrid_reduction_per_cycle\":" << mg_report.mean_reduction()
        << ",\"multigrid_kernels\":\"" << (constant ? "constant" : "general") << "\"";
   const double triad = stream_triad_bytes_per_s();
-  const double effective = vcycle_bytes_per_cell(!constant) *
-                           static_cast<double>(mg_report.cycles) * cells / mg_seconds;
+  const double effective =
+      vcycle_bytes_per_cell(!constant) * static_cast<double>(mg_report.cycles) * cells / mg_seconds;
   json << ",\"stream_triad_GB_s\":" << triad * 1e-9
        << ",\"multigrid_effective_GB_s\":" << effective * 1e-9
        << ",\"multigrid_bandwidth_fraction\":" << effective / triad << "}";

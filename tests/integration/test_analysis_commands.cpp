@@ -139,6 +139,58 @@ TEST_F(AnalysisCommandTest, CalibrateFitsAParameterToATarget) {
   EXPECT_NEAR(number(result, "estimate"), 0.45, 1e-6);
 }
 
+// A calibration continued from one prepared state (the column at rest before
+// the gate opens), varying two keys together; a second call with --reuse keeps
+// the finished runs, and a changed command line runs them again.
+TEST_F(AnalysisCommandTest, CalibrateContinuesFromAPreparedStateAndReusesRuns) {
+  const fs::path prepared = dir_ / "prepared";
+  const CommandResult p =
+      sanguis("run " + kTinyCase + " --quiet --threads 1 -o " + shell_quoted(prepared.string()) +
+              " --set simulation.end_time_s=0.2");
+  ASSERT_EQ(p.code, 0) << p.err;
+  const fs::path root = dir_ / "cal";
+  const auto calibrate = [&](const std::string& values, const fs::path& from) {
+    return "calibrate " + kTinyCase +
+           " --parameter interaction[0].friction,interaction[1].friction --values " + values +
+           " --measure Linf_m --target 0.05 --jobs 2 --set simulation.end_time_s=0.45 -o " +
+           shell_quoted(root.string()) + " --from " + shell_quoted(from.string());
+  };
+  const std::string common = calibrate("0.1,0.8", prepared);
+  const CommandResult c = sanguis(common);
+  ASSERT_EQ(c.code, 0) << c.err << c.out;
+  EXPECT_NE(c.out.find("(0 reused)"), std::string::npos) << c.out;
+  const fs::path run = root / "value_1" / "seed_1";
+  // The run holds the prepared frames unchanged and continues them with both keys set.
+  EXPECT_EQ(read_text_file(run / "particles" / "particles_00000000.vtu"),
+            read_text_file(prepared / "particles" / "particles_00000000.vtu"));
+  const std::string log = read_text_file(run / "run.log");
+  const std::string prepared_log = read_text_file(prepared / "run.log");
+  ASSERT_EQ(log.substr(0, prepared_log.size()), prepared_log);  // continued, not restarted
+  const std::string continuation = log.substr(prepared_log.size());
+  EXPECT_NE(continuation.find("mu_c = 0.8"), std::string::npos) << continuation;
+  EXPECT_EQ(continuation.find("mu_c = 0.5\n"), std::string::npos);
+  EXPECT_EQ(continuation.find("mu_c = 0.45"), std::string::npos);
+  EXPECT_NE(read_text_file(run / "calibration_run.txt").find("--restart"), std::string::npos);
+  const std::string table = read_text_file(root / "calibration.csv");
+
+  const CommandResult again = sanguis(common + " --reuse");
+  ASSERT_EQ(again.code, 0) << again.err;
+  EXPECT_NE(again.out.find("(2 reused)"), std::string::npos) << again.out;
+  EXPECT_EQ(read_text_file(run / "run.log"), log);  // not run again
+  EXPECT_EQ(read_text_file(root / "calibration.csv"), table);
+  const CommandResult changed = sanguis(calibrate("0.1,0.9", prepared) + " --reuse");
+  ASSERT_EQ(changed.code, 0) << changed.err;
+  EXPECT_NE(changed.out.find("(1 reused)"), std::string::npos) << changed.out;
+  EXPECT_NE(read_text_file(run / "run.log").find("mu_c = 0.9"), std::string::npos);
+
+  const CommandResult seeds = sanguis(common + " --seeds 2");
+  EXPECT_EQ(seeds.code, 2);
+  EXPECT_NE(seeds.err.find("--seeds"), std::string::npos) << seeds.err;
+  const CommandResult empty = sanguis(calibrate("0.1,0.8", dir_));
+  EXPECT_EQ(empty.code, 2);
+  EXPECT_NE(empty.err.find("no checkpoint.bin"), std::string::npos) << empty.err;
+}
+
 TEST_F(AnalysisCommandTest, RunSetOverridesAreStrict) {
   const fs::path out = dir_ / "o";
   CommandResult r = sanguis("run " + kTinyCase + " -q -o " + shell_quoted(out.string()) +
