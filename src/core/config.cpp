@@ -94,8 +94,10 @@ void ConfigTable::set_override(const std::string& assignment) {
     throw InputError(source_, where,
                      std::string("value is not TOML: ") + std::string(e.description()));
   }
-  // Walk "a.b[2].c": every component but the last must name an existing table
-  // (or an element of an array of tables).
+  // Walk "a.b[2].c": an indexed component must name an existing element of an
+  // array of tables; a missing plain table is created (an optional table the
+  // case leaves out, e.g. [stop]): the reader then refuses it if it is not a
+  // key of the case, like a misspelt table in the file.
   toml::table* table = &shared_->root;
   std::size_t begin = 0;
   while (true) {
@@ -122,7 +124,10 @@ void ConfigTable::set_override(const std::string& assignment) {
       return;
     }
     toml::node* next = table->get(part);
-    if (next == nullptr) throw InputError(source_, where, "no table '" + part + "' in the case");
+    if (next == nullptr) {
+      if (index) throw InputError(source_, where, "no array of tables '" + part + "' in the case");
+      next = table->insert(part, toml::table{}).first->second.as_table();
+    }
     if (index) {
       toml::array* array = next->as_array();
       if (array == nullptr || *index >= array->size()) {

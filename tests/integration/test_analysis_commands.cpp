@@ -205,6 +205,17 @@ TEST_F(AnalysisCommandTest, RunSetOverridesAreStrict) {
               " --set simulation.end_time_s=-1");
   EXPECT_EQ(r.code, 2);
   EXPECT_FALSE(fs::exists(out));
+  // A table the case leaves out can be given; a misspelt one is refused.
+  r = sanguis("run " + kTinyCase + " -q -o " + shell_quoted(out.string()) +
+              " --set stopp.mean_velocity_below_m_s=1e-3");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("stopp"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  r = sanguis("run " + kTinyCase + " -q -o " + shell_quoted(out.string()) +
+              " --set stop.mean_velocity_below_m_s=100 --set stop.check_after_s=0.3");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(read_text_file(out / "run.log").find("settled"), std::string::npos)
+      << read_text_file(out / "run.log");
 }
 
 }  // namespace
