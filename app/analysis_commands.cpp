@@ -1,11 +1,15 @@
 #include "analysis_commands.hpp"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <array>
+#include <atomic>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -157,9 +161,51 @@ bool already_done(const Job& job) {
   return line == command_line(job.argv);
 }
 
+// The running children, for the signal handler below (async-signal-safe: a
+// fixed array of atomics, 0 = free slot).
+constexpr std::size_t kMaxChildren = 256;
+std::array<std::atomic<pid_t>, kMaxChildren> g_children{};
+
+// Stopping `calibrate` or `ensemble` (Ctrl-C, kill, a closed terminal) stops its
+// runs too: they would otherwise go on writing into folders that a new call
+// clears and fills again.
+extern "C" void stop_children_and_exit(int signal_number) {
+  for (auto& child : g_children) {
+    const pid_t pid = child.load();
+    if (pid > 0) kill(pid, SIGTERM);
+  }
+  std::signal(signal_number, SIG_DFL);
+  raise(signal_number);
+}
+
+struct ChildSignalGuard {
+  ChildSignalGuard() {
+    for (int s : {SIGINT, SIGTERM, SIGHUP}) std::signal(s, stop_children_and_exit);
+  }
+  ~ChildSignalGuard() {
+    for (int s : {SIGINT, SIGTERM, SIGHUP}) std::signal(s, SIG_DFL);
+  }
+  ChildSignalGuard(const ChildSignalGuard&) = delete;
+  ChildSignalGuard& operator=(const ChildSignalGuard&) = delete;
+  static void add(pid_t pid) {
+    for (auto& child : g_children) {
+      pid_t free_slot = 0;
+      if (child.compare_exchange_strong(free_slot, pid)) return;
+    }
+  }
+  static void remove(pid_t pid) {
+    for (auto& child : g_children) {
+      pid_t expected = pid;
+      if (child.compare_exchange_strong(expected, 0)) return;
+    }
+  }
+};
+
 // Runs the jobs as child processes of this executable, at most `parallel` at a
-// time; each writes its console output to its log. Throws if any failed.
+// time; each writes its console output to its log. Throws if any failed. A
+// signal that stops this process stops the children first.
 void run_jobs(const char* self, const std::vector<Job>& jobs, int parallel) {
+  const ChildSignalGuard guard;
   ProgressReporter progress(std::cerr, isatty(STDERR_FILENO) != 0);
   std::map<pid_t, std::size_t> running;
   std::size_t next = 0, done = 0;
@@ -170,6 +216,7 @@ void run_jobs(const char* self, const std::vector<Job>& jobs, int parallel) {
     if (pid < 0) return;
     const std::size_t k = running.at(pid);
     running.erase(pid);
+    ChildSignalGuard::remove(pid);
     ++done;
     if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
       failures.push_back(jobs[k].log.string());
@@ -206,6 +253,7 @@ void run_jobs(const char* self, const std::vector<Job>& jobs, int parallel) {
       const int rc = posix_spawn(&pid, self, &actions, nullptr, argv.data(), environ);
       posix_spawn_file_actions_destroy(&actions);
       if (rc != 0) throw std::runtime_error(std::string("cannot start ") + self);
+      ChildSignalGuard::add(pid);
       running[pid] = next++;
     } else {
       wait_one();
@@ -225,10 +273,11 @@ int default_jobs(int jobs) {
   return cores > 0 ? static_cast<int>(cores) : 1;
 }
 
-Job run_job(const std::string& self, const std::string& case_file, const fs::path& out, int seed,
+// argv[0] names the program for ps (run_jobs starts this executable by its path).
+Job run_job(const std::string& case_file, const fs::path& out, int seed,
             const std::vector<std::string>& overrides) {
   Job job;
-  job.argv = {self,      "run",       case_file, "--output", out.string(),
+  job.argv = {"sanguis", "run",       case_file, "--output", out.string(),
               "--quiet", "--threads", "1",       "--seed",   std::to_string(seed)};
   for (const std::string& o : overrides) {
     job.argv.push_back("--set");
@@ -251,7 +300,7 @@ int run_ensemble(const char* self, const EnsembleArgs& args) {
   for (int k = 0; k < args.seeds; ++k) {
     const int seed = args.first_seed + k;
     runs.push_back(root / ("seed_" + std::to_string(seed)));
-    jobs.push_back(run_job(self, args.case_file, runs.back(), seed, args.overrides));
+    jobs.push_back(run_job(args.case_file, runs.back(), seed, args.overrides));
   }
   std::printf("sanguis ensemble: %d runs of %s, %d at a time, into %s\n", args.seeds,
               args.case_file.c_str(), default_jobs(args.jobs), root.string().c_str());
@@ -367,7 +416,7 @@ int run_calibrate(const char* self, const CalibrateArgs& args) {
     for (int k = 0; k < seeds; ++k) {
       const int seed = args.first_seed + k;
       runs[i].push_back(root / ("value_" + std::to_string(i)) / ("seed_" + std::to_string(seed)));
-      Job job = run_job(self, args.case_file, runs[i].back(), seed, overrides);
+      Job job = run_job(args.case_file, runs[i].back(), seed, overrides);
       if (!args.from.empty()) {
         job.argv.erase(job.argv.begin() + 8, job.argv.begin() + 10);  // no --seed
         job.argv.insert(job.argv.begin() + 5, "--restart");

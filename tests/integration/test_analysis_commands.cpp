@@ -2,9 +2,13 @@
 // dam break (tests/integration/data/dam-break-tiny.toml), and of `run --set`.
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <fstream>
+#include <iterator>
 #include <map>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "cli_harness.hpp"
@@ -189,6 +193,42 @@ TEST_F(AnalysisCommandTest, CalibrateContinuesFromAPreparedStateAndReusesRuns) {
   const CommandResult empty = sanguis(calibrate("0.1,0.8", dir_));
   EXPECT_EQ(empty.code, 2);
   EXPECT_NE(empty.err.find("no checkpoint.bin"), std::string::npos) << empty.err;
+}
+
+// Processes whose command line mentions `text` (a scan of /proc).
+int processes_mentioning(const std::string& text) {
+  int count = 0;
+  for (const auto& entry : fs::directory_iterator("/proc")) {
+    const std::string name = entry.path().filename().string();
+    if (name.find_first_not_of("0123456789") != std::string::npos) continue;
+    std::ifstream in(entry.path() / "cmdline", std::ios::binary);
+    const std::string cmdline((std::istreambuf_iterator<char>(in)),
+                              std::istreambuf_iterator<char>());
+    if (cmdline.find(text) != std::string::npos) ++count;
+  }
+  return count;
+}
+
+// Stopping an ensemble stops its runs: they must not go on writing into
+// folders that the next call clears.
+TEST_F(AnalysisCommandTest, StoppingAnEnsembleStopsItsRuns) {
+  const fs::path root = dir_ / "ens";
+  const std::string command =
+      shell_quoted(SANGUIS_BINARY) + " ensemble " + kTinyCase + " --seeds 2 --jobs 2 -o " +
+      shell_quoted(root.string()) + " --set simulation.end_time_s=1000 >/dev/null 2>&1 & " +
+      "P=$!; for i in $(seq 100); do [ -s " + shell_quoted((root / "seed_2" / "run.log").string()) +
+      " ] && break; sleep 0.1; done; kill -TERM $P; wait $P; echo $? > " +
+      shell_quoted((dir_ / "status").string());
+  ASSERT_EQ(std::system(command.c_str()), 0);
+  EXPECT_EQ(read_text_file(dir_ / "status"), "143\n");  // ended by SIGTERM
+  int left = processes_mentioning(root.string());
+  for (int wait = 0; wait < 50 && left > 0; ++wait) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    left = processes_mentioning(root.string());
+  }
+  EXPECT_EQ(left, 0);
+  // The runs had started.
+  EXPECT_TRUE(fs::exists(root / "seed_1" / "console.txt"));
 }
 
 TEST_F(AnalysisCommandTest, RunSetOverridesAreStrict) {
