@@ -4,8 +4,10 @@
 # lid-driven cubic cavity (Re = 100, lid velocity 1, nu = 0.01, uniform N^3
 # cells, fixed dt = 0.01, projection tolerance 1e-3), one core each.
 #
-#   bench/flow_cavity_vs_gerris.sh [--cells-per-side N] [--steps S]
+#   bench/flow_cavity_vs_gerris.sh [--cells-per-side N] [--steps S] [--block-cells B]
 #
+# B: sanguis' cells per block edge (default 8, its case-file default; 16 runs
+# a uniform grid about twice as fast per cell, see docs/performance.md).
 # N must be a power of two for Gerris (2^level); default 64 and 10 steps.
 # Gerris' time is the wall time between its step 0 and its last step (its own
 # log), so its set-up is excluded as for sanguis. Prints one JSON line per code
@@ -18,11 +20,13 @@ sanguis="${SANGUIS:-$root/build/app/sanguis}"
 gerris="${GERRIS:-gerris3D}"
 cells=64
 steps=10
+block=8
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --cells-per-side) cells="${2:?--cells-per-side needs a value}"; shift 2 ;;
     --steps) steps="${2:?--steps needs a value}"; shift 2 ;;
-    -h|--help) sed -n '2,14p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --block-cells) block="${2:?--block-cells needs a value}"; shift 2 ;;
+    -h|--help) sed -n '2,17p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "flow_cavity_vs_gerris: unknown option $1" >&2; exit 2 ;;
   esac
 done
@@ -40,8 +44,8 @@ gerris_seconds=$(awk '/^step:/ { if ($2 == 0) t0 = $10; t1 = $10 } END { printf 
 gerris_rate=$(awk -v n="$cells" -v s="$steps" -v t="$gerris_seconds" 'BEGIN { printf "%.6g", n * n * n * s / t }')
 echo "{\"benchmark\":\"flow-cavity\",\"code\":\"gerris\",\"cells\":$((cells * cells * cells)),\"steps\":$steps,\"seconds\":$gerris_seconds,\"cell_updates_per_s\":$gerris_rate}"
 echo "flow-cavity: sanguis ..." >&2
-line=$("$sanguis" bench flow-cavity --cells-per-side "$cells" --steps "$steps" --threads 1)
+line=$("$sanguis" bench flow-cavity --cells-per-side "$cells" --steps "$steps" --threads 1 --block-cells "$block")
 echo "$line"
 sanguis_rate=$(echo "$line" | sed 's/.*"cell_updates_per_s":\([0-9.e+-]*\).*/\1/')
-awk -v a="$sanguis_rate" -v b="$gerris_rate" -v n="$cells" -v s="$steps" \
-  'BEGIN { printf "{\"benchmark\":\"flow-cavity\",\"summary\":true,\"cells_per_side\":%d,\"steps\":%d,\"gerris_cell_updates_per_s\":%s,\"sanguis_cell_updates_per_s\":%s,\"ratio_sanguis_over_gerris\":%.3g}\n", n, s, b, a, a / b }'
+awk -v a="$sanguis_rate" -v b="$gerris_rate" -v n="$cells" -v s="$steps" -v blk="$block" \
+  'BEGIN { printf "{\"benchmark\":\"flow-cavity\",\"summary\":true,\"block_cells\":%d,\"cells_per_side\":%d,\"steps\":%d,\"gerris_cell_updates_per_s\":%s,\"sanguis_cell_updates_per_s\":%s,\"ratio_sanguis_over_gerris\":%.3g}\n", blk, n, s, b, a, a / b }'
