@@ -8,6 +8,7 @@
 
 #include <array>
 #include <atomic>
+#include <charconv>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -146,9 +147,17 @@ struct Job {
   fs::path done_record;  // not empty: written with the command line once the run succeeded
 };
 
+// The arguments that decide what a run computes: all but the program and the
+// output folder (a run keeps its record when its folder is renamed).
 std::string command_line(const std::vector<std::string>& argv) {
   std::string line;
-  for (std::size_t k = 1; k < argv.size(); ++k) line += (k > 1 ? " " : "") + argv[k];
+  for (std::size_t k = 1; k < argv.size(); ++k) {
+    if (argv[k] == "--output") {
+      ++k;
+      continue;
+    }
+    line += (line.empty() ? "" : " ") + argv[k];
+  }
   return line;
 }
 
@@ -328,8 +337,12 @@ struct Fit {
 // Solves m(v) = target with a weighted straight line m = a + b v through the
 // grid values around the first crossing of the target by the mean curve; the
 // uncertainty propagates the line's covariance and the target's spread.
+// Without replicate runs (one per value: `sem` unknown) the points weigh the
+// same and their scatter about the line stands for the noise (NaN with two
+// points: nothing measures it).
 Fit fit_crossing(const std::vector<double>& v, const std::vector<double>& mean,
-                 const std::vector<double>& sem, double target, double target_std) {
+                 const std::vector<double>& sem, bool replicates, double target,
+                 double target_std) {
   Fit fit;
   std::size_t cross = v.size();
   for (std::size_t k = 0; k + 1 < v.size(); ++k) {
@@ -346,7 +359,8 @@ Fit fit_crossing(const std::vector<double>& v, const std::vector<double>& mean,
   const std::size_t hi = std::min(v.size() - 1, cross + 2);
   double sw = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
   for (std::size_t k = lo; k <= hi; ++k) {
-    const double w = 1.0 / std::max(sem[k] * sem[k], 1e-12 * (1.0 + mean[k] * mean[k]));
+    const double w =
+        replicates ? 1.0 / std::max(sem[k] * sem[k], 1e-12 * (1.0 + mean[k] * mean[k])) : 1.0;
     sw += w;
     sx += w * v[k];
     sy += w * mean[k];
@@ -356,7 +370,14 @@ Fit fit_crossing(const std::vector<double>& v, const std::vector<double>& mean,
   const double det = sw * sxx - sx * sx;
   const double b = (sw * sxy - sx * sy) / det;
   const double a = (sy - b * sx) / sw;
-  const double var_a = sxx / det, var_b = sw / det, cov_ab = -sx / det;
+  double scale = 1.0;  // the variance of one point, in units of 1/w
+  if (!replicates) {
+    double squares = 0.0;
+    for (std::size_t k = lo; k <= hi; ++k) squares += std::pow(mean[k] - a - b * v[k], 2);
+    const double points = static_cast<double>(hi - lo + 1);
+    scale = points > 2 ? squares / (points - 2) : NAN;
+  }
+  const double var_a = scale * sxx / det, var_b = scale * sw / det, cov_ab = -scale * sx / det;
   fit.slope = b;
   fit.value = (target - a) / b;
   // v* = (t - a) / b: derivatives -1/b (a), -(t - a)/b^2 (b), 1/b (t).
@@ -408,14 +429,17 @@ int run_calibrate(const char* self, const CalibrateArgs& args) {
   std::vector<std::vector<fs::path>> runs(args.values.size());
   std::size_t reused = 0;
   for (std::size_t i = 0; i < args.values.size(); ++i) {
-    std::ostringstream value;
-    value.precision(17);
-    value << args.values[i];
+    // The shortest text that reads back as the same double: exact in --set,
+    // and a readable folder name (0.8, not 0.80000000000000004).
+    char text[32];
+    const auto written = std::to_chars(text, text + sizeof text, args.values[i]);
+    const std::string value(text, written.ptr);
     std::vector<std::string> overrides = args.overrides;
-    for (const std::string& key : args.parameters) overrides.push_back(key + "=" + value.str());
+    for (const std::string& key : args.parameters) overrides.push_back(key + "=" + value);
     for (int k = 0; k < seeds; ++k) {
       const int seed = args.first_seed + k;
-      runs[i].push_back(root / ("value_" + std::to_string(i)) / ("seed_" + std::to_string(seed)));
+      // Folders named by the value: a list with a value added reuses the others.
+      runs[i].push_back(root / ("value_" + value) / ("seed_" + std::to_string(seed)));
       Job job = run_job(args.case_file, runs[i].back(), seed, overrides);
       if (!args.from.empty()) {
         job.argv.erase(job.argv.begin() + 8, job.argv.begin() + 10);  // no --seed
@@ -473,7 +497,7 @@ int run_calibrate(const char* self, const CalibrateArgs& args) {
       sem[i] = std::sqrt(pooled_variance / static_cast<double>(samples[i].size()));
     }
   }
-  const Fit fit = fit_crossing(args.values, mean, sem, args.target, args.target_std);
+  const Fit fit = fit_crossing(args.values, mean, sem, dof > 0, args.target, args.target_std);
 
   io::write_file_atomically(root / "calibration.csv", [&](std::ostream& out) {
     out.precision(10);

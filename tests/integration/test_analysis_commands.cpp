@@ -163,7 +163,7 @@ TEST_F(AnalysisCommandTest, CalibrateContinuesFromAPreparedStateAndReusesRuns) {
   const CommandResult c = sanguis(common);
   ASSERT_EQ(c.code, 0) << c.err << c.out;
   EXPECT_NE(c.out.find("(0 reused)"), std::string::npos) << c.out;
-  const fs::path run = root / "value_1" / "seed_1";
+  const fs::path run = root / "value_0.8" / "seed_1";
   // The run holds the prepared frames unchanged and continues them with both keys set.
   EXPECT_EQ(read_text_file(run / "particles" / "particles_00000000.vtu"),
             read_text_file(prepared / "particles" / "particles_00000000.vtu"));
@@ -175,6 +175,7 @@ TEST_F(AnalysisCommandTest, CalibrateContinuesFromAPreparedStateAndReusesRuns) {
   EXPECT_EQ(continuation.find("mu_c = 0.5\n"), std::string::npos);
   EXPECT_EQ(continuation.find("mu_c = 0.45"), std::string::npos);
   EXPECT_NE(read_text_file(run / "calibration_run.txt").find("--restart"), std::string::npos);
+  EXPECT_EQ(read_text_file(run / "calibration_run.txt").find("--output"), std::string::npos);
   const std::string table = read_text_file(root / "calibration.csv");
 
   const CommandResult again = sanguis(common + " --reuse");
@@ -182,10 +183,18 @@ TEST_F(AnalysisCommandTest, CalibrateContinuesFromAPreparedStateAndReusesRuns) {
   EXPECT_NE(again.out.find("(2 reused)"), std::string::npos) << again.out;
   EXPECT_EQ(read_text_file(run / "run.log"), log);  // not run again
   EXPECT_EQ(read_text_file(root / "calibration.csv"), table);
-  const CommandResult changed = sanguis(calibrate("0.1,0.9", prepared) + " --reuse");
+  // A value added: the others are kept.
+  const CommandResult changed = sanguis(calibrate("0.1,0.5,0.8", prepared) + " --reuse");
   ASSERT_EQ(changed.code, 0) << changed.err;
-  EXPECT_NE(changed.out.find("(1 reused)"), std::string::npos) << changed.out;
-  EXPECT_NE(read_text_file(run / "run.log").find("mu_c = 0.9"), std::string::npos);
+  EXPECT_NE(changed.out.find("(2 reused)"), std::string::npos) << changed.out;
+  EXPECT_EQ(read_text_file(run / "run.log"), log);
+  EXPECT_NE(read_text_file(root / "value_0.5" / "seed_1" / "run.log").find("mu_c = 0.5"),
+            std::string::npos);
+  // Changed settings: run again.
+  const CommandResult other = sanguis(calibrate("0.1,0.8", prepared) +
+                                      " --reuse --set interaction[0].rolling_friction=0.1");
+  ASSERT_EQ(other.code, 0) << other.err;
+  EXPECT_NE(other.out.find("(0 reused)"), std::string::npos) << other.out;
 
   const CommandResult seeds = sanguis(common + " --seeds 2");
   EXPECT_EQ(seeds.code, 2);
