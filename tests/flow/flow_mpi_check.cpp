@@ -13,6 +13,7 @@
 #include "flow/adapt_criterion.hpp"
 #include "flow/mpi_session.hpp"
 #include "flow/navier_stokes.hpp"
+#include "navier_stokes_problems.hpp"
 #include "poisson_problems.hpp"
 
 namespace {
@@ -75,8 +76,7 @@ int check_navier_stokes() {
     spec.level = 1;
     spec.comm = comm;
     const Forest forest(spec);
-    std::array<FlowBoundary, 6> bcs{};
-    bcs[face_index(1, 1)].wall_velocity = {1.0, 0.0, 0.0};
+    const auto bcs = testing::lid_driven_cavity();
     NavierStokesOptions options;
     options.pressure.tolerance = 1e-10;
     options.viscous.tolerance = 1e-10;

@@ -16,6 +16,13 @@ inline std::array<FlowBoundary, 6> all_periodic() {
   return bcs;
 }
 
+/// The lid-driven cavity: walls all round, the lid y = max moving along x at 1.
+inline std::array<FlowBoundary, 6> lid_driven_cavity() {
+  std::array<FlowBoundary, 6> bcs{};
+  bcs[face_index(1, 1)].wall_velocity = {1.0, 0.0, 0.0};
+  return bcs;
+}
+
 /// A deterministic rough field in [-1, 1] (no structure the projection could exploit).
 inline double rough(const Vec3& x, int seed) {
   const double v = std::sin(12.9898 * x.x + 78.233 * x.y + 37.719 * x.z + 4.1 * seed) * 43758.5453;

@@ -243,8 +243,7 @@ TEST(FlowNavierStokes, OpenMpThreadsOverBlocksGiveTheSameResultBitForBit) {
     spec.level = 1;  // 16^3 cells in 8 blocks
     spec.threads = threads;
     const Forest forest(spec);
-    std::array<FlowBoundary, 6> bcs{};
-    bcs[face_index(1, 1)].wall_velocity = {1.0, 0.0, 0.0};
+    const auto bcs = testing::lid_driven_cavity();
     NavierStokes ns(forest, bcs, Fluid{1.0, 0.01});
     ns.set_velocity([](const Vec3&) { return Vec3{}; });
     for (int s = 0; s < 5; ++s) ns.step(0.02);
@@ -269,8 +268,7 @@ TEST(FlowNavierStokes, TheBlockSizeDoesNotChangeTheFlow) {
     spec.trees = {trees, trees, trees};
     spec.tree_length = 1.0 / trees;
     const Forest forest(spec);
-    std::array<FlowBoundary, 6> bcs{};
-    bcs[face_index(1, 1)].wall_velocity = {1.0, 0.0, 0.0};
+    const auto bcs = testing::lid_driven_cavity();
     NavierStokesOptions options;
     options.pressure.tolerance = 1e-12;
     options.viscous.tolerance = 1e-12;
