@@ -283,16 +283,24 @@ int default_jobs(int jobs) {
 }
 
 // argv[0] names the program for ps (run_jobs starts this executable by its path).
+// A run continued from `start_from` (a run folder with a checkpoint) takes no
+// seed: it restarts from the copied checkpoint.
 Job run_job(const std::string& case_file, const fs::path& out, int seed,
-            const std::vector<std::string>& overrides) {
+            const std::vector<std::string>& overrides, const fs::path& start_from = {}) {
   Job job;
-  job.argv = {"sanguis", "run",       case_file, "--output", out.string(),
-              "--quiet", "--threads", "1",       "--seed",   std::to_string(seed)};
+  job.argv = {"sanguis", "run", case_file, "--output", out.string()};
+  if (!start_from.empty()) job.argv.push_back("--restart");
+  for (const char* a : {"--quiet", "--threads", "1"}) job.argv.push_back(a);
+  if (start_from.empty()) {
+    job.argv.push_back("--seed");
+    job.argv.push_back(std::to_string(seed));
+  }
   for (const std::string& o : overrides) {
     job.argv.push_back("--set");
     job.argv.push_back(o);
   }
   job.log = out / "console.txt";
+  job.start_from = start_from;
   return job;
 }
 
@@ -440,12 +448,7 @@ int run_calibrate(const char* self, const CalibrateArgs& args) {
       const int seed = args.first_seed + k;
       // Folders named by the value: a list with a value added reuses the others.
       runs[i].push_back(root / ("value_" + value) / ("seed_" + std::to_string(seed)));
-      Job job = run_job(args.case_file, runs[i].back(), seed, overrides);
-      if (!args.from.empty()) {
-        job.argv.erase(job.argv.begin() + 8, job.argv.begin() + 10);  // no --seed
-        job.argv.insert(job.argv.begin() + 5, "--restart");
-        job.start_from = args.from;
-      }
+      Job job = run_job(args.case_file, runs[i].back(), seed, overrides, args.from);
       job.done_record = runs[i].back() / "calibration_run.txt";
       if (args.reuse && already_done(job)) {
         ++reused;

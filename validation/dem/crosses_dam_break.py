@@ -162,6 +162,17 @@ def diagnostics(run):
         return [{k: float(v) for k, v in r.items()} for r in csv.DictReader(f)]
 
 
+def draw_velocity_bands(ax):
+    """The thesis' Fig. 3.9 peaks (mean speed against t / tau_c) as bands, the 0.05
+    line, axis labels and legend: the frame of every mean-speed panel."""
+    ax.fill_between([3.0, 5.0], 0.34, 0.39, color="0.85", label="thesis, 1000 crosses (narrow)")
+    ax.fill_between([2.0, 3.0], 0.18, 0.22, color="0.65", label="thesis, 3000 crosses (wide)")
+    ax.axhline(0.05, color="k", lw=0.8, ls=":")
+    ax.set_xlabel(r"$t/\tau_c$")
+    ax.set_ylabel(r"mean speed / $\sqrt{g H_0}$")
+    ax.legend(fontsize=8)
+
+
 def velocity_curve(run):
     with open(os.path.join(run, "analysis", "velocity.csv"), newline="") as f:
         rows = list(csv.DictReader(f))
@@ -270,12 +281,7 @@ def main():
     for gate, _, out in points:
         t, v = velocity_curve(out)
         a2.plot(t, v, label=f"sanguis, gate {gate} cm")
-    a2.fill_between([3.0, 5.0], 0.34, 0.39, color="0.85", label="thesis, 1000 crosses (narrow)")
-    a2.fill_between([2.0, 3.0], 0.18, 0.22, color="0.65", label="thesis, 3000 crosses (wide)")
-    a2.axhline(0.05, color="k", lw=0.8, ls=":")
-    a2.set_xlabel(r"$t/\tau_c$")
-    a2.set_ylabel(r"mean speed / $\sqrt{g H_0}$")
-    a2.legend(fontsize=8)
+    draw_velocity_bands(a2)
     fig.tight_layout()
     fig.savefig(FIGURE, dpi=130)
 
