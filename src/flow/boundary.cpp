@@ -72,24 +72,25 @@ void fill_face(const Block& block, BlockField& field, int blk, int d, int side, 
 
 void fill_all(const Forest& forest, BlockField& field, const std::array<BcKind, 6>& kinds,
               const std::array<FaceValue, 6>* values, int width) {
-  width = std::min({width, field.cells(), field.layout().ghost});
-  forest.for_each_block([&](int blk) {
-    const Block& block = forest.block(blk);
-    for (int d = 0; d < 3; ++d) {
-      for (int side = 0; side < 2; ++side) {
-        std::array<int, 3> o{0, 0, 0};
-        o[static_cast<std::size_t>(d)] = side == 0 ? -1 : 1;
-        const Neighbour nb =
-            block.neighbours[static_cast<std::size_t>(neighbour_slot(o[0], o[1], o[2]))];
-        if (nb.link != Link::Boundary) continue;
-        const auto f = static_cast<std::size_t>(face_index(d, side));
-        fill_face(block, field, blk, d, side, kinds[f], values ? &(*values)[f] : nullptr, width);
-      }
-    }
-  });
+  forest.for_each_block(
+      [&](int blk) { fill_block_boundary_ghosts(forest, field, blk, kinds, values, width); });
 }
 
 }  // namespace
+
+void fill_block_boundary_ghosts(const Forest& forest, BlockField& field, int blk,
+                                const std::array<BcKind, 6>& kinds,
+                                const std::array<FaceValue, 6>* values, int width) {
+  width = std::min({width, field.cells(), field.layout().ghost});
+  const Block& block = forest.block(blk);
+  for (int d = 0; d < 3; ++d) {
+    for (int side = 0; side < 2; ++side) {
+      if (block.neighbours[face_neighbour_slot(d, side)].link != Link::Boundary) continue;
+      const auto f = static_cast<std::size_t>(face_index(d, side));
+      fill_face(block, field, blk, d, side, kinds[f], values ? &(*values)[f] : nullptr, width);
+    }
+  }
+}
 
 void fill_face_field_ghosts(const Forest& forest, FaceField& uf, int width) {
   const int b = uf[0].cells();

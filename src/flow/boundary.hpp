@@ -52,6 +52,11 @@ void fill_boundary_ghosts(const Forest& forest, BlockField& field, const ScalarB
 void fill_boundary_ghosts(const Forest& forest, BlockField& field,
                           const std::array<BcKind, 6>& kinds, int width);
 
+/// fill_boundary_ghosts() for block `blk` alone (`values` null: homogeneous).
+void fill_block_boundary_ghosts(const Forest& forest, BlockField& field, int blk,
+                                const std::array<BcKind, 6>& kinds,
+                                const std::array<FaceValue, 6>* values, int width);
+
 /// Zero-gradient extrapolation of a face field into the ghost cells beyond
 /// domain faces (`width` layers). The faces on the domain boundary itself
 /// (slot 0 of a lower face, slot b of an upper face of the normal component)

@@ -443,6 +443,35 @@ void Forest::exchange(std::span<BlockField* const> fields, int width, bool faces
   exchange_scoped(fields, width, faces_only, -1);
 }
 
+void Forest::copy_face_ghosts(BlockField& field, int blk, int colour) const {
+  const BlockLayout L = field.layout();
+  const int b = L.cells;
+  const Block& block = blocks_[static_cast<std::size_t>(blk)];
+  const int parity = static_cast<int>((block.coord[0] + block.coord[1] + block.coord[2]) * b) & 1;
+  double* dst = field.block(blk);
+  for (int d = 0; d < 3; ++d) {
+    // The face's cells by (t1, t2), t1 the faster-varying of the other two directions.
+    const int a1 = d == 0 ? 1 : 0, a2 = d == 2 ? 1 : 2;
+    const std::ptrdiff_t s1 = L.stride(a1), s2 = L.stride(a2), sd = L.stride(d);
+    for (int side = 0; side < 2; ++side) {
+      const Neighbour& nb = block.neighbours[face_neighbour_slot(d, side)];
+      if (nb.link == Link::Boundary) continue;
+      const int ghost = side == 0 ? -1 : b, from = side == 0 ? b - 1 : 0;
+      double* to = dst + L.index(0, 0, 0) + ghost * sd;
+      const double* src = field.block(nb.index) + L.index(0, 0, 0) + from * sd;
+      const int step = colour < 0 ? 1 : 2;
+      for (int t2 = 0; t2 < b; ++t2) {
+        // (ghost + t1 + t2 + parity) & 1 == colour
+        const int first = colour < 0 ? 0 : (colour + ghost + t2 + parity) & 1;
+        for (int t1 = first; t1 < b; t1 += step) {
+          const std::ptrdiff_t c = t1 * s1 + t2 * s2;
+          to[c] = src[c];
+        }
+      }
+    }
+  }
+}
+
 void Forest::exchange_from_finer(BlockField& field, int face) const {
   BlockField* one[] = {&field};
   exchange_scoped(one, 1, true, face);

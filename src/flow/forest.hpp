@@ -164,6 +164,18 @@ class Forest {
   /// fraction of a full exchange's cost. Collective like exchange().
   void exchange_from_finer(BlockField& field, int face) const;
 
+  /// Whether every face neighbour of every block is a block of the same level
+  /// on this rank (or the domain boundary): one rank, a uniform forest. Then
+  /// copy_face_ghosts() can fill one block's face ghosts on its own, right
+  /// before a kernel reads them (the fused multigrid smoother).
+  [[nodiscard]] bool faces_local_same_level() const { return ranks_ == 1 && uniform(); }
+  /// The face ghosts (width 1) of block `blk` from its neighbours' interiors,
+  /// the values exchange(field, 1, true) puts there; with `colour` 0 or 1 only
+  /// the ghosts of that cell colour, (i + j + k + b (coord sum)) & 1 (red-black
+  /// sweeps read one colour and may write the other meanwhile). Boundary
+  /// faces are left alone. Requires faces_local_same_level().
+  void copy_face_ghosts(BlockField& field, int blk, int colour = -1) const;
+
   /// Runs body(b) for every local block, on the forest's OpenMP threads.
   template <typename Body>
   void for_each_block(Body&& body) const;

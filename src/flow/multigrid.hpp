@@ -123,6 +123,9 @@ class Multigrid {
   /// matched fluxes (unless `match` is false: plain restricted values).
   void fill_ghosts(int level, BlockField& x, const ScalarBoundary* bc, bool faces_only = false,
                    bool match = true);
+  /// fill_ghosts(.., faces_only) for block `blk` alone, on a forest whose
+  /// faces_local_same_level(); `colour` as in Forest::copy_face_ghosts.
+  void fill_block_ghosts(int blk, BlockField& x, const ScalarBoundary* bc, int colour) const;
   void smooth(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc,
               int sweeps);
   void compute_residual(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc,

@@ -84,6 +84,52 @@ TEST(FlowForest, GhostExchangeCopiesNeighbourCellsWithPeriodicWrap) {
   EXPECT_GT(checked, 0);
 }
 
+// The fused smoother fills one block's face ghosts at a time: copy_face_ghosts
+// must put there what exchange(field, 1, faces only) does (periodic wrap and
+// boundary faces included), and a colour must copy that colour and no other.
+TEST(FlowForest, OneBlocksFaceGhostsMatchTheExchangeColourByColour) {
+  ForestSpec spec;
+  spec.trees = {2, 1, 1};
+  spec.periodic = {true, false, true};
+  spec.level = 1;
+  spec.block_cells = 4;
+  const Forest forest(spec);
+  ASSERT_TRUE(forest.faces_local_same_level() || forest.ranks() > 1);
+  if (!forest.faces_local_same_level()) GTEST_SKIP() << "needs one rank";
+  const int b = spec.block_cells;
+  BlockField exchanged(forest.local_blocks(), b);
+  exchanged.fill(-1.0);
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    const auto& c = forest.block(blk).coord;
+    for (int k = 0; k < b; ++k)
+      for (int j = 0; j < b; ++j)
+        for (int i = 0; i < b; ++i)
+          exchanged(blk, i, j, k) = cell_tag(c[0] * b + i, c[1] * b + j, c[2] * b + k);
+  }
+  BlockField whole = exchanged, red = exchanged;
+  forest.exchange(exchanged, 1, true);
+  int face_ghosts = 0, red_ghosts = 0;
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    forest.copy_face_ghosts(whole, blk);
+    forest.copy_face_ghosts(red, blk, 0);
+    const auto& c = forest.block(blk).coord;
+    for (int k = -1; k <= b; ++k)
+      for (int j = -1; j <= b; ++j)
+        for (int i = -1; i <= b; ++i) {
+          const int outside = (i < 0 || i >= b) + (j < 0 || j >= b) + (k < 0 || k >= b);
+          if (outside != 1) continue;  // interior, edge and corner ghosts: not face ghosts
+          ASSERT_EQ(whole(blk, i, j, k), exchanged(blk, i, j, k)) << blk << ' ' << i << j << k;
+          const bool is_red = ((c[0] + c[1] + c[2]) * b + i + j + k) % 2 == 0;
+          EXPECT_EQ(red(blk, i, j, k), is_red ? exchanged(blk, i, j, k) : -1.0);
+          face_ghosts += exchanged(blk, i, j, k) != -1.0;
+          red_ghosts += is_red && exchanged(blk, i, j, k) != -1.0;
+        }
+  }
+  // 4 x 2 x 2 blocks of 4^3: each has a wall at one of its y faces, 5 faces of 16 ghosts left.
+  EXPECT_EQ(face_ghosts, forest.local_blocks() * 5 * b * b);
+  EXPECT_EQ(2 * red_ghosts, face_ghosts);
+}
+
 TEST(FlowForest, DirichletAndNeumannGhostsReproduceTheFaceValue) {
   ForestSpec spec;
   spec.level = 1;
