@@ -650,6 +650,48 @@ void Multigrid::compute_residual(int level, BlockField& x, const BlockField& rhs
   });
 }
 
+namespace {
+
+// The trilinear prolongation of vcycle() where every coarse cell is active:
+// the same terms in the same order (dk, dj, di), so the same bits (the
+// weights are exact binary fractions summing to 1 exactly), from four coarse
+// rows per fine row instead of an index computation per term.
+void prolong_all_active(const BlockField& coarse, int blk, int b, BlockField& x) {
+  constexpr double kNear = 0.75, kFar = 0.25;
+  const BlockLayout C = coarse.layout();
+  const BlockLayout F = x.layout();
+  const double* cb = coarse.block(blk);
+  double* fb = x.block(blk);
+  for (int k = 0; k < b; ++k)
+    for (int j = 0; j < b; ++j) {
+      const int cj = j >> 1, ck = k >> 1;
+      const int sj = (j & 1) ? 1 : -1, sk = (k & 1) ? 1 : -1;
+      // rows (dj, dk): 00, 10, 01, 11
+      const double* r00 = cb + C.index(0, cj, ck);
+      const double* r10 = cb + C.index(0, cj + sj, ck);
+      const double* r01 = cb + C.index(0, cj, ck + sk);
+      const double* r11 = cb + C.index(0, cj + sj, ck + sk);
+      double* row = fb + F.index(0, j, k);
+      const double w00 = kNear * kNear, w10 = kNear * kFar;  // wy * wz, exact
+      const double w01 = kFar * kNear, w11 = kFar * kFar;
+      for (int i = 0; i < b; ++i) {
+        const int ci = i >> 1, o = ci + ((i & 1) ? 1 : -1);
+        double value = 0.0;
+        value += kNear * w00 * r00[ci];
+        value += kFar * w00 * r00[o];
+        value += kNear * w10 * r10[ci];
+        value += kFar * w10 * r10[o];
+        value += kNear * w01 * r01[ci];
+        value += kFar * w01 * r01[o];
+        value += kNear * w11 * r11[ci];
+        value += kFar * w11 * r11[o];
+        row[i] += value;  // / weight, which is exactly 1
+      }
+    }
+}
+
+}  // namespace
+
 void Multigrid::vcycle(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc) {
   if (static_cast<std::size_t>(level) + 1 == levels_.size()) {
     coarse_solve();
@@ -669,6 +711,10 @@ void Multigrid::vcycle(int level, BlockField& x, const BlockField& rhs, const Sc
   const int b = fine.cells;
   const bool all_active = coarse.constant_coefficients && constant_kernels_;
   forest_.for_each_block([&](int blk) {
+    if (all_active) {
+      prolong_all_active(coarse.x, blk, b, x);
+      return;
+    }
     for (int k = 0; k < b; ++k)
       for (int j = 0; j < b; ++j)
         for (int i = 0; i < b; ++i) {
