@@ -25,6 +25,7 @@
 #include "core/io/atomic_file.hpp"
 #include "core/progress.hpp"
 #include "dem/analysis/analyze.hpp"
+#include "dem/analysis/calibration_fit.hpp"
 
 extern char** environ;
 
@@ -336,65 +337,6 @@ int run_ensemble(const char* self, const EnsembleArgs& args) {
 
 // --- Calibration ---------------------------------------------------------------
 
-struct Fit {
-  double value = NAN, std = NAN;
-  double slope = NAN;
-  bool bracketed = false;
-};
-
-// Solves m(v) = target with a weighted straight line m = a + b v through the
-// grid values around the first crossing of the target by the mean curve; the
-// uncertainty propagates the line's covariance and the target's spread.
-// Without replicate runs (one per value: `sem` unknown) the points weigh the
-// same and their scatter about the line stands for the noise (NaN with two
-// points: nothing measures it).
-Fit fit_crossing(const std::vector<double>& v, const std::vector<double>& mean,
-                 const std::vector<double>& sem, bool replicates, double target,
-                 double target_std) {
-  Fit fit;
-  std::size_t cross = v.size();
-  for (std::size_t k = 0; k + 1 < v.size(); ++k) {
-    if ((mean[k] - target) * (mean[k + 1] - target) <= 0) {
-      cross = k;
-      break;
-    }
-  }
-  fit.bracketed = cross < v.size();
-  if (!fit.bracketed) {  // extrapolate from the nearest end
-    cross = std::abs(mean.front() - target) < std::abs(mean.back() - target) ? 0 : v.size() - 2;
-  }
-  const std::size_t lo = cross > 0 ? cross - 1 : 0;
-  const std::size_t hi = std::min(v.size() - 1, cross + 2);
-  double sw = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
-  for (std::size_t k = lo; k <= hi; ++k) {
-    const double w =
-        replicates ? 1.0 / std::max(sem[k] * sem[k], 1e-12 * (1.0 + mean[k] * mean[k])) : 1.0;
-    sw += w;
-    sx += w * v[k];
-    sy += w * mean[k];
-    sxx += w * v[k] * v[k];
-    sxy += w * v[k] * mean[k];
-  }
-  const double det = sw * sxx - sx * sx;
-  const double b = (sw * sxy - sx * sy) / det;
-  const double a = (sy - b * sx) / sw;
-  double scale = 1.0;  // the variance of one point, in units of 1/w
-  if (!replicates) {
-    double squares = 0.0;
-    for (std::size_t k = lo; k <= hi; ++k) squares += std::pow(mean[k] - a - b * v[k], 2);
-    const double points = static_cast<double>(hi - lo + 1);
-    scale = points > 2 ? squares / (points - 2) : NAN;
-  }
-  const double var_a = scale * sxx / det, var_b = scale * sw / det, cov_ab = -scale * sx / det;
-  fit.slope = b;
-  fit.value = (target - a) / b;
-  // v* = (t - a) / b: derivatives -1/b (a), -(t - a)/b^2 (b), 1/b (t).
-  const double da = -1.0 / b, db = -(target - a) / (b * b), dt = 1.0 / b;
-  fit.std = std::sqrt(std::max(0.0, da * da * var_a + db * db * var_b + 2 * da * db * cov_ab +
-                                        dt * dt * target_std * target_std));
-  return fit;
-}
-
 double summary_value(const RunAnalysis& a, const std::string& name) {
   for (const auto& [key, value] : dem::analysis::summary_values(a)) {
     if (key == name) return value;
@@ -500,7 +442,8 @@ int run_calibrate(const char* self, const CalibrateArgs& args) {
       sem[i] = std::sqrt(pooled_variance / static_cast<double>(samples[i].size()));
     }
   }
-  const Fit fit = fit_crossing(args.values, mean, sem, dof > 0, args.target, args.target_std);
+  const dem::analysis::CalibrationFit fit =
+      dem::analysis::fit_crossing(args.values, mean, sem, dof > 0, args.target, args.target_std);
 
   io::write_file_atomically(root / "calibration.csv", [&](std::ostream& out) {
     out.precision(10);
@@ -511,18 +454,26 @@ int run_calibrate(const char* self, const CalibrateArgs& args) {
   });
   io::write_file_atomically(root / "calibration_result.csv", [&](std::ostream& out) {
     out.precision(10);
-    out << "parameter,measure,target,target_std,estimate,estimate_std,bracketed,slope\n"
+    out << "parameter,measure,target,target_std,estimate,estimate_std,bracketed,slope,turns\n"
         << csv_keys << "," << args.measure << "," << args.target << "," << args.target_std << ","
-        << fit.value << "," << fit.std << "," << (fit.bracketed ? 1 : 0) << "," << fit.slope
-        << "\n";
+        << fit.value << "," << fit.std << "," << (fit.bracketed ? 1 : 0) << "," << fit.slope << ","
+        << (fit.turns ? 1 : 0) << "\n";
   });
   for (std::size_t i = 0; i < args.values.size(); ++i) {
     std::printf("  %s = %-10.4g %s = %.4g +- %.2g\n", keys.c_str(), args.values[i],
                 args.measure.c_str(), mean[i], sd[i]);
   }
-  std::printf("%s = %.4g +- %.2g for %s = %.4g%s\n", keys.c_str(), fit.value, fit.std,
-              args.measure.c_str(), args.target,
-              fit.bracketed ? "" : "  (WARNING: target outside the measured range, extrapolated)");
+  if (fit.turns) {
+    std::printf(
+        "WARNING: %s does not reach %.4g over these values: it comes nearest (%.4g) at %s = %.4g "
+        "and moves away on both sides. No crossing to fit; the nearest value is given.\n",
+        args.measure.c_str(), args.target, mean[fit.closest], keys.c_str(), fit.value);
+  } else {
+    std::printf(
+        "%s = %.4g +- %.2g for %s = %.4g%s\n", keys.c_str(), fit.value, fit.std,
+        args.measure.c_str(), args.target,
+        fit.bracketed ? "" : "  (WARNING: target outside the measured range, extrapolated)");
+  }
   std::printf("written: %s\n", (root / "calibration_result.csv").string().c_str());
   return 0;
 }
