@@ -455,7 +455,7 @@ void Forest::copy_face_ghosts(BlockField& field, int blk, int colour) const {
     const std::ptrdiff_t s1 = L.stride(a1), s2 = L.stride(a2), sd = L.stride(d);
     for (int side = 0; side < 2; ++side) {
       const Neighbour& nb = block.neighbours[face_neighbour_slot(d, side)];
-      if (nb.link == Link::Boundary) continue;
+      if (nb.link != Link::Local || nb.jump != LevelJump::Same) continue;
       const int ghost = side == 0 ? -1 : b, from = side == 0 ? b - 1 : 0;
       double* to = dst + L.index(0, 0, 0) + ghost * sd;
       const double* src = field.block(nb.index) + L.index(0, 0, 0) + from * sd;
@@ -477,8 +477,13 @@ void Forest::exchange_from_finer(BlockField& field, int face) const {
   exchange_scoped(one, 1, true, face);
 }
 
+void Forest::exchange_face_ghosts_but_local_same_level(BlockField& field) const {
+  BlockField* one[] = {&field};
+  exchange_scoped(one, 1, true, -1, true);
+}
+
 void Forest::exchange_scoped(std::span<BlockField* const> fields, int width, bool faces_only,
-                             int finer_face) const {
+                             int finer_face, bool skip_local_same_level) const {
   if (fields.empty()) return;
   const BlockLayout layout = fields[0]->layout();
   const int b = layout.cells;
@@ -520,6 +525,9 @@ void Forest::exchange_scoped(std::span<BlockField* const> fields, int width, boo
               block.neighbours[static_cast<std::size_t>(neighbour_slot(ox, oy, oz))];
           if (nb.link == Link::Boundary) continue;
           if (finer_face >= 0 && nb.jump != LevelJump::Finer) continue;
+          if (skip_local_same_level && nb.jump == LevelJump::Same && nb.link == Link::Local) {
+            continue;
+          }
           const Range rx = ghost_range(ox, b, width), ry = ghost_range(oy, b, width),
                       rz = ghost_range(oz, b, width);
           if (nb.jump != LevelJump::Same) {

@@ -163,17 +163,21 @@ class Forest {
   /// data that only coarse-fine faces read (Multigrid::match_fluxes), at a
   /// fraction of a full exchange's cost. Collective like exchange().
   void exchange_from_finer(BlockField& field, int face) const;
+  /// exchange(field, 1, true) without the faces copy_face_ghosts() fills: the
+  /// faces towards blocks of another level or on another rank. Collective.
+  void exchange_face_ghosts_but_local_same_level(BlockField& field) const;
 
   /// Whether every face neighbour of every block is a block of the same level
   /// on this rank (or the domain boundary): one rank, a uniform forest. Then
-  /// copy_face_ghosts() can fill one block's face ghosts on its own, right
-  /// before a kernel reads them (the fused multigrid smoother).
+  /// copy_face_ghosts() fills every face ghost there is to fill.
   [[nodiscard]] bool faces_local_same_level() const { return ranks_ == 1 && uniform(); }
-  /// The face ghosts (width 1) of block `blk` from its neighbours' interiors,
-  /// the values exchange(field, 1, true) puts there; with `colour` 0 or 1 only
-  /// the ghosts of that cell colour, (i + j + k + b (coord sum)) & 1 (red-black
-  /// sweeps read one colour and may write the other meanwhile). Boundary
-  /// faces are left alone. Requires faces_local_same_level().
+  /// The face ghosts (width 1) of block `blk` towards its neighbours of the
+  /// same level on this rank, from their interiors: the values
+  /// exchange(field, 1, true) puts there, one block at a time, right before a
+  /// kernel reads them (the multigrid smoother). With `colour` 0 or 1 only the
+  /// ghosts of that cell colour, (i + j + k + b (coord sum)) & 1 (red-black
+  /// sweeps read one colour and may write the other meanwhile). Other faces
+  /// (boundary, other level, other rank) are left alone.
   void copy_face_ghosts(BlockField& field, int blk, int colour = -1) const;
 
   /// Runs body(b) for every local block, on the forest's OpenMP threads.
@@ -227,9 +231,10 @@ class Forest {
              int max_level = kForestMaxLevel);
 
  private:
-  /// exchange(); with finer_face >= 0 only that face of blocks beside finer ones.
+  /// exchange(); with finer_face >= 0 only that face of blocks beside finer
+  /// ones; with skip_local_same_level not the faces copy_face_ghosts() fills.
   void exchange_scoped(std::span<BlockField* const> fields, int width, bool faces_only,
-                       int finer_face) const;
+                       int finer_face, bool skip_local_same_level = false) const;
   void build_blocks();
   void build_ghost_tables();
   void build_neighbours();

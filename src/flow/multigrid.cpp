@@ -529,6 +529,11 @@ void Multigrid::fill_ghosts(int level, BlockField& x, const ScalarBoundary* bc, 
   if (composite_ && match) match_fluxes(level, x);
 }
 
+void Multigrid::fill_ghosts_between_blocks_apart(int level, BlockField& x) {
+  if (!forest_.faces_local_same_level()) forest_.exchange_face_ghosts_but_local_same_level(x);
+  if (composite_) match_fluxes(level, x);
+}
+
 void Multigrid::fill_block_ghosts(int blk, BlockField& x, const ScalarBoundary* bc,
                                   int colour) const {
   forest_.copy_face_ghosts(x, blk, colour);
@@ -545,15 +550,21 @@ void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const Sc
   const BlockLayout L = x.layout();
   const int b = L.cells;
   const std::array<std::ptrdiff_t, 3> s{L.stride(0), L.stride(1), L.stride(2)};
-  // One rank, one level, an even b (the colours match across periodic faces):
-  // each block fills its own face ghosts right before it relaxes, while its
-  // cells are in cache, instead of a pass over all blocks first. It copies
-  // the colour the half-sweep reads, which no block changes meanwhile: the
-  // same values, in any block order and on any number of threads.
-  const bool fused = b % 2 == 0 && !composite_ && forest_.faces_local_same_level();
+  // With an even b (the colours match across periodic faces) each block fills
+  // its face ghosts towards same-level blocks of this rank and its boundary
+  // ghosts right before it relaxes, while its cells are in cache, instead of
+  // a pass over all blocks first. It copies the colour the half-sweep reads,
+  // which no block changes meanwhile: the same values, in any block order and
+  // on any number of threads. The other faces (level jumps, other ranks, and
+  // the matched fluxes) are filled first, as before.
+  const bool fused = b % 2 == 0;
   for (int sweep = 0; sweep < sweeps; ++sweep) {
     for (int colour = 0; colour < 2; ++colour) {
-      if (!fused) fill_ghosts(level, x, bc, true);  // the 7-point stencil reads face ghosts only
+      if (fused) {
+        fill_ghosts_between_blocks_apart(level, x);
+      } else {
+        fill_ghosts(level, x, bc, true);  // the 7-point stencil reads face ghosts only
+      }
       forest_.for_each_block([&](int blk) {
         if (fused) fill_block_ghosts(blk, x, bc, 1 - colour);
         const Block& block = forest_.block(blk);
@@ -624,10 +635,9 @@ void Multigrid::compute_residual(int level, BlockField& x, const BlockField& rhs
   const BlockLayout L = x.layout();
   const int b = L.cells;
   const std::array<std::ptrdiff_t, 3> s{L.stride(0), L.stride(1), L.stride(2)};
-  const bool fused = !composite_ && forest_.faces_local_same_level();  // as in smooth()
-  if (!fused) fill_ghosts(level, x, bc, true);
+  fill_ghosts_between_blocks_apart(level, x);  // the rest block by block, as in smooth()
   forest_.for_each_block([&](int blk) {
-    if (fused) fill_block_ghosts(blk, x, bc, -1);
+    fill_block_ghosts(blk, x, bc, -1);
     const double h = forest_.block(blk).length / b;
     const double inv_h2 = 1.0 / (h * h);
     const BlockCoefficients k{

@@ -123,8 +123,12 @@ class Multigrid {
   /// matched fluxes (unless `match` is false: plain restricted values).
   void fill_ghosts(int level, BlockField& x, const ScalarBoundary* bc, bool faces_only = false,
                    bool match = true);
-  /// fill_ghosts(.., faces_only) for block `blk` alone, on a forest whose
-  /// faces_local_same_level(); `colour` as in Forest::copy_face_ghosts.
+  /// The part of fill_ghosts(.., faces_only) that fill_block_ghosts() leaves:
+  /// face ghosts towards other levels and ranks, then the matched fluxes.
+  void fill_ghosts_between_blocks_apart(int level, BlockField& x);
+  /// The rest of fill_ghosts(.., faces_only) for block `blk` alone: its face
+  /// ghosts towards same-level blocks of this rank (`colour` as in
+  /// Forest::copy_face_ghosts) and its boundary ghosts.
   void fill_block_ghosts(int blk, BlockField& x, const ScalarBoundary* bc, int colour) const;
   void smooth(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc,
               int sweeps);
