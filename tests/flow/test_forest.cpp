@@ -15,6 +15,21 @@ double cell_tag(std::int64_t gx, std::int64_t gy, std::int64_t gz) {
   return static_cast<double>(gx) + 1000.0 * static_cast<double>(gy) + 1e6 * static_cast<double>(gz);
 }
 
+/// A field whose cells hold their cell_tag and whose ghosts hold -1.
+BlockField tagged_cells(const Forest& forest) {
+  const int b = forest.block_cells();
+  BlockField field(forest.local_blocks(), b);
+  field.fill(-1.0);
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    const auto& c = forest.block(blk).coord;
+    for (int k = 0; k < b; ++k)
+      for (int j = 0; j < b; ++j)
+        for (int i = 0; i < b; ++i)
+          field(blk, i, j, k) = cell_tag(c[0] * b + i, c[1] * b + j, c[2] * b + k);
+  }
+  return field;
+}
+
 TEST(FlowForest, BrickOfAnyAspectRatioHasTheRightBlocksAndExtent) {
   ForestSpec spec;
   spec.trees = {1, 2, 3};
@@ -45,15 +60,7 @@ TEST(FlowForest, GhostExchangeCopiesNeighbourCellsWithPeriodicWrap) {
   const int b = spec.block_cells;
   const auto nb = forest.blocks_per_direction(spec.level);
   const std::array<std::int64_t, 3> n{nb[0] * b, nb[1] * b, nb[2] * b};
-  BlockField field(forest.local_blocks(), b);
-  field.fill(-1.0);
-  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
-    const auto& c = forest.block(blk).coord;
-    for (int k = 0; k < b; ++k)
-      for (int j = 0; j < b; ++j)
-        for (int i = 0; i < b; ++i)
-          field(blk, i, j, k) = cell_tag(c[0] * b + i, c[1] * b + j, c[2] * b + k);
-  }
+  BlockField field = tagged_cells(forest);
   forest.exchange(field, kGhost);
   int checked = 0;
   for (int blk = 0; blk < forest.local_blocks(); ++blk) {
@@ -97,15 +104,7 @@ TEST(FlowForest, OneBlocksFaceGhostsMatchTheExchangeColourByColour) {
   ASSERT_TRUE(forest.faces_local_same_level() || forest.ranks() > 1);
   if (!forest.faces_local_same_level()) GTEST_SKIP() << "needs one rank";
   const int b = spec.block_cells;
-  BlockField exchanged(forest.local_blocks(), b);
-  exchanged.fill(-1.0);
-  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
-    const auto& c = forest.block(blk).coord;
-    for (int k = 0; k < b; ++k)
-      for (int j = 0; j < b; ++j)
-        for (int i = 0; i < b; ++i)
-          exchanged(blk, i, j, k) = cell_tag(c[0] * b + i, c[1] * b + j, c[2] * b + k);
-  }
+  BlockField exchanged = tagged_cells(forest);
   BlockField whole = exchanged, red = exchanged;
   forest.exchange(exchanged, 1, true);
   int face_ghosts = 0, red_ghosts = 0;
