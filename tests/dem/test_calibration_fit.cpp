@@ -55,6 +55,31 @@ TEST(CalibrationFit, ACurveThatTurnsBeforeTheTargetGivesItsNearestValueNotALine)
   EXPECT_TRUE(std::isnan(fit.std));
 }
 
+TEST(CalibrationFit, AFlatOrTurningEndGivesTheNearestValueNotAnInfiniteOne) {
+  // Flat: every run the same.
+  const CalibrationFit flat = fit_crossing({1, 2, 3}, {6, 6, 6}, {0, 0, 0}, false, 8.0, 0.0);
+  EXPECT_TRUE(flat.turns);
+  EXPECT_EQ(flat.value, 1.0);
+  // Nearest at the end, but the window around it turns: no extrapolation back into the range.
+  const CalibrationFit back = fit_crossing({1, 2, 3}, {7, 6, 7}, {0, 0, 0}, false, 8.0, 0.0);
+  EXPECT_TRUE(back.turns);
+  EXPECT_TRUE(std::isfinite(back.value));
+  EXPECT_EQ(back.value, 1.0);
+}
+
+TEST(CalibrationFit, ATurnNextToTheBracketingPairDoesNotPullTheEstimateOutOfIt) {
+  // Crosses 6 between v = 1 (7) and v = 2 (5.5); the line through 7, 5.5, 6.5
+  // would meet 6 far beyond v = 2. The pair alone gives 1 + 1/1.5.
+  const CalibrationFit fit =
+      fit_crossing({1, 2, 3, 4}, {7, 5.5, 6.5, 7.5}, {0, 0, 0, 0}, false, 6.0, 0.0);
+  EXPECT_TRUE(fit.bracketed);
+  EXPECT_NEAR(fit.value, 1.0 + 1.0 / 1.5, 1e-12);
+  // A target met exactly at a grid value.
+  const CalibrationFit exact = fit_crossing({1, 2, 3}, {7, 6, 5}, {0, 0, 0}, false, 6.0, 0.0);
+  EXPECT_TRUE(exact.bracketed);
+  EXPECT_NEAR(exact.value, 2.0, 1e-12);
+}
+
 TEST(CalibrationFit, FewerThanTwoValuesAreRefused) {
   EXPECT_THROW(fit_crossing({1.0}, {2.0}, {0.0}, false, 1.0, 0.0), std::invalid_argument);
   EXPECT_THROW(fit_crossing({1.0, 2.0}, {2.0}, {0.0, 0.0}, false, 1.0, 0.0), std::invalid_argument);

@@ -81,6 +81,15 @@ def calibrate(exe, target):
         read_csv(os.path.join(CALIBRATION, "calibration_result.csv"))[0]
 
 
+def value_folder(value):
+    """The calibration's folder of a value (named by `sanguis calibrate` in the value's
+    shortest exact form, which Python's formats do not always reproduce)."""
+    for name in os.listdir(CALIBRATION):
+        if name.startswith("value_") and float(name[len("value_"):]) == value:
+            return os.path.join(CALIBRATION, name)
+    sys.exit(f"no run folder for the value {value:g} in {CALIBRATION}")
+
+
 def read_csv(path):
     with open(path, newline="") as f:
         return [{k: (float(v) if k not in ("parameter", "measure") else v) for k, v in r.items()}
@@ -156,7 +165,7 @@ def main():
         # The run-out turns before the target: the calibration's own run nearest it is
         # the answer (a line through a turn means nothing); no run of its own.
         gamma = fit["estimate"]
-        cal_dir = os.path.join(CALIBRATION, f"value_{gamma:g}", "seed_1")
+        cal_dir = os.path.join(value_folder(gamma), "seed_1")
         done = os.path.join(CALIBRATED, "gamma_t.txt")
         if os.path.exists(done):
             subprocess.run([exe, "analyze", CALIBRATED], check=True, stdout=subprocess.DEVNULL)
@@ -175,8 +184,8 @@ def main():
                "thesis": f"{ref:.2f} (Lajeunesse, a ≳ 4, §3.3)", "tolerance": "±35 %",
                "pass": abs(cal["runout_ratio"] / ref - 1) <= 0.35},
               {"quantity": "calibration of γt at kt 1e2: target bracketed by the runs",
-               "measured": (f"no crossing: lowest {cal['runout_ratio']:.2f} at γt {gamma:g}, "
-                            "rising on both sides" if turns else
+               "measured": (f"no crossing: nearest {cal['runout_ratio']:.2f} at γt {gamma:g}, "
+                            "moving away on both sides" if turns else
                             f"γt = {fit['estimate']:.3g} ± {fit['estimate_std']:.2g} 1/s"),
                "thesis": "kt 3e2, γt 1e3 (Table 3.1, Grains3D)", "tolerance": "bracketed",
                "pass": fit["bracketed"] == 1.0},
@@ -253,7 +262,7 @@ def main():
         if not turns or extrapolated:
             elapsed += wall_time(CALIBRATED, OPENING_S)
         # the runs of the calibration ran side by side: count the longest
-        elapsed += max(wall_time(os.path.join(CALIBRATION, f"value_{r['value']:g}", "seed_1"),
+        elapsed += max(wall_time(os.path.join(value_folder(r["value"]), "seed_1"),
                                  OPENING_S) for r in table)
     ok = all(c["pass"] for c in checks if c["pass"] is not None)
     summary = {
@@ -296,8 +305,8 @@ def main():
                      f"{100 * (closest['runout_ratio_mean'] / ref - 1):+.1f} % from the target. "
                      if closest else "")
                   + ("The fit brackets the target. " if fit["bracketed"] == 1.0 else
-                     "The run-out turns before it reaches the target, lowest near "
-                     f"{gamma:g} 1/s and rising on both sides: γt alone at kt 1e2 does not "
+                     "The run-out turns before it reaches the target, nearest it at "
+                     f"{gamma:g} 1/s and moving away on both sides: γt alone at kt 1e2 does not "
                      "bring this packing to the reference. " if turns else
                      "The target lies beyond the runs: the fitted line extrapolates. ")
                   + "The steep change is in kt (Table 3.1, kt 3e2: "

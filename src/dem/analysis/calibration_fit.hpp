@@ -12,17 +12,19 @@ struct CalibrationFit {
   double slope = 0.0;  ///< d measure / d parameter of the fitted line
   /// The target lies between two neighbouring grid values' measures.
   bool bracketed = false;
-  /// Not bracketed, and the measure is nearest the target at an inner grid
-  /// value: the curve turns there without reaching the target. `value` is
-  /// then that grid value (no line: a line through a turn is meaningless).
+  /// Not bracketed, and no line can locate a crossing: the measure is nearest
+  /// the target at an inner grid value (the curve turns there without
+  /// reaching it), or the line at the nearer end is flat or points back into
+  /// the range. `value` is then the nearest grid value, `std` and `slope` NaN.
   bool turns = false;
   std::size_t closest = 0;  ///< index of the grid value whose measure is nearest the target
 };
 
 /// Solves m(v) = target with a weighted straight line m = a + b v through the
 /// grid values around the first crossing of the target by the mean curve
-/// (`v` increasing); extrapolates from the end nearer the target when no pair
-/// brackets it, unless the curve turns (see CalibrationFit::turns). The
+/// (`v` increasing; the bracketing pair alone when the wider line meets the
+/// target outside it); extrapolates from the end nearer the target when no
+/// pair brackets it, unless the curve turns (see CalibrationFit::turns). The
 /// uncertainty propagates the line's covariance and the target's spread.
 /// With `replicates` the points weigh 1/sem^2; without (one run per value)
 /// they weigh the same and their scatter about the line stands for the noise
