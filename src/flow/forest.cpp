@@ -274,6 +274,30 @@ void Forest::build_neighbours() {
       }
     }
   }
+  list_face_exchanges();
+}
+
+void Forest::list_face_exchanges() {
+  faces_apart_blocks_.clear();
+  beside_finer_blocks_.clear();
+  beside_coarser_blocks_.clear();
+  for (auto& list : finer_face_blocks_) list.clear();
+  for (std::size_t b = 0; b < blocks_.size(); ++b) {
+    const auto blk = static_cast<std::int32_t>(b);
+    bool apart = false, finer = false, coarser = false;
+    for (int f = 0; f < 6; ++f) {
+      const Neighbour& nb = blocks_[b].neighbours[face_neighbour_slot(f / 2, f % 2)];
+      if (nb.link == Link::Boundary) continue;
+      apart = apart || nb.link != Link::Local || nb.jump != LevelJump::Same;
+      finer = finer || nb.jump == LevelJump::Finer;
+      coarser = coarser || nb.jump == LevelJump::Coarser;
+      if (nb.jump == LevelJump::Finer)
+        finer_face_blocks_[static_cast<std::size_t>(f)].push_back(blk);
+    }
+    if (apart) faces_apart_blocks_.push_back(blk);
+    if (finer) beside_finer_blocks_.push_back(blk);
+    if (coarser) beside_coarser_blocks_.push_back(blk);
+  }
 }
 
 namespace {
@@ -513,7 +537,7 @@ void Forest::exchange_scoped(std::span<BlockField* const> fields, int width, boo
                                 per_block * sizeof(double), mirror_ptrs.data(), remote.data());
   }
 
-  for_each_block([&](int blk) {
+  const auto fill = [&](int blk) {
     const Block& block = blocks_[static_cast<std::size_t>(blk)];
     for (int oz = -1; oz <= 1; ++oz) {
       for (int oy = -1; oy <= 1; ++oy) {
@@ -582,7 +606,15 @@ void Forest::exchange_scoped(std::span<BlockField* const> fields, int width, boo
         }
       }
     }
-  });
+  };
+  // Only the blocks with something to fill when the exchange is narrowed.
+  if (finer_face >= 0) {
+    for_each_listed(finer_face_blocks_[static_cast<std::size_t>(finer_face)], fill);
+  } else if (skip_local_same_level && faces_only) {
+    for_each_listed(faces_apart_blocks_, fill);
+  } else {
+    for_each_block(fill);
+  }
 }
 
 double Forest::sum(double local) const {

@@ -180,6 +180,17 @@ class Forest {
   /// (boundary, other level, other rank) are left alone.
   void copy_face_ghosts(BlockField& field, int blk, int colour = -1) const;
 
+  /// body(b) for the listed local blocks, on the forest's OpenMP threads.
+  template <typename Body>
+  void for_each_listed(const std::vector<std::int32_t>& list, Body&& body) const;
+  /// Local blocks with a finer / a coarser neighbour across at least one face.
+  [[nodiscard]] const std::vector<std::int32_t>& blocks_beside_finer() const {
+    return beside_finer_blocks_;
+  }
+  [[nodiscard]] const std::vector<std::int32_t>& blocks_beside_coarser() const {
+    return beside_coarser_blocks_;
+  }
+
   /// Runs body(b) for every local block, on the forest's OpenMP threads.
   template <typename Body>
   void for_each_block(Body&& body) const;
@@ -238,6 +249,9 @@ class Forest {
   void build_blocks();
   void build_ghost_tables();
   void build_neighbours();
+  /// faces_apart_blocks_ and finer_face_blocks_ from the neighbours.
+  void list_face_exchanges();
+
   void rebuild_tables();  ///< ghost layer, block list, mirrors, neighbours
   void migrate_fields(const std::vector<std::int64_t>& before, std::span<BlockField* const> fields);
   /// Key of the block at (level, coord) for the neighbour and matching maps.
@@ -261,6 +275,12 @@ class Forest {
   /// split them (families of 8 on one rank); a forest just built is split
   /// evenly instead, unless it has one rank.
   bool families_partitioned_ = false;
+  /// Blocks with a face towards another level or rank (what
+  /// exchange_face_ghosts_but_local_same_level fills), and per face (2 d +
+  /// side) the blocks whose neighbour there is finer (exchange_from_finer).
+  std::vector<std::int32_t> faces_apart_blocks_;
+  std::array<std::vector<std::int32_t>, 6> finer_face_blocks_;
+  std::vector<std::int32_t> beside_finer_blocks_, beside_coarser_blocks_;
 };
 
 template <typename Body>
@@ -271,6 +291,17 @@ void Forest::for_each_block(Body&& body) const {
     for (int b = 0; b < n; ++b) body(b);
   } else {
     for (int b = 0; b < n; ++b) body(b);
+  }
+}
+
+template <typename Body>
+void Forest::for_each_listed(const std::vector<std::int32_t>& list, Body&& body) const {
+  const auto n = static_cast<std::ptrdiff_t>(list.size());
+  if (spec_.threads > 1) {
+#pragma omp parallel for schedule(static) num_threads(spec_.threads)
+    for (std::ptrdiff_t k = 0; k < n; ++k) body(list[static_cast<std::size_t>(k)]);
+  } else {
+    for (std::ptrdiff_t k = 0; k < n; ++k) body(list[static_cast<std::size_t>(k)]);
   }
 }
 

@@ -34,7 +34,7 @@ void Multigrid::match_fluxes(int level, BlockField& x) {
   if (lv.face_flux[0].blocks() == 0) return;  // one cell per block: the gathered bottom level
   const BlockLayout L = x.layout();
   const int b = L.cells;
-  forest_.for_each_block([&](int blk) {
+  forest_.for_each_listed(forest_.blocks_beside_coarser(), [&](int blk) {
     const Block& block = forest_.block(blk);
     const double h = block.length / b;
     for (int d = 0; d < 3; ++d)
@@ -60,7 +60,7 @@ void Multigrid::match_fluxes(int level, BlockField& x) {
     for (int side = 0; side < 2; ++side) {
       forest_.exchange_from_finer(lv.face_flux[D(face_index(d, side))], face_index(d, 1 - side));
     }
-  forest_.for_each_block([&](int blk) {
+  forest_.for_each_listed(forest_.blocks_beside_finer(), [&](int blk) {
     const Block& block = forest_.block(blk);
     const double h = block.length / b;
     double* xb = x.block(blk);
