@@ -67,7 +67,7 @@ SEED = 3
 
 def pour_rate(gate_cm):
     """Crosses per second asked of the pour (the region's free room grows with its
-    length; run_gate waits for the pour to end whatever rate is reached)."""
+    length; pour_gate waits for the pour to end whatever rate is reached)."""
     return 150.0 * gate_cm
 
 
@@ -100,22 +100,51 @@ def wait_while(hold_file):
             time.sleep(5)
 
 
-def run_gate(exe, gate, out, threads, hold_file=None):
-    """Pour and settle with the gate in place, extending by 0.5 s until every cross is in
-    and at rest (the pour rate is bounded by the free room of the region), then remove
-    the gate and follow the collapse for COLLAPSE_S. A folder with a checkpoint (a run
-    stopped on the way) is continued from it. Returns the opening time."""
+def gate_runner(exe, gate, out, threads, hold_file=None, extra=()):
+    """advance(end, more): runs the gate's case in `out` up to `end` (continued from its
+    checkpoint when there is one), with the gate's overrides, `extra` and `more`."""
     base = [exe, "run", CASE, "--output", out, "--quiet", "--threads", str(threads)]
     for o in overrides(gate):
         base += ["--set", o]
+    base += list(extra)
     checkpoint = os.path.join(out, "checkpoint.bin")
 
-    def advance(end, extra=()):
-        cmd = base + (["--restart"] if os.path.exists(checkpoint) else []) + list(extra)
+    def advance(end, more=()):
+        cmd = base + (["--restart"] if os.path.exists(checkpoint) else []) + list(more)
         cmd += ["--set", f"simulation.end_time_s={end}"]
         wait_while(hold_file)
         print(" ".join(cmd), flush=True)
         subprocess.run(cmd, check=True)
+    return advance
+
+
+def pour_gate(exe, gate, out, threads, hold_file=None):
+    """Pour and settle with the gate in place, extending by 0.5 s until every cross is in
+    and at rest (the pour rate is bounded by the free room of the region). A folder with
+    a checkpoint of a pour stopped on the way is continued. Returns the time reached,
+    when the gate can go."""
+    advance = gate_runner(exe, gate, out, threads, hold_file)
+    checkpoint = os.path.join(out, "checkpoint.bin")
+    t = math.ceil(10 * (CROSSES[gate] / pour_rate(gate) + SETTLE_S)) / 10
+    reached = diagnostics(out)[-1]["time_s"] if os.path.exists(checkpoint) else 0.0
+    if reached > t + 1e-9:  # stopped in an extension of the pour: on the 0.5 s grid beyond t
+        t = round(t + 0.5 * math.ceil((reached - t) / 0.5 - 1e-9), 1)
+    if reached < t - 1e-9:  # a fresh run, or stopped in the pour: go on to t
+        advance(t)
+    while not poured_and_at_rest(out, CROSSES[gate]):
+        if t > 20.0:
+            sys.exit(f"gate {gate} cm: the pour has not come to rest by {t} s")
+        t = round(t + 0.5, 1)
+        advance(t)
+    return t
+
+
+def run_gate(exe, gate, out, threads, hold_file=None):
+    """pour_gate, then remove the gate and follow the collapse for COLLAPSE_S. A folder
+    with a checkpoint (a run stopped on the way) is continued from it. Returns the
+    opening time."""
+    advance = gate_runner(exe, gate, out, threads, hold_file)
+    checkpoint = os.path.join(out, "checkpoint.bin")
 
     def collapse(t):
         """Follow the collapse in segments that end on the checkpoint grid: a segment
@@ -130,19 +159,8 @@ def run_gate(exe, gate, out, threads, hold_file=None):
 
     if os.path.exists(checkpoint) and opening_time(out) < 1e5:  # stopped in the collapse
         t = opening_time(out)
-        collapse(t)
-        return t
-    t = math.ceil(10 * (CROSSES[gate] / pour_rate(gate) + SETTLE_S)) / 10
-    reached = diagnostics(out)[-1]["time_s"] if os.path.exists(checkpoint) else 0.0
-    if reached > t + 1e-9:  # stopped in an extension of the pour: on the 0.5 s grid beyond t
-        t = round(t + 0.5 * math.ceil((reached - t) / 0.5 - 1e-9), 1)
-    if reached < t - 1e-9:  # a fresh run, or stopped in the pour: go on to t
-        advance(t)
-    while not poured_and_at_rest(out, CROSSES[gate]):
-        if t > 20.0:
-            sys.exit(f"gate {gate} cm: the pour has not come to rest by {t} s")
-        t = round(t + 0.5, 1)
-        advance(t)
+    else:
+        t = pour_gate(exe, gate, out, threads, hold_file)
     collapse(t)
     return t
 

@@ -1,0 +1,214 @@
+#!/usr/bin/python3
+"""The calibrated tangential parameters of the crosses tested on another gate (issue #4).
+
+crosses_recalibrated fits gamma_t at kt = 1e2 N/m to the 4 cm gate's run-out and finds
+it nearest the reference at gamma_t = 2e3 1/s. One number fitted is a calibration; this
+case is the test: the same parameters on the wider gates of §3.2.1, where the column is
+lower (a = H0/L0 about 2.5 at 8 cm), with a packing poured anew exactly as
+crosses_dam_break pours it (Table 3.1 parameters, gate in place, at rest), then the gate
+removed at once and the collapse followed with kt = 1e2 N/m, gamma_t = 2e3 1/s (both
+interactions) until the pile is at rest (mean speed below 1 mm/s, checked from 1.5 s
+after the opening; at most 3 s).
+
+Checks (tolerances fixed before running):
+- K = (L_inf - L0)/(L0 a): the thesis finds the crosses on a linear law K a with K
+  "slightly lower" than the 1.2 of Lajeunesse et al.'s spheres (§3.3, Fig. 3.7): K within
+  35 % of 1.2 (the tolerance of the other run-out checks);
+- sanity: the pour at rest before the opening (mean speed below 1 mm/s).
+Reported: the exponent n of the run-out between this gate and the 4 cm calibration run
+(thesis: n about 1 for its crosses, 2/3 for spheres above a = 3), H0/H_inf, the peak
+mean speed and the regime.
+
+Writes validation/dem/results/crosses_calibrated_gates.json and
+docs/validation/figures/crosses_calibrated_gates.png. `--reuse`: analyse the runs on disk.
+A pour stopped on the way is continued; a collapse stopped on the way is run again.
+Usage: /usr/bin/python3 validation/dem/crosses_calibrated_gates.py [--build build]
+           [--gates 8 ...] [--threads T] [--reuse]
+"""
+import argparse
+import math
+import os
+import shutil
+import subprocess
+import sys
+import time
+
+import matplotlib
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from _outputs import read_summary, wall_time, write_summary  # noqa: E402
+from crosses_dam_break import (CROSSES, GATE_INDEX, RESULTS, ROOT, diagnostics,  # noqa: E402
+                               draw_velocity_bands, gate_runner, lajeunesse, pour_gate,
+                               velocity_curve)
+from crosses_tangential_map import tangential_settings  # noqa: E402
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+RUNS = os.path.join(RESULTS, "runs", "crosses_calibrated_gates")
+FIGURE = os.path.join(ROOT, "docs", "validation", "figures", "crosses_calibrated_gates.png")
+# The calibration of crosses_recalibrated: kt fixed, gamma_t its run nearest the target.
+KT, GAMMA_T = 1e2, 2e3
+# Its run at these values on the 4 cm gate (the point the exponent is taken against).
+CALIBRATION_RUN = os.path.join(RESULTS, "runs", "crosses_calibration", "gamma_t", "value_2000",
+                               "seed_1")
+SPHERES_K = 1.2  # Lajeunesse et al. (2005), a below about 3
+COLLAPSE_MAX_S = 3.0
+AT_REST_AFTER_S = 1.5
+
+
+def collapse(exe, gate, pour, out, opening, threads):
+    """The collapse from the pour's state with the calibrated parameters, stopped at rest.
+    A folder without its completion mark (a stopped run) is made again from the pour."""
+    done = os.path.join(out, "calibrated.txt")
+    mark = f"kt {KT:g} gamma_t {GAMMA_T:g} opening {opening:g}"
+    if os.path.exists(done) and open(done).read().strip() == mark:
+        return
+    shutil.rmtree(out, ignore_errors=True)
+    shutil.copytree(pour, out)
+    advance = gate_runner(exe, gate, out, threads,
+                          extra=tangential_settings(KT, GAMMA_T)
+                          + ["--set", "stop.mean_velocity_below_m_s=1e-3",
+                             "--set", f"stop.check_after_s={opening + AT_REST_AFTER_S}"])
+    advance(opening + COLLAPSE_MAX_S, ["--set", f"obstacle[{GATE_INDEX}].remove_at_s={opening}"])
+    with open(done, "w") as f:
+        f.write(mark + "\n")
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--build", default="build")
+    ap.add_argument("--gates", type=int, nargs="+", default=[8],
+                    choices=sorted(g for g in CROSSES if g != 4))
+    ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--reuse", action="store_true", help="analyse the runs already on disk")
+    ap.add_argument("--quick", action="store_true", help="same as the default (the 8 cm gate)")
+    args = ap.parse_args()
+    exe = os.path.join(ROOT, args.build, "app", "sanguis")
+    t0 = time.time()
+    runs = {}
+    for gate in args.gates:
+        pour = os.path.join(RUNS, f"L{gate}cm_pour")
+        out = os.path.join(RUNS, f"L{gate}cm_kt{KT:g}_gamma{GAMMA_T:g}")
+        if not args.reuse:
+            opening = pour_gate(exe, gate, pour, args.threads)
+            collapse(exe, gate, pour, out, opening, args.threads)
+        runs[gate] = (pour, out)
+        subprocess.run([exe, "analyze", out], check=True, stdout=subprocess.DEVNULL)
+
+    reference = None
+    if os.path.exists(os.path.join(CALIBRATION_RUN, "run.log")):
+        subprocess.run([exe, "analyze", CALIBRATION_RUN], check=True, stdout=subprocess.DEVNULL)
+        reference = read_summary(CALIBRATION_RUN)
+
+    checks, rows, notes = [], [], []
+    elapsed = 0.0
+    for gate, (pour, out) in runs.items():
+        s = read_summary(out)
+        a, ratio = s["aspect_ratio_H0_over_L0"], s["runout_ratio"]
+        k = ratio / a
+        before = diagnostics(pour)[-1]
+        opening = before["time_s"]
+        pour_s, collapse_s = wall_time(pour), wall_time(out, opening)
+        elapsed += pour_s + collapse_s
+        checks.append({"quantity": f"K = (L∞−L0)/(L0 a), gate {gate} cm, a = {a:.2f}, "
+                                   f"kt {KT:g}, γt {GAMMA_T:g}",
+                       "measured": round(k, 3),
+                       "thesis": f"slightly below the spheres' {SPHERES_K} (§3.3, Fig. 3.7)",
+                       "tolerance": "±35 % of 1.2", "pass": abs(k / SPHERES_K - 1) <= 0.35})
+        checks.append({"quantity": f"sanity, gate {gate} cm: mean speed at the opening [m/s]",
+                       "measured": f"{before['mean_velocity_m_s']:.2g}", "thesis": "—",
+                       "tolerance": "< 1e-3", "pass": before["mean_velocity_m_s"] < 1e-3})
+        if reference:
+            ar, rr = reference["aspect_ratio_H0_over_L0"], reference["runout_ratio"]
+            n = math.log(rr / ratio) / math.log(ar / a)
+            checks.append({"quantity": f"exponent n of (L∞−L0)/L0 ∝ a^n between the 4 cm "
+                                       f"(a = {ar:.2f}) and the {gate} cm gate",
+                           "measured": round(n, 3),
+                           "thesis": "about 1 for its crosses (2/3: spheres above a = 3)",
+                           "tolerance": "reported", "pass": None})
+        rows.append([f"{gate}", f"{CROSSES[gate]}", f"{100 * s['L0_m']:.1f}",
+                     f"{100 * s['H0_m']:.1f}", f"{a:.2f}", f"{ratio:.2f}", f"{k:.2f}",
+                     f"{lajeunesse(a):.2f}", f"{s['height_ratio_H0_over_Hinf']:.2f}",
+                     f"{s['peak_mean_speed_over_sqrt_gH0']:.3f}",
+                     f"{s['peak_time_over_tau_c']:.1f}",
+                     ["stable", "fractured", "collapsed"][int(s["regime"])],
+                     f"{pour_s / 3600:.2f}", f"{collapse_s / 3600:.2f}"])
+        notes.append(f"Gate {gate} cm: {CROSSES[gate]} crosses poured with Table 3.1 and at "
+                     f"rest at {opening:g} s ({pour_s / 3600:.2f} h on {args.threads} threads); "
+                     f"the collapse with kt {KT:g} N/m, γt {GAMMA_T:g} 1/s stopped at "
+                     f"{diagnostics(out)[-1]['time_s'] - opening:.2f} s after the opening "
+                     f"({collapse_s / 3600:.2f} h).")
+    if reference:
+        rows.append(["4 (calibration run)", f"{CROSSES[4]}",
+                     f"{100 * reference['L0_m']:.1f}", f"{100 * reference['H0_m']:.1f}",
+                     f"{reference['aspect_ratio_H0_over_L0']:.2f}",
+                     f"{reference['runout_ratio']:.2f}",
+                     f"{reference['runout_ratio'] / reference['aspect_ratio_H0_over_L0']:.2f}",
+                     f"{lajeunesse(reference['aspect_ratio_H0_over_L0']):.2f}",
+                     f"{reference['height_ratio_H0_over_Hinf']:.2f}",
+                     f"{reference['peak_mean_speed_over_sqrt_gH0']:.3f}",
+                     f"{reference['peak_time_over_tau_c']:.1f}",
+                     ["stable", "fractured", "collapsed"][int(reference["regime"])], "—", "—"])
+    notes.append("The parameters were fitted on the 4 cm gate only (crosses_recalibrated); "
+                 "this gate was not used in the fit. The packings are poured with Table 3.1, "
+                 "as in crosses_dam_break, so the two cases share their state at the opening.")
+
+    os.makedirs(os.path.dirname(FIGURE), exist_ok=True)
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.2))
+    a_line = [0.3 * 1.05 ** k for k in range(70)]
+    a1.loglog(a_line, [lajeunesse(x) for x in a_line], "k--", label="Lajeunesse et al. (spheres)")
+    a1.loglog(a_line, [0.65 * SPHERES_K * x for x in a_line], ":", color="0.5", lw=0.8)
+    a1.loglog(a_line, [1.35 * SPHERES_K * x for x in a_line], ":", color="0.5", lw=0.8,
+              label="1.2 a ± 35 %")
+    for gate, (_, out) in runs.items():
+        s = read_summary(out)
+        l0, r = s["L0_m"], s["runout_ratio"]
+        lo, hi = (s["Linf_20pc_m"] - l0) / l0, (s["Linf_1pc_m"] - l0) / l0
+        a1.errorbar([s["aspect_ratio_H0_over_L0"]], [r],
+                    yerr=[[max(0.0, r - lo)], [max(0.0, hi - r)]], fmt="o", capsize=3,
+                    label=f"gate {gate} cm (test)")
+        t, v = velocity_curve(out)
+        a2.plot(t, v, label=f"gate {gate} cm")
+    if reference:
+        a1.plot([reference["aspect_ratio_H0_over_L0"]], [reference["runout_ratio"]], "s",
+                label="gate 4 cm (the calibration)")
+        t, v = velocity_curve(CALIBRATION_RUN)
+        a2.plot(t, v, label="gate 4 cm (the calibration)")
+    a1.set_xlabel(r"$a = H_0/L_0$")
+    a1.set_ylabel(r"$(L_\infty - L_0)/L_0$")
+    a1.set_title(f"kt {KT:g} N/m, γt {GAMMA_T:g} 1/s", fontsize=9)
+    a1.legend(fontsize=8)
+    draw_velocity_bands(a2)
+    fig.tight_layout()
+    fig.savefig(FIGURE, dpi=130)
+
+    if not args.reuse:
+        elapsed = time.time() - t0
+    ok = all(c["pass"] for c in checks if c["pass"] is not None)
+    summary = {
+        "name": "crosses_calibrated_gates",
+        "title": "Dam break of crosses: the calibrated kt, γt on another gate",
+        "thesis": "§3.2.1, §3.3 (Fig. 3.7), §3.4.3",
+        "description": (
+            f"The calibration of crosses_recalibrated (kt {KT:g} N/m, γt {GAMMA_T:g} 1/s, "
+            "fitted on the 4 cm gate's run-out) tested on the wider gates of §3.2.1: the "
+            "column poured with the gate in place as in crosses_dam_break, the gate removed "
+            "at once, the collapse followed until the pile is at rest."),
+        "command": "/usr/bin/python3 validation/dem/crosses_calibrated_gates.py --build BUILD",
+        "figures": ["docs/validation/figures/crosses_calibrated_gates.png"],
+        "checks": checks,
+        "tables": [{"caption": "Per gate (`sanguis analyze`); wall times on the 2-core VM.",
+                    "header": ["gate [cm]", "crosses", "L0 [cm]", "H0 [cm]", "a",
+                               "(L∞−L0)/L0", "K", "Lajeunesse", "H0/H∞", "peak v/√(gH0)",
+                               "peak t/τc", "regime", "pour [h]", "collapse [h]"],
+                    "rows": rows}],
+        "notes": notes,
+    }
+    write_summary(summary, RESULTS, elapsed, args.quick, ok)
+    print(f"{'PASS' if ok else 'FAIL'}: {elapsed / 3600:.2f} h")
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
