@@ -323,7 +323,8 @@ def main():
                      f"γt = {gamma:g} gives {cal['runout_ratio']:.2f}. ")
                   + "This fits one number "
                   "(the 4 cm gate's run-out), so it is a calibration, not a validation: the "
-                  "other gates of Fig. 3.7 with these parameters would be the test.",
+                  "other gates of Fig. 3.7 with these parameters are the test "
+                  "(crosses_calibrated_gates: the 8 cm gate).",
                   "Wall times: the pour on 2 threads; the two 3 s collapses side by side, one "
                   "thread each; the calibration's runs side by side, one thread each; the run "
                   "at the fit on 2 threads; all on the 2-core VM, with other jobs for part of "
