@@ -17,7 +17,8 @@ Checks (tolerances fixed before running):
 - sanity: the pour at rest before the opening (mean speed below 1 mm/s).
 Reported: the exponent n of the run-out between this gate and the 4 cm calibration run
 (thesis: n about 1 for its crosses, 2/3 for spheres above a = 3), H0/H_inf, the peak
-mean speed and the regime.
+mean speed and the regime; and the same collapse with Table 3.1 (kt 3e2 N/m, gamma_t
+1e3 1/s) from the same packing, stopped at rest the same way.
 
 Writes validation/dem/results/crosses_calibrated_gates.json and
 docs/validation/figures/crosses_calibrated_gates.png. `--reuse`: analyse the runs on disk.
@@ -56,17 +57,19 @@ COLLAPSE_MAX_S = 3.0
 AT_REST_AFTER_S = 1.5
 
 
-def collapse(exe, gate, pour, out, opening, threads):
-    """The collapse from the pour's state with the calibrated parameters, stopped at rest.
-    A folder without its completion mark (a stopped run) is made again from the pour."""
+def collapse(exe, gate, pour, out, opening, threads, tangential=(KT, GAMMA_T)):
+    """The collapse from the pour's state with the tangential (kt, gamma_t) given (None:
+    the case's Table 3.1), stopped at rest. A folder without its completion mark (a
+    stopped run) is made again from the pour."""
     done = os.path.join(out, "calibrated.txt")
-    mark = f"kt {KT:g} gamma_t {GAMMA_T:g} opening {opening:g}"
+    label = "Table 3.1" if tangential is None else f"kt {tangential[0]:g} gamma_t {tangential[1]:g}"
+    mark = f"{label} opening {opening:g}"
     if os.path.exists(done) and open(done).read().strip() == mark:
         return
     shutil.rmtree(out, ignore_errors=True)
     shutil.copytree(pour, out)
     advance = gate_runner(exe, gate, out, threads,
-                          extra=tangential_settings(KT, GAMMA_T)
+                          extra=(tangential_settings(*tangential) if tangential else [])
                           + ["--set", "stop.mean_velocity_below_m_s=1e-3",
                              "--set", f"stop.check_after_s={opening + AT_REST_AFTER_S}"])
     advance(opening + COLLAPSE_MAX_S, ["--set", f"obstacle[{GATE_INDEX}].remove_at_s={opening}"])
@@ -88,11 +91,14 @@ def main():
     for gate in args.gates:
         pour = os.path.join(RUNS, f"L{gate}cm_pour")
         out = os.path.join(RUNS, f"L{gate}cm_kt{KT:g}_gamma{GAMMA_T:g}")
+        table31 = os.path.join(RUNS, f"L{gate}cm_table31")
         if not args.reuse:
             opening = pour_gate(exe, gate, pour, args.threads)
             collapse(exe, gate, pour, out, opening, args.threads)
-        runs[gate] = (pour, out)
-        subprocess.run([exe, "analyze", out], check=True, stdout=subprocess.DEVNULL)
+            collapse(exe, gate, pour, table31, opening, args.threads, tangential=None)
+        runs[gate] = (pour, out, table31)
+        for run in (out, table31):
+            subprocess.run([exe, "analyze", run], check=True, stdout=subprocess.DEVNULL)
 
     reference = None
     if os.path.exists(os.path.join(CALIBRATION_RUN, "run.log")):
@@ -101,19 +107,25 @@ def main():
 
     checks, rows, notes = [], [], []
     elapsed = 0.0  # the run segments' wall times (a pour reused by a later call counts)
-    for gate, (pour, out) in runs.items():
+    for gate, (pour, out, table31) in runs.items():
         s = read_summary(out)
+        t31 = read_summary(table31)
         a, ratio = s["aspect_ratio_H0_over_L0"], s["runout_ratio"]
         k = ratio / a
         before = diagnostics(pour)[-1]
         opening = before["time_s"]
         pour_s, collapse_s = wall_time(pour), wall_time(out, opening)
-        elapsed += pour_s + collapse_s
+        elapsed += pour_s + collapse_s + wall_time(table31, opening)
         checks.append({"quantity": f"K = (L∞−L0)/(L0 a), gate {gate} cm, a = {a:.2f}, "
                                    f"kt {KT:g}, γt {GAMMA_T:g}",
                        "measured": round(k, 3),
                        "thesis": f"slightly below the spheres' {SPHERES_K} (§3.3, Fig. 3.7)",
                        "tolerance": "±35 % of 1.2", "pass": abs(k / SPHERES_K - 1) <= 0.35})
+        checks.append({"quantity": f"(L∞−L0)/L0, gate {gate} cm, Table 3.1 (kt 3e2, γt 1e3), "
+                                   "the same packing",
+                       "measured": round(t31["runout_ratio"], 3),
+                       "thesis": f"{SPHERES_K * t31['aspect_ratio_H0_over_L0']:.2f} (1.2 a)",
+                       "tolerance": "reported", "pass": None})
         checks.append({"quantity": f"sanity, gate {gate} cm: mean speed at the opening [m/s]",
                        "measured": f"{before['mean_velocity_m_s']:.2g}", "thesis": "—",
                        "tolerance": "< 1e-3", "pass": before["mean_velocity_m_s"] < 1e-3})
@@ -125,6 +137,16 @@ def main():
                            "measured": round(n, 3),
                            "thesis": "about 1 for its crosses (2/3: spheres above a = 3)",
                            "tolerance": "reported", "pass": None})
+        rows.append([f"{gate}, Table 3.1", f"{CROSSES[gate]}", f"{100 * t31['L0_m']:.1f}",
+                     f"{100 * t31['H0_m']:.1f}", f"{t31['aspect_ratio_H0_over_L0']:.2f}",
+                     f"{t31['runout_ratio']:.2f}",
+                     f"{t31['runout_ratio'] / t31['aspect_ratio_H0_over_L0']:.2f}",
+                     f"{lajeunesse(t31['aspect_ratio_H0_over_L0']):.2f}",
+                     f"{t31['height_ratio_H0_over_Hinf']:.2f}",
+                     f"{t31['peak_mean_speed_over_sqrt_gH0']:.3f}",
+                     f"{t31['peak_time_over_tau_c']:.1f}",
+                     ["stable", "fractured", "collapsed"][int(t31["regime"])], "(same)",
+                     f"{wall_time(table31, opening) / 3600:.2f}"])
         rows.append([f"{gate}", f"{CROSSES[gate]}", f"{100 * s['L0_m']:.1f}",
                      f"{100 * s['H0_m']:.1f}", f"{a:.2f}", f"{ratio:.2f}", f"{k:.2f}",
                      f"{lajeunesse(a):.2f}", f"{s['height_ratio_H0_over_Hinf']:.2f}",
@@ -170,7 +192,12 @@ def main():
     a1.loglog(a_line, [0.65 * SPHERES_K * x for x in a_line], ":", color="0.5", lw=0.8)
     a1.loglog(a_line, [1.35 * SPHERES_K * x for x in a_line], ":", color="0.5", lw=0.8,
               label="1.2 a ± 35 %")
-    for gate, (_, out) in runs.items():
+    for gate, (_, out, table31) in runs.items():
+        t31 = read_summary(table31)
+        a1.plot([t31["aspect_ratio_H0_over_L0"]], [t31["runout_ratio"]], "v",
+                label=f"gate {gate} cm, Table 3.1, same packing")
+        t, v = velocity_curve(table31)
+        a2.plot(t, v, ls="--", label=f"gate {gate} cm, Table 3.1")
         s = read_summary(out)
         l0, r = s["L0_m"], s["runout_ratio"]
         lo, hi = (s["Linf_20pc_m"] - l0) / l0, (s["Linf_1pc_m"] - l0) / l0
@@ -206,7 +233,7 @@ def main():
         "figures": ["docs/validation/figures/crosses_calibrated_gates.png"],
         "checks": checks,
         "tables": [{"caption": "Per gate (`sanguis analyze`); wall times on the 2-core VM.",
-                    "header": ["gate [cm]", "crosses", "L0 [cm]", "H0 [cm]", "a",
+                    "header": ["gate [cm] (kt 1e2, γt 2e3 unless said)", "crosses", "L0 [cm]", "H0 [cm]", "a",
                                "(L∞−L0)/L0", "K", "Lajeunesse", "H0/H∞", "peak v/√(gH0)",
                                "peak t/τc", "regime", "pour [h]", "collapse [h]"],
                     "rows": rows}],
