@@ -18,13 +18,20 @@ Checks (tolerances fixed before running):
 Reported: the exponent n of the run-out between this gate and the 4 cm calibration run
 (thesis: n about 1 for its crosses, 2/3 for spheres above a = 3), H0/H_inf, the peak
 mean speed and the regime; and the same collapse with Table 3.1 (kt 3e2 N/m, gamma_t
-1e3 1/s) from the same packing, stopped at rest the same way.
+1e3 1/s) from the case's packing, stopped at rest the same way.
+
+Seeds: the thesis' regime map (Fig. 3.6) is intermittent at low aspect ratio (a column
+stands or collapses with the draw of its packing), so one pour cannot tell a shifted
+regime boundary from a standing draw. `--seeds` pours the gate once per seed (the
+case's seed 3 in the folders without a suffix); each pour is a test of its own (the K
+check above), and the spread over the seeds is reported. The Table 3.1 collapse is run
+from the case's seed only.
 
 Writes validation/dem/results/crosses_calibrated_gates.json and
 docs/validation/figures/crosses_calibrated_gates.png. `--reuse`: analyse the runs on disk.
 A pour stopped on the way is continued; a collapse stopped on the way is run again.
 Usage: /usr/bin/python3 validation/dem/crosses_calibrated_gates.py [--build build]
-           [--gates 8 ...] [--threads T] [--reuse]
+           [--gates 8 ...] [--seeds 3 ...] [--threads T] [--reuse]
 """
 import argparse
 import math
@@ -37,9 +44,9 @@ import matplotlib
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from _outputs import read_summary, wall_time, write_summary  # noqa: E402
-from crosses_dam_break import (CROSSES, GATE_INDEX, RESULTS, ROOT, diagnostics,  # noqa: E402
-                               draw_velocity_bands, gate_runner, lajeunesse, pour_gate,
-                               velocity_curve)
+from crosses_dam_break import (CROSSES, GATE_INDEX, RESULTS, ROOT, SEED,  # noqa: E402
+                               diagnostics, draw_velocity_bands, gate_runner, lajeunesse,
+                               pour_gate, velocity_curve)
 from crosses_tangential_map import tangential_settings  # noqa: E402
 
 matplotlib.use("Agg")
@@ -55,6 +62,22 @@ CALIBRATION_RUN = os.path.join(RESULTS, "runs", "crosses_calibration", "gamma_t"
 SPHERES_K = 1.2  # Lajeunesse et al. (2005), a below about 3
 COLLAPSE_MAX_S = 3.0
 AT_REST_AFTER_S = 1.5
+# The pours of the report: the case's seed, then one more.
+SEEDS = (SEED,)
+
+
+def seed_settings(seed):
+    """The override that pours another packing (none for the case's own seed)."""
+    return [] if seed == SEED else ["--set", f"simulation.seed={seed}"]
+
+
+def folders(gate, seed):
+    """The pour, the calibrated collapse and (case's seed only, else None) the Table 3.1
+    collapse of one gate and seed."""
+    tag = f"L{gate}cm" if seed == SEED else f"L{gate}cm_seed{seed}"
+    return (os.path.join(RUNS, f"{tag}_pour"),
+            os.path.join(RUNS, f"{tag}_kt{KT:g}_gamma{GAMMA_T:g}"),
+            os.path.join(RUNS, f"{tag}_table31") if seed == SEED else None)
 
 
 def completion_mark(tangential, opening):
@@ -69,7 +92,7 @@ def finished(out, tangential, opening):
                                                                                   opening)
 
 
-def collapse(exe, gate, pour, out, opening, threads, tangential=(KT, GAMMA_T)):
+def collapse(exe, gate, pour, out, opening, threads, tangential=(KT, GAMMA_T), seed=SEED):
     """The collapse from the pour's state with the tangential (kt, gamma_t) given (None:
     the case's Table 3.1), stopped at rest. A folder without its completion mark (a
     stopped run) is made again from the pour."""
@@ -78,7 +101,8 @@ def collapse(exe, gate, pour, out, opening, threads, tangential=(KT, GAMMA_T)):
     shutil.rmtree(out, ignore_errors=True)
     shutil.copytree(pour, out)
     advance = gate_runner(exe, gate, out, threads,
-                          extra=(tangential_settings(*tangential) if tangential else [])
+                          extra=seed_settings(seed)
+                          + (tangential_settings(*tangential) if tangential else [])
                           + ["--set", "stop.mean_velocity_below_m_s=1e-3",
                              "--set", f"stop.check_after_s={opening + AT_REST_AFTER_S}"])
     advance(opening + COLLAPSE_MAX_S, ["--set", f"obstacle[{GATE_INDEX}].remove_at_s={opening}"])
@@ -107,33 +131,54 @@ def run_row(label, crosses, s, pour, collapse_s):
             pour, "—" if collapse_s is None else f"{collapse_s / 3600:.2f}"]
 
 
+def run_gate_seed(exe, gate, seed, threads, reuse):
+    """Pours (unless --reuse) and checks the runs of one gate and seed; returns the
+    pour, the calibrated collapse and the Table 3.1 collapse (None for other seeds)."""
+    pour, out, table31 = folders(gate, seed)
+    if not reuse:
+        opening = pour_gate(exe, gate, pour, threads, extra=seed_settings(seed))
+        collapse(exe, gate, pour, out, opening, threads, seed=seed)
+        if table31:
+            collapse(exe, gate, pour, table31, opening, threads, tangential=None)
+    opening = diagnostics(pour)[-1]["time_s"]
+    for run, tangential in ((out, (KT, GAMMA_T)), (table31, None)):
+        if run and not finished(run, tangential, opening):
+            sys.exit(f"{run}: not finished (no completion mark for the opening at "
+                     f"{opening:g} s); run without --reuse to finish it")
+    for run in (out, table31):
+        if run:
+            subprocess.run([exe, "analyze", run], check=True, stdout=subprocess.DEVNULL)
+    return pour, out, table31
+
+
+def seeds_note(gate, seeds, summaries):
+    """What the pours of one gate show together (more than one seed)."""
+    ks = [s["runout_ratio"] / s["aspect_ratio_H0_over_L0"] for s in summaries]
+    regimes = [["stable", "fractured", "collapsed"][int(s["regime"])] for s in summaries]
+    mean = sum(ks) / len(ks)
+    return (f"Gate {gate} cm, kt {KT:g}, γt {GAMMA_T:g}, {len(seeds)} pours (seeds "
+            f"{', '.join(str(x) for x in seeds)}): K = {', '.join(f'{k:.2f}' for k in ks)} "
+            f"(mean {mean:.2f}, {'within' if abs(mean / SPHERES_K - 1) <= 0.35 else 'outside'} "
+            f"1.2 ± 35 %), regimes {', '.join(regimes)}.")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--build", default="build")
     ap.add_argument("--gates", type=int, nargs="+", default=[8],
                     choices=sorted(g for g in CROSSES if g != 4))
+    ap.add_argument("--seeds", type=int, nargs="+", default=list(SEEDS),
+                    help=f"one pour per seed (default {' '.join(str(x) for x in SEEDS)}; "
+                         f"{SEED} is the case's own)")
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--reuse", action="store_true", help="analyse the runs already on disk")
     ap.add_argument("--quick", action="store_true", help="same as the default (the 8 cm gate)")
     args = ap.parse_args()
+    if len(set(args.seeds)) != len(args.seeds) or min(args.seeds) < 0:
+        ap.error("--seeds: distinct non-negative integers")
     exe = os.path.join(ROOT, args.build, "app", "sanguis")
-    runs = {}
-    for gate in args.gates:
-        pour = os.path.join(RUNS, f"L{gate}cm_pour")
-        out = os.path.join(RUNS, f"L{gate}cm_kt{KT:g}_gamma{GAMMA_T:g}")
-        table31 = os.path.join(RUNS, f"L{gate}cm_table31")
-        if not args.reuse:
-            opening = pour_gate(exe, gate, pour, args.threads)
-            collapse(exe, gate, pour, out, opening, args.threads)
-            collapse(exe, gate, pour, table31, opening, args.threads, tangential=None)
-        opening = diagnostics(pour)[-1]["time_s"]
-        for run, tangential in ((out, (KT, GAMMA_T)), (table31, None)):
-            if not finished(run, tangential, opening):
-                sys.exit(f"{run}: not finished (no completion mark for the opening at "
-                         f"{opening:g} s); run without --reuse to finish it")
-        runs[gate] = (pour, out, table31)
-        for run in (out, table31):
-            subprocess.run([exe, "analyze", run], check=True, stdout=subprocess.DEVNULL)
+    runs = {(gate, seed): run_gate_seed(exe, gate, seed, args.threads, args.reuse)
+            for gate in args.gates for seed in args.seeds}
 
     reference = None
     if os.path.exists(os.path.join(CALIBRATION_RUN, "run.log")):
@@ -142,58 +187,71 @@ def main():
 
     checks, rows, notes = [], [], []
     elapsed = 0.0  # the run segments' wall times (a pour reused by a later call counts)
-    for gate, (pour, out, table31) in runs.items():
+    several = len(args.seeds) > 1
+    for (gate, seed), (pour, out, table31) in runs.items():
         s = read_summary(out)
-        t31 = read_summary(table31)
         a, ratio = s["aspect_ratio_H0_over_L0"], s["runout_ratio"]
         k = ratio / a
         before = diagnostics(pour)[-1]
         opening = before["time_s"]
         pour_s, collapse_s = wall_time(pour), wall_time(out, opening)
-        elapsed += pour_s + collapse_s + wall_time(table31, opening)
-        checks.append({"quantity": f"K = (L∞−L0)/(L0 a), gate {gate} cm, a = {a:.2f}, "
+        elapsed += pour_s + collapse_s + (wall_time(table31, opening) if table31 else 0.0)
+        which = f"gate {gate} cm" + (f", seed {seed}" if several else "")
+        checks.append({"quantity": f"K = (L∞−L0)/(L0 a), {which}, a = {a:.2f}, "
                                    f"kt {KT:g}, γt {GAMMA_T:g}",
                        "measured": round(k, 3),
                        "thesis": f"slightly below the spheres' {SPHERES_K} (§3.3, Fig. 3.7)",
                        "tolerance": "±35 % of 1.2", "pass": abs(k / SPHERES_K - 1) <= 0.35})
-        checks.append({"quantity": f"(L∞−L0)/L0, gate {gate} cm, Table 3.1 (kt 3e2, γt 1e3), "
-                                   "the same packing",
-                       "measured": round(t31["runout_ratio"], 3),
-                       "thesis": f"{SPHERES_K * t31['aspect_ratio_H0_over_L0']:.2f} (1.2 a)",
-                       "tolerance": "reported", "pass": None})
-        checks.append({"quantity": f"sanity, gate {gate} cm: mean speed at the opening [m/s]",
+        if table31:
+            t31 = read_summary(table31)
+            checks.append({"quantity": f"(L∞−L0)/L0, {which}, Table 3.1 (kt 3e2, γt 1e3), "
+                                       "the same packing",
+                           "measured": round(t31["runout_ratio"], 3),
+                           "thesis": f"{SPHERES_K * t31['aspect_ratio_H0_over_L0']:.2f} (1.2 a)",
+                           "tolerance": "reported", "pass": None})
+        checks.append({"quantity": f"sanity, {which}: mean speed at the opening [m/s]",
                        "measured": f"{before['mean_velocity_m_s']:.2g}", "thesis": "—",
                        "tolerance": "< 1e-3", "pass": before["mean_velocity_m_s"] < 1e-3})
         if reference:
             ar, rr = reference["aspect_ratio_H0_over_L0"], reference["runout_ratio"]
             n = math.log(rr / ratio) / math.log(ar / a)
             checks.append({"quantity": f"exponent n of (L∞−L0)/L0 ∝ a^n between the 4 cm "
-                                       f"(a = {ar:.2f}) and the {gate} cm gate",
+                                       f"(a = {ar:.2f}) and the {gate} cm gate"
+                                       + (f", seed {seed}" if several else ""),
                            "measured": round(n, 3),
                            "thesis": "about 1 for its crosses (2/3: spheres above a = 3)",
                            "tolerance": "reported", "pass": None})
-        rows.append(run_row(f"{gate}", CROSSES[gate], s, f"{pour_s / 3600:.2f}", collapse_s))
-        rows.append(run_row(f"{gate}, Table 3.1", CROSSES[gate], t31, "(as above)",
-                            wall_time(table31, opening)))
+        label = f"{gate}" + (f", seed {seed}" if several else "")
+        rows.append(run_row(label, CROSSES[gate], s, f"{pour_s / 3600:.2f}", collapse_s))
+        if table31:
+            rows.append(run_row(f"{label}, Table 3.1", CROSSES[gate], t31, "(as above)",
+                                wall_time(table31, opening)))
         if s["regime"] != 2:
             what = ("stands" if s["regime"] == 0 else
                     "does not collapse as a whole: its face avalanches (fractured)")
             verdict = ("K passes" if abs(k / SPHERES_K - 1) <= 0.35 else
                        "on this packing the calibration of the 4 cm gate does not carry over "
                        "to the lower column")
+            more = ("" if several else
+                    " The thesis' regime map (Fig. 3.6) has intermittent outcomes (a column "
+                    "that stands or collapses with the draw of its packing) at low aspect "
+                    "ratios, so one pour cannot tell a shifted regime boundary from a "
+                    "standing draw: several pours (seeds) would.")
             notes.append(
-                f"Gate {gate} cm, kt {KT:g}, γt {GAMMA_T:g}: the column (a = {a:.2f}) {what}; "
-                f"H0/H∞ = {s['height_ratio_H0_over_Hinf']:.2f}, the mean speed peaks at "
-                f"{s['peak_mean_speed_over_sqrt_gH0']:.3f} sqrt(g H0) and K = {k:.2f}: "
-                f"{verdict}. The thesis' regime map (Fig. 3.6) has intermittent outcomes (a "
-                "column that stands or collapses with the draw of its packing) at low aspect "
-                "ratios, so one pour cannot tell a shifted regime boundary from a standing "
-                "draw: several pours (seeds) would.")
-        notes.append(f"Gate {gate} cm: {CROSSES[gate]} crosses poured with Table 3.1 and at "
-                     f"rest at {opening:g} s ({pour_s / 3600:.2f} h); the collapse with kt "
-                     f"{KT:g} N/m, γt {GAMMA_T:g} 1/s {stopped(out, opening)} "
-                     f"({collapse_s / 3600:.2f} h), the one with Table 3.1 "
-                     f"{stopped(table31, opening)} ({wall_time(table31, opening) / 3600:.2f} h).")
+                f"{which[0].upper() + which[1:]}, kt {KT:g}, γt {GAMMA_T:g}: the column "
+                f"(a = {a:.2f}) {what}; H0/H∞ = {s['height_ratio_H0_over_Hinf']:.2f}, the "
+                f"mean speed peaks at {s['peak_mean_speed_over_sqrt_gH0']:.3f} sqrt(g H0) "
+                f"and K = {k:.2f}: {verdict}.{more}")
+        end = (f", the one with Table 3.1 {stopped(table31, opening)} "
+               f"({wall_time(table31, opening) / 3600:.2f} h)." if table31 else ".")
+        notes.append(f"{which[0].upper() + which[1:]}: {CROSSES[gate]} crosses poured with "
+                     f"Table 3.1 and at rest at {opening:g} s ({pour_s / 3600:.2f} h); the "
+                     f"collapse with kt {KT:g} N/m, γt {GAMMA_T:g} 1/s {stopped(out, opening)} "
+                     f"({collapse_s / 3600:.2f} h){end}")
+    if several:
+        for gate in args.gates:
+            notes.append(seeds_note(gate, args.seeds,
+                                    [read_summary(runs[(gate, x)][1]) for x in args.seeds]))
     if reference:
         rows.append(run_row("4 (calibration run)", CROSSES[4], reference, "—", None))
     notes.append("The parameters were fitted on the 4 cm gate only (crosses_recalibrated); "
@@ -210,20 +268,22 @@ def main():
     a1.loglog(a_line, [0.65 * SPHERES_K * x for x in a_line], ":", color="0.5", lw=0.8)
     a1.loglog(a_line, [1.35 * SPHERES_K * x for x in a_line], ":", color="0.5", lw=0.8,
               label="1.2 a ± 35 %")
-    for gate, (_, out, table31) in runs.items():
-        t31 = read_summary(table31)
-        a1.plot([t31["aspect_ratio_H0_over_L0"]], [t31["runout_ratio"]], "v",
-                label=f"gate {gate} cm, Table 3.1, same packing")
-        t, v = velocity_curve(table31)
-        a2.plot(t, v, ls="--", label=f"gate {gate} cm, Table 3.1")
+    for (gate, seed), (_, out, table31) in runs.items():
+        which = f"gate {gate} cm" + (f", seed {seed}" if several else "")
+        if table31:
+            t31 = read_summary(table31)
+            a1.plot([t31["aspect_ratio_H0_over_L0"]], [t31["runout_ratio"]], "v",
+                    label=f"{which}, Table 3.1, same packing")
+            t, v = velocity_curve(table31)
+            a2.plot(t, v, ls="--", label=f"{which}, Table 3.1")
         s = read_summary(out)
         l0, r = s["L0_m"], s["runout_ratio"]
         lo, hi = (s["Linf_20pc_m"] - l0) / l0, (s["Linf_1pc_m"] - l0) / l0
         a1.errorbar([s["aspect_ratio_H0_over_L0"]], [r],
                     yerr=[[max(0.0, r - lo)], [max(0.0, hi - r)]], fmt="o", capsize=3,
-                    label=f"gate {gate} cm (test)")
+                    label=f"{which} (test)")
         t, v = velocity_curve(out)
-        a2.plot(t, v, label=f"gate {gate} cm")
+        a2.plot(t, v, label=which)
     if reference:
         a1.plot([reference["aspect_ratio_H0_over_L0"]], [reference["runout_ratio"]], "s",
                 label="gate 4 cm (the calibration)")

@@ -118,12 +118,12 @@ def gate_runner(exe, gate, out, threads, hold_file=None, extra=()):
     return advance
 
 
-def pour_gate(exe, gate, out, threads, hold_file=None):
+def pour_gate(exe, gate, out, threads, hold_file=None, extra=()):
     """Pour and settle with the gate in place, extending by 0.5 s until every cross is in
     and at rest (the pour rate is bounded by the free room of the region). A folder with
-    a checkpoint of a pour stopped on the way is continued. Returns the time reached,
-    when the gate can go."""
-    advance = gate_runner(exe, gate, out, threads, hold_file)
+    a checkpoint of a pour stopped on the way is continued; `extra` are more overrides
+    (another seed). Returns the time reached, when the gate can go."""
+    advance = gate_runner(exe, gate, out, threads, hold_file, extra)
     checkpoint = os.path.join(out, "checkpoint.bin")
     t = math.ceil(10 * (CROSSES[gate] / pour_rate(gate) + SETTLE_S)) / 10
     reached = diagnostics(out)[-1]["time_s"] if os.path.exists(checkpoint) else 0.0
