@@ -6,9 +6,9 @@ another, then reads the JSON summary each writes to validation/dem/results/NAME.
 and writes docs/validation/dem.md: per case its figures, the measured numbers next to
 the thesis' numbers with the tolerance and PASS/FAIL, the run time, and the hardware and
 date of the run. Exits 1 if any script fails. `make validate-dem` calls it; on the
-2-core development machine it takes about 4.5 hours: the 8 cm gate with the calibrated
-crosses (pour ~43 min, collapse ~33 min, the same collapse with Table 3.1 ~32 min,
-2 threads), the cross columns (pour ~15 min,
+2-core development machine it takes about 6 hours: the 8 cm gate with the calibrated
+crosses (two pours ~45 min each, their collapses ~33 and ~53 min, the first one's collapse
+with Table 3.1 ~32 min, 2 threads), the cross columns (pour ~15 min,
 memory pair ~12 min, tangential map ~40 min), the hopper sweep (~75 min), the friction
 calibration (~11 min), the run-out scaling (~10 min) and the settling runs (~6.5 min); `--quick` runs reduced
 variants where a script has one. `--only NAME` reruns one case.
