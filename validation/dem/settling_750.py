@@ -176,7 +176,7 @@ def main():
         runs.append({"name": name, "memory": memory, "seed": seed, "wall_s": wall,
                      "diagnostics": d})
 
-    checks, ok, table = [], True, []
+    checks, ok = [], True
 
     def check(quantity, measured, thesis, tolerance, good):
         nonlocal ok
