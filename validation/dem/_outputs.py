@@ -44,6 +44,11 @@ def read_pvd(path):
             for d in root.iter("DataSet")]
 
 
+def regime_name(summary):
+    """The flow regime of a `sanguis analyze` summary row, in words."""
+    return ("stable", "fractured", "collapsed")[int(summary["regime"])]
+
+
 def read_summary(run_dir):
     """The one row of RUN/analysis/summary.csv (written by `sanguis analyze`) as floats."""
     with open(os.path.join(run_dir, "analysis", "summary.csv"), newline="") as f:

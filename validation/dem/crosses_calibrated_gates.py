@@ -43,7 +43,7 @@ import sys
 import matplotlib
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import read_summary, wall_time, write_summary  # noqa: E402
+from _outputs import read_summary, regime_name, wall_time, write_summary  # noqa: E402
 from crosses_dam_break import (CROSSES, GATE_INDEX, RESULTS, ROOT, SEED,  # noqa: E402
                                diagnostics, draw_velocity_bands, gate_runner, lajeunesse,
                                pour_gate, velocity_curve)
@@ -64,6 +64,16 @@ COLLAPSE_MAX_S = 3.0
 AT_REST_AFTER_S = 1.5
 # The pours of the report: the case's seed, then one more.
 SEEDS = (SEED, 4)
+
+
+def k_passes(k):
+    """The check on K fixed before the runs: within 35 % of the spheres' 1.2."""
+    return abs(k / SPHERES_K - 1) <= 0.35
+
+
+def describe(gate, seed, several):
+    """A run's name in the report (the seed only when there are several)."""
+    return f"gate {gate} cm" + (f", seed {seed}" if several else "")
 
 
 def seed_settings(seed):
@@ -113,11 +123,12 @@ def collapse(exe, gate, pour, out, opening, threads, tangential=(KT, GAMMA_T), s
 def stopped(run, opening):
     """When a collapse ended, in words (the at-rest test starts AT_REST_AFTER_S after the
     opening, so an end there means at rest by then)."""
-    after = diagnostics(run)[-1]["time_s"] - opening
+    last = diagnostics(run)[-1]
+    after = last["time_s"] - opening
     if after <= AT_REST_AFTER_S + 1e-6:
         return f"was at rest at the first check, {AT_REST_AFTER_S:g} s after the opening"
     if after >= COLLAPSE_MAX_S - 1e-6:
-        speed = diagnostics(run)[-1]["mean_velocity_m_s"]
+        speed = last["mean_velocity_m_s"]
         if speed >= 1e-3:
             return (f"ran the full {COLLAPSE_MAX_S:g} s and was still moving (mean speed "
                     f"{speed:.2g} m/s at the end, so its run-out is a lower bound)")
@@ -131,7 +142,7 @@ def run_row(label, crosses, s, pour, collapse_s):
     return [label, f"{crosses}", f"{100 * s['L0_m']:.1f}", f"{100 * s['H0_m']:.1f}", f"{a:.2f}",
             f"{s['runout_ratio']:.2f}", f"{s['runout_ratio'] / a:.2f}", f"{lajeunesse(a):.2f}",
             f"{s['height_ratio_H0_over_Hinf']:.2f}", f"{s['peak_mean_speed_over_sqrt_gH0']:.3f}",
-            f"{s['peak_time_over_tau_c']:.1f}", ["stable", "fractured", "collapsed"][int(s["regime"])],
+            f"{s['peak_time_over_tau_c']:.1f}", regime_name(s),
             pour, "—" if collapse_s is None else f"{collapse_s / 3600:.2f}"]
 
 
@@ -158,11 +169,11 @@ def run_gate_seed(exe, gate, seed, threads, reuse):
 def seeds_note(gate, seeds, summaries):
     """What the pours of one gate show together (more than one seed)."""
     ks = [s["runout_ratio"] / s["aspect_ratio_H0_over_L0"] for s in summaries]
-    regimes = [["stable", "fractured", "collapsed"][int(s["regime"])] for s in summaries]
+    regimes = [regime_name(s) for s in summaries]
     mean = sum(ks) / len(ks)
     return (f"Gate {gate} cm, kt {KT:g}, γt {GAMMA_T:g}, {len(seeds)} pours (seeds "
             f"{', '.join(str(x) for x in seeds)}): K = {', '.join(f'{k:.2f}' for k in ks)} "
-            f"(mean {mean:.2f}, {'within' if abs(mean / SPHERES_K - 1) <= 0.35 else 'outside'} "
+            f"(mean {mean:.2f}, {'within' if k_passes(mean) else 'outside'} "
             f"1.2 ± 35 %), regimes {', '.join(regimes)}."
             + (" The outcome changes with the packing alone, as in the thesis' intermittent "
                "regime at low aspect ratio (Fig. 3.6) and its staggered collapses (Fig. 3.10); "
@@ -196,22 +207,25 @@ def main():
     checks, rows, notes = [], [], []
     elapsed = 0.0  # the run segments' wall times (a pour reused by a later call counts)
     several = len(args.seeds) > 1
+    # Each run's summary, read once: (calibrated, Table 3.1 or None) per (gate, seed).
+    summaries = {key: (read_summary(out), read_summary(table31) if table31 else None)
+                 for key, (_, out, table31) in runs.items()}
     for (gate, seed), (pour, out, table31) in runs.items():
-        s = read_summary(out)
+        s, t31 = summaries[(gate, seed)]
         a, ratio = s["aspect_ratio_H0_over_L0"], s["runout_ratio"]
         k = ratio / a
         before = diagnostics(pour)[-1]
         opening = before["time_s"]
         pour_s, collapse_s = wall_time(pour), wall_time(out, opening)
-        elapsed += pour_s + collapse_s + (wall_time(table31, opening) if table31 else 0.0)
-        which = f"gate {gate} cm" + (f", seed {seed}" if several else "")
+        table31_s = wall_time(table31, opening) if table31 else 0.0
+        elapsed += pour_s + collapse_s + table31_s
+        which = describe(gate, seed, several)
         checks.append({"quantity": f"K = (L∞−L0)/(L0 a), {which}, a = {a:.2f}, "
                                    f"kt {KT:g}, γt {GAMMA_T:g}",
                        "measured": round(k, 3),
                        "thesis": f"slightly below the spheres' {SPHERES_K} (§3.3, Fig. 3.7)",
-                       "tolerance": "±35 % of 1.2", "pass": abs(k / SPHERES_K - 1) <= 0.35})
+                       "tolerance": "±35 % of 1.2", "pass": k_passes(k)})
         if table31:
-            t31 = read_summary(table31)
             checks.append({"quantity": f"(L∞−L0)/L0, {which}, Table 3.1 (kt 3e2, γt 1e3), "
                                        "the same packing",
                            "measured": round(t31["runout_ratio"], 3),
@@ -233,11 +247,11 @@ def main():
         rows.append(run_row(label, CROSSES[gate], s, f"{pour_s / 3600:.2f}", collapse_s))
         if table31:
             rows.append(run_row(f"{label}, Table 3.1", CROSSES[gate], t31, "(as above)",
-                                wall_time(table31, opening)))
+                                table31_s))
         if s["regime"] != 2:
             what = ("stands" if s["regime"] == 0 else
                     "does not collapse as a whole: its face avalanches (fractured)")
-            verdict = ("K passes" if abs(k / SPHERES_K - 1) <= 0.35 else
+            verdict = ("K passes" if k_passes(k) else
                        "on this packing the calibration of the 4 cm gate does not carry over "
                        "to the lower column")
             more = ("" if several else
@@ -246,20 +260,20 @@ def main():
                     "ratios, so one pour cannot tell a shifted regime boundary from a "
                     "standing draw: several pours (seeds) would.")
             notes.append(
-                f"{which[0].upper() + which[1:]}, kt {KT:g}, γt {GAMMA_T:g}: the column "
+                f"{which.capitalize()}, kt {KT:g}, γt {GAMMA_T:g}: the column "
                 f"(a = {a:.2f}) {what}; H0/H∞ = {s['height_ratio_H0_over_Hinf']:.2f}, the "
                 f"mean speed peaks at {s['peak_mean_speed_over_sqrt_gH0']:.3f} sqrt(g H0) "
                 f"and K = {k:.2f}: {verdict}.{more}")
         end = (f", the one with Table 3.1 {stopped(table31, opening)} "
-               f"({wall_time(table31, opening) / 3600:.2f} h)." if table31 else ".")
-        notes.append(f"{which[0].upper() + which[1:]}: {CROSSES[gate]} crosses poured with "
+               f"({table31_s / 3600:.2f} h)." if table31 else ".")
+        notes.append(f"{which.capitalize()}: {CROSSES[gate]} crosses poured with "
                      f"Table 3.1 and at rest at {opening:g} s ({pour_s / 3600:.2f} h); the "
                      f"collapse with kt {KT:g} N/m, γt {GAMMA_T:g} 1/s {stopped(out, opening)} "
                      f"({collapse_s / 3600:.2f} h){end}")
     if several:
         for gate in args.gates:
             notes.append(seeds_note(gate, args.seeds,
-                                    [read_summary(runs[(gate, x)][1]) for x in args.seeds]))
+                                    [summaries[(gate, x)][0] for x in args.seeds]))
     if reference:
         rows.append(run_row("4 (calibration run)", CROSSES[4], reference, "—", None))
     notes.append("The parameters were fitted on the 4 cm gate only (crosses_recalibrated); "
@@ -277,14 +291,13 @@ def main():
     a1.loglog(a_line, [1.35 * SPHERES_K * x for x in a_line], ":", color="0.5", lw=0.8,
               label="1.2 a ± 35 %")
     for (gate, seed), (_, out, table31) in runs.items():
-        which = f"gate {gate} cm" + (f", seed {seed}" if several else "")
+        which = describe(gate, seed, several)
+        s, t31 = summaries[(gate, seed)]
         if table31:
-            t31 = read_summary(table31)
             a1.plot([t31["aspect_ratio_H0_over_L0"]], [t31["runout_ratio"]], "v",
                     label=f"{which}, Table 3.1, same packing")
             t, v = velocity_curve(table31)
             a2.plot(t, v, ls="--", label=f"{which}, Table 3.1")
-        s = read_summary(out)
         l0, r = s["L0_m"], s["runout_ratio"]
         lo, hi = (s["Linf_20pc_m"] - l0) / l0, (s["Linf_1pc_m"] - l0) / l0
         a1.errorbar([s["aspect_ratio_H0_over_L0"]], [r],

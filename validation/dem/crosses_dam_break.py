@@ -45,7 +45,7 @@ import time
 import matplotlib
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import read_summary, wall_time  # noqa: E402
+from _outputs import read_summary, regime_name, wall_time  # noqa: E402
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -235,7 +235,7 @@ def main():
                      f"{lajeunesse(a):.2f}", f"{s['height_ratio_H0_over_Hinf']:.2f}",
                      f"{s['peak_mean_speed_over_sqrt_gH0']:.3f}", f"{s['peak_time_over_tau_c']:.1f}",
                      f"{s['pair_coordination']:.2f}", f"{s['contact_point_coordination']:.2f}",
-                     ["stable", "fractured", "collapsed"][int(s["regime"])],
+                     regime_name(s),
                      f"{seconds / 3600:.2f}"])
         if a >= 4.0:
             ref = 1.9 * a ** (2.0 / 3.0)

@@ -37,7 +37,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import read_arrays, read_pvd, read_summary  # noqa: E402
+from _outputs import read_arrays, read_pvd, read_summary, regime_name  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 CASE = os.path.join(ROOT, "cases", "dem", "dam-break-crosses-memory.toml")
@@ -132,7 +132,7 @@ def main():
     for name, d in runs.items():
         s = read_summary(d)
         rows.append([name, f"{100 * s['L0_m']:.1f}", f"{100 * s['H0_m']:.1f}", f"{100 * s['Linf_m']:.1f}",
-                     f"{100 * s['Hinf_m']:.1f}", ["stable", "fractured", "collapsed"][int(s["regime"])],
+                     f"{100 * s['Hinf_m']:.1f}", regime_name(s),
                      f"{1e3 * final[name]:.3g}"])
 
     os.makedirs(os.path.dirname(FIGURE), exist_ok=True)

@@ -36,7 +36,7 @@ import time
 import matplotlib
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import read_summary, wall_time, write_summary  # noqa: E402
+from _outputs import read_summary, regime_name, wall_time, write_summary  # noqa: E402
 from crosses_dam_break import (CASE, RESULTS, ROOT, diagnostics,  # noqa: E402
                                draw_velocity_bands, lajeunesse, opening_time, velocity_curve)
 from crosses_tangential_map import tangential_settings  # noqa: E402
@@ -102,7 +102,7 @@ def run_row(label, s, wall_s):
     return [label, f"{100 * s['L0_m']:.1f}", f"{100 * s['H0_m']:.1f}", f"{a:.2f}",
             f"{s['runout_ratio']:.2f}", f"{lajeunesse(a):.2f}",
             f"{s['height_ratio_H0_over_Hinf']:.2f}", f"{s['peak_mean_speed_over_sqrt_gH0']:.3f}",
-            f"{s['peak_time_over_tau_c']:.1f}", ["stable", "fractured", "collapsed"][int(s["regime"])],
+            f"{s['peak_time_over_tau_c']:.1f}", regime_name(s),
             f"{wall_s / 3600:.2f}"]
 
 

@@ -35,7 +35,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import read_arrays, read_pvd, read_summary, write_summary  # noqa: E402
+from _outputs import (read_arrays, read_pvd, read_summary, regime_name,  # noqa: E402
+                      write_summary)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 CASE = os.path.join(ROOT, "cases", "dem", "dam-break-crosses-memory.toml")
@@ -95,7 +96,7 @@ def classify(run):
         region = 2 if top_move > bottom_move else 1
     return {"region": region, "top_move_mm": 1e3 * top_move, "bottom_move_mm": 1e3 * bottom_move,
             "height_loss": height_loss, "runout_ratio": s["runout_ratio"],
-            "regime": ["stable", "fractured", "collapsed"][int(s["regime"])]}
+            "regime": regime_name(s)}
 
 
 def main():

@@ -39,7 +39,7 @@ import matplotlib
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import read_arrays, read_pvd, read_summary  # noqa: E402
+from _outputs import read_arrays, read_pvd, read_summary, regime_name  # noqa: E402
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -187,7 +187,7 @@ def main():
         rows.append([f"{p['gate_m'] * 100:g}", f"{p['L0_m'] * 100:.2f}", f"{p['H0_m'] * 100:.2f}",
                      f"{a:.2f}", f"{p['runout_ratio']:.2f}", f"{ref:.2f}", f"{100 * dev:+.0f} %",
                      f"{p['height_ratio_H0_over_Hinf']:.2f}", f"{p['com_displacement_x_over_L0']:.2f}",
-                     ["stable", "fractured", "collapsed"][int(p["regime"])]])
+                     regime_name(p)])
         checks.append({"quantity": f"(L∞−L0)/L0 at a = {a:.2f}", "measured": round(p["runout_ratio"], 3),
                        "thesis": f"{ref:.2f} (Lajeunesse)", "tolerance": "±35 %",
                        "pass": abs(dev) <= 0.35})
