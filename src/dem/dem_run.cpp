@@ -210,10 +210,13 @@ io::PolyMesh body_mesh(const std::vector<ParticleShape>& shapes, const ParticleS
 }
 
 ParticleStore owned_particles(const DemSimulation& sim) {
-  if (sim.ghost_flags().empty()) return sim.particles();
+  // In id order, whatever the storage order (see DemSetup::storage_sort_interval).
+  const ParticleStore& p = sim.particles();
+  const bool in_order = std::is_sorted(p.id.begin(), p.id.end());
+  if (sim.ghost_flags().empty() && in_order) return p;
   ParticleStore owned;
-  for (std::size_t i = 0; i < sim.particles().size(); ++i) {
-    if (!sim.is_ghost(i)) owned.append_from(sim.particles(), i);
+  for (const std::uint32_t i : id_order(p.id)) {
+    if (!sim.is_ghost(i)) owned.append_from(p, i);
   }
   return owned;
 }

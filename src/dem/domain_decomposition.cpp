@@ -189,8 +189,8 @@ void SlabDecomposition::balance(const ParticleStore& p, const std::vector<std::u
       equal_weight_cuts(histogram, static_cast<std::size_t>(ranks_));
   bounds_.resize(cut.size());
   for (std::size_t k = 0; k < cut.size(); ++k) {
-    bounds_[k] = cut[k] == kBins ? axis_max_
-                                 : axis_min_ + length * static_cast<double>(cut[k]) / kBins;
+    bounds_[k] =
+        cut[k] == kBins ? axis_max_ : axis_min_ + length * static_cast<double>(cut[k]) / kBins;
   }
 }
 

@@ -1,6 +1,8 @@
 #include "dem/particle_store.hpp"
 
+#include <algorithm>
 #include <numbers>
+#include <numeric>
 
 namespace sanguis::dem {
 
@@ -62,6 +64,35 @@ void ParticleStore::append_from(const ParticleStore& o, std::size_t i) {
   force.push_back(o.force[i]);
   torque.push_back(o.torque[i]);
   coordination.push_back(o.coordination[i]);
+}
+
+void ParticleStore::permute(std::span<const std::uint32_t> order) {
+  apply_order(id, order);
+  apply_order(material, order);
+  apply_order(radius, order);
+  apply_order(mass, order);
+  apply_order(inverse_mass, order);
+  apply_order(species, order);
+  apply_order(spherical, order);
+  apply_order(inertia_body, order);
+  apply_order(inverse_inertia_body, order);
+  apply_order(orientation, order);
+  apply_order(position, order);
+  apply_order(velocity, order);
+  apply_order(angular_velocity, order);
+  apply_order(force, order);
+  apply_order(torque, order);
+  apply_order(coordination, order);
+}
+
+std::vector<std::uint32_t> id_order(const std::vector<std::int64_t>& id) {
+  std::vector<std::uint32_t> order(id.size());
+  std::iota(order.begin(), order.end(), 0u);
+  if (!std::is_sorted(id.begin(), id.end())) {
+    std::sort(order.begin(), order.end(),
+              [&](std::uint32_t a, std::uint32_t b) { return id[a] < id[b]; });
+  }
+  return order;
 }
 
 }  // namespace sanguis::dem

@@ -5,6 +5,7 @@
 // principal moments of inertia (body frame = principal axes, origin = centroid).
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "core/quaternion.hpp"
@@ -38,6 +39,10 @@ struct ParticleStore {
   void fix(std::size_t i);
   bool is_fixed(std::size_t i) const { return inverse_mass[i] == 0.0; }
 
+  // Reorders the particles: the new particle k is the old particle order[k] (`order` is a
+  // permutation of 0..size()-1). The storage sort of DemSimulation uses it.
+  void permute(std::span<const std::uint32_t> order);
+
   // Appends particle i of `other`, every field as it is.
   void append_from(const ParticleStore& other, std::size_t i);
 
@@ -53,5 +58,19 @@ struct ParticleStore {
                        const Vec3& inertia, const Quaternion& q, const Vec3& x, const Vec3& v,
                        const Vec3& w);
 };
+
+// values[k] = old values[order[k]] for a per-particle array; an array of another length
+// (an empty history) is left as it is.
+template <typename T>
+void apply_order(std::vector<T>& values, std::span<const std::uint32_t> order) {
+  if (values.size() != order.size()) return;
+  std::vector<T> ordered(values.size());
+  for (std::size_t k = 0; k < order.size(); ++k) ordered[k] = values[order[k]];
+  values.swap(ordered);
+}
+
+// Storage indices in increasing id order: 0, 1, 2, ... when the ids increase with the
+// index (the order particles are created and read in), else sorted by id.
+std::vector<std::uint32_t> id_order(const std::vector<std::int64_t>& id);
 
 }  // namespace sanguis::dem

@@ -84,7 +84,10 @@ void DemSimulation::step() {
   integrator_.advance(p, setup_.gravity, dt);
   ++step_;
   if (exchange_ == nullptr) {
-    if (search_.needs_rebuild(p, setup_.obstacles, time(), threads_)) rebuild_lists();
+    if (search_.needs_rebuild(p, setup_.obstacles, time(), threads_)) {
+      sort_storage_if_due();
+      rebuild_lists();
+    }
     compute_forces();
     integrator_.finish(p, setup_.gravity, dt);
     if (step_ % 64 == 0) check_state();
@@ -493,10 +496,11 @@ void DemSimulation::compute_forces() {
             ++count;
           }
         };
-        const auto add_walls = [&](const std::vector<std::uint32_t>& offset,
+        const auto add_walls = [&](const std::vector<std::uint32_t>& begin,
+                                   const std::vector<std::uint32_t>& end,
                                    const std::vector<ContactOutcome>& outcomes,
                                    const std::vector<std::uint8_t>& touching) {
-          for (std::uint32_t k = offset[i]; k < offset[i + 1]; ++k) {
+          for (std::uint32_t k = begin[i]; k < end[i]; ++k) {
             if (!touching[k]) continue;
             force += outcomes[k].force;
             torque += outcomes[k].torque_first;
@@ -507,8 +511,10 @@ void DemSimulation::compute_forces() {
         if (has_bodies_) {
           add_pairs(body_incident_offset_, body_incident_, body_pair_buffer_, body_pair_touching_);
         }
-        add_walls(wall_offset_, wall_buffer_, wall_touching_);
-        if (has_bodies_) add_walls(body_wall_offset_, body_wall_buffer_, body_wall_touching_);
+        add_walls(wall_begin_, wall_end_, wall_buffer_, wall_touching_);
+        if (has_bodies_) {
+          add_walls(body_wall_begin_, body_wall_end_, body_wall_buffer_, body_wall_touching_);
+        }
         f[i] = force;
         tq[i] = torque;
         coord[i] = count;
@@ -548,6 +554,29 @@ void DemSimulation::rebuild_lists() {
   search_.rebuild(setup_.particles, setup_.obstacles, time(), pairs_, walls_,
                   ghost_.empty() ? nullptr : ghost_.data());
   if (has_bodies_) split_body_contacts();
+  build_incidence();
+}
+
+void DemSimulation::sort_storage_if_due() {
+  const int interval = setup_.storage_sort_interval;
+  if (interval <= 0 || exchange_ != nullptr || search_.rebuild_count() % interval != 0) return;
+  const ParticleStore& p = setup_.particles;
+  const int axis = longest_axis(p.position, setup_.domain.min, setup_.domain.max).axis;
+  permute_storage(search_.space_order(p, axis));
+}
+
+void DemSimulation::permute_storage(std::span<const std::uint32_t> order) {
+  std::vector<std::uint32_t> new_index(order.size());
+  for (std::size_t k = 0; k < order.size(); ++k)
+    new_index[order[k]] = static_cast<std::uint32_t>(k);
+  setup_.particles.permute(order);
+  integrator_.permute(order);
+  search_.permute(order);
+  apply_order(ghost_, order);
+  for (auto* list : {&pairs_.first, &pairs_.second, &walls_.first, &body_pairs_.first,
+                     &body_pairs_.second, &body_walls_.first}) {
+    renumber(*list, new_index);
+  }
   build_incidence();
 }
 
@@ -619,7 +648,7 @@ void DemSimulation::split_body_contacts() {
     }
   }
   pairs_ = std::move(spheres_only);
-  carry_history(body_pairs_, fresh);
+  carry_history(body_pairs_, fresh, p.id.data(), true);
   body_pairs_ = std::move(fresh);
 
   ContactList sphere_walls;
@@ -654,7 +683,7 @@ void DemSimulation::split_body_contacts() {
     }
   }
   walls_ = std::move(sphere_walls);
-  carry_history(body_walls_, fresh_walls);
+  carry_history(body_walls_, fresh_walls, p.id.data(), false);
   body_walls_ = std::move(fresh_walls);
 }
 
@@ -681,12 +710,16 @@ void pair_incidence(const std::vector<std::uint32_t>& first,
   }
 }
 
-// For a list sorted by particle (walls), each particle's range of entries.
+// For a list whose entries of each particle are adjacent (walls, sorted by particle id),
+// each particle's range of entries [begin[i], end[i]).
 void particle_ranges(const std::vector<std::uint32_t>& first, std::size_t n,
-                     std::vector<std::uint32_t>& offset) {
-  offset.assign(n + 1, 0);
-  for (std::uint32_t i : first) ++offset[i + 1];
-  for (std::size_t i = 0; i < n; ++i) offset[i + 1] += offset[i];
+                     std::vector<std::uint32_t>& begin, std::vector<std::uint32_t>& end) {
+  begin.assign(n, 0);
+  end.assign(n, 0);
+  for (std::size_t k = 0; k < first.size(); ++k) {
+    if (k == 0 || first[k] != first[k - 1]) begin[first[k]] = static_cast<std::uint32_t>(k);
+    end[first[k]] = static_cast<std::uint32_t>(k + 1);
+  }
 }
 
 }  // namespace
@@ -696,10 +729,10 @@ void DemSimulation::build_incidence() {
   // What the threaded gather reads (see compute_forces).
   const std::size_t n = setup_.particles.size();
   pair_incidence(pairs_.first, pairs_.second, n, incident_offset_, incident_, incident_fill_);
-  particle_ranges(walls_.first, n, wall_offset_);
+  particle_ranges(walls_.first, n, wall_begin_, wall_end_);
   pair_incidence(body_pairs_.first, body_pairs_.second, n, body_incident_offset_, body_incident_,
                  incident_fill_);
-  particle_ranges(body_walls_.first, n, body_wall_offset_);
+  particle_ranges(body_walls_.first, n, body_wall_begin_, body_wall_end_);
   pair_buffer_.resize(pairs_.size());
   wall_buffer_.resize(walls_.size());
   body_pair_buffer_.resize(body_pairs_.size());
@@ -723,20 +756,8 @@ void DemSimulation::build_blocks() {
   const ParticleStore& p = setup_.particles;
   const std::size_t n = p.size();
   const auto blocks = static_cast<std::size_t>(threads_);
-  // The longest axis of the particles' extent (a column in a long channel is cut
-  // across its height, not along the empty channel).
-  Vec3 low = setup_.domain.max, high = setup_.domain.min;
-  for (const Vec3& x : p.position) {
-    for (int k = 0; k < 3; ++k) {
-      low[k] = std::min(low[k], x[k]);
-      high[k] = std::max(high[k], x[k]);
-    }
-  }
-  int axis = 0;
-  for (int k = 1; k < 3; ++k) {
-    if (high[k] - low[k] > high[axis] - low[axis]) axis = k;
-  }
-  const double lo = low[axis], span = std::max(high[axis] - low[axis], 1e-300);
+  const auto [axis, lo, hi] = longest_axis(p.position, setup_.domain.min, setup_.domain.max);
+  const double span = std::max(hi - lo, 1e-300);
   std::vector<std::uint32_t> bin(n);
   for (std::size_t i = 0; i < n; ++i) {
     bin[i] = static_cast<std::uint32_t>(axis_bin(p.position[i][axis], lo, span, kBins));
@@ -805,7 +826,7 @@ DemDiagnostics DemSimulation::diagnostics() const {
   DemDiagnostics d;
   d.time = time();
   std::size_t owned = 0;
-  for (std::size_t i = 0; i < p.size(); ++i) {
+  for (const std::uint32_t i : id_order(p.id)) {  // sums in id order: any storage order
     if (is_ghost(i) || p.is_fixed(i)) continue;
     ++owned;
     const double v2 = norm2(p.velocity[i]);
@@ -1040,6 +1061,15 @@ void for_each_particle_array(ParticleStore& p, F&& f) {
 }  // namespace
 
 void DemSimulation::save_checkpoint(const std::filesystem::path& file) const {
+  // Written in id order whatever the storage order: the same file for any storage sort
+  // and thread count, and as a decomposed run writes it.
+  const std::vector<std::int64_t>& ids = setup_.particles.id;
+  if (!std::is_sorted(ids.begin(), ids.end())) {
+    DemSimulation in_id_order(*this);
+    in_id_order.permute_storage(id_order(ids));
+    in_id_order.save_checkpoint(file);
+    return;
+  }
   io::write_file_atomically(file, [&](std::ostream& out) {
     out.write(kMagic, sizeof(kMagic));
     put(out, setup_.time_step);

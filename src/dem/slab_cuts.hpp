@@ -3,9 +3,12 @@
 // the bins where each slab starts. Shared by the MPI decomposition (slabs per process,
 // from a histogram summed over the processes) and the threaded force loop (slabs per
 // thread).
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <vector>
+
+#include "core/vec3.hpp"
 
 namespace sanguis::dem {
 
@@ -17,11 +20,33 @@ inline std::size_t axis_bin(double coordinate, double lo, double length, std::si
   return u >= static_cast<double>(bins - 1) ? bins - 1 : static_cast<std::size_t>(u);
 }
 
+// The axis along which the points spread furthest (a column in a long channel is cut
+// across its height, not along the empty channel), with the points' range along it.
+struct LongestAxis {
+  int axis = 0;
+  double low = 0.0, high = 0.0;
+};
+
+inline LongestAxis longest_axis(const std::vector<Vec3>& points, const Vec3& box_min,
+                                const Vec3& box_max) {
+  Vec3 low = box_max, high = box_min;
+  for (const Vec3& x : points) {
+    for (int k = 0; k < 3; ++k) {
+      low[k] = std::min(low[k], x[k]);
+      high[k] = std::max(high[k], x[k]);
+    }
+  }
+  int axis = 0;
+  for (int k = 1; k < 3; ++k) {
+    if (high[k] - low[k] > high[axis] - low[axis]) axis = k;
+  }
+  return {axis, low[axis], high[axis]};
+}
+
 // parts + 1 bin indices: part k holds the bins [cut[k], cut[k + 1]), each part about
 // 1 / parts of the histogram's weight (a part ends after the bin that reaches its share).
 template <typename Count>
-std::vector<std::size_t> equal_weight_cuts(const std::vector<Count>& histogram,
-                                           std::size_t parts) {
+std::vector<std::size_t> equal_weight_cuts(const std::vector<Count>& histogram, std::size_t parts) {
   Count total = 0;
   for (Count c : histogram) total += c;
   std::vector<std::size_t> cut(parts + 1, histogram.size());

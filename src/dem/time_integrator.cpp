@@ -229,13 +229,23 @@ void TimeIntegrator::extend_history(const ParticleStore& p, const Vec3& gravity)
   }
 }
 
+void TimeIntegrator::permute(std::span<const std::uint32_t> order) {
+  for (int k = 0; k < 2; ++k) {
+    apply_order(history_.velocity[k], order);
+    apply_order(history_.acceleration[k], order);
+    apply_order(history_.angular_velocity[k], order);
+    apply_order(history_.angular_acceleration[k], order);
+  }
+  apply_order(half_velocity_, order);
+  apply_order(half_angular_velocity_, order);
+}
+
 void TimeIntegrator::finish(ParticleStore& p, const Vec3& gravity, double dt) {
   if (kind_ != IntegratorKind::kLeapfrog) return;
   const std::size_t n = p.size();
   parallel_for(n, threads_, [&](std::size_t i) {  // final half kick with a_{n+1}
-    p.velocity[i] =
-        half_velocity_[i] +
-        (0.5 * dt) * (p.inverse_mass[i] * p.force[i] + gravity_on(p.inverse_mass[i], gravity));
+    p.velocity[i] = half_velocity_[i] + (0.5 * dt) * (p.inverse_mass[i] * p.force[i] +
+                                                      gravity_on(p.inverse_mass[i], gravity));
     if (p.spherical[i]) {
       p.angular_velocity[i] =
           half_angular_velocity_[i] + (0.5 * dt * p.inverse_inertia_body[i].x) * p.torque[i];

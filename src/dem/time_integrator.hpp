@@ -21,6 +21,7 @@
 // Forces at x_{n+1} see the predicted velocity v_n + dt a_n, not v_{n+1/2}: with
 // damping forces the half-step velocity would make the scheme first order.
 #include <array>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -54,6 +55,8 @@ class TimeIntegrator {
   // Particles were appended (pouring): their multistep history is that of free flight
   // (past velocity = current, past acceleration = gravity), the others keep theirs.
   void extend_history(const ParticleStore& p, const Vec3& gravity);
+  // The particles were reordered (ParticleStore::permute with the same `order`).
+  void permute(std::span<const std::uint32_t> order);
 
   MultistepHistory& history() { return history_; }
   const MultistepHistory& history() const { return history_; }

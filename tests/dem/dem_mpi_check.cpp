@@ -31,12 +31,16 @@ namespace {
 
 double largest_difference(const DemSimulation& mine, const ParticleStore& alone) {
   const ParticleStore& p = mine.particles();
+  // The single process sorts its storage along space: find its particles by id.
+  const std::vector<std::uint32_t> by_id = id_order(alone.id);
   double worst = 0.0;
   for (std::size_t i = 0; i < p.size(); ++i) {
     if (mine.is_ghost(i)) continue;
-    const auto it = std::lower_bound(alone.id.begin(), alone.id.end(), p.id[i]);
-    if (it == alone.id.end() || *it != p.id[i]) return INFINITY;
-    const auto j = static_cast<std::size_t>(it - alone.id.begin());
+    const auto it =
+        std::lower_bound(by_id.begin(), by_id.end(), p.id[i],
+                         [&](std::uint32_t k, std::int64_t id) { return alone.id[k] < id; });
+    if (it == by_id.end() || alone.id[*it] != p.id[i]) return INFINITY;
+    const std::size_t j = *it;
     worst = std::max({worst, norm(p.position[i] - alone.position[j]),
                       norm(p.velocity[i] - alone.velocity[j]),
                       norm(p.angular_velocity[i] - alone.angular_velocity[j])});
