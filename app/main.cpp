@@ -253,6 +253,13 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   bench_cmd->add_flag("--general-kernels", bo.general_kernels,
                       "flow-cavity: multigrid kernels that read constant coefficients too (A/B)");
+  bench_cmd->add_flag("--scatter", bo.scatter,
+                      "dem-spheres: fill the lattice in random order (ids scattered in space)");
+  bench_cmd
+      ->add_option("--storage-sort", bo.storage_sort_interval,
+                   "dem: re-sort particles along space every N list rebuilds (0: never; "
+                   "default: the solver's)")
+      ->check(CLI::Range(0, 1000000));
   std::string bench_case;
   bench_cmd->add_option("--case", bench_case,
                         "flow-adaptive: flow case file (default cases/flow/obstacle-wake.toml)");

@@ -23,6 +23,11 @@ struct BenchOptions {
   // flow-cavity: multigrid kernels that read the coefficient arrays even where they
   // are constant (MultigridOptions::uniform_coefficient_kernels = false), for A/B runs.
   bool general_kernels = false;
+  // dem-spheres: lattice sites filled in random order, so that ids (and the storage
+  // until it is sorted) are scattered in space, as a random fill leaves them.
+  bool scatter = false;
+  // dem-spheres, dem-crosses: DemSetup::storage_sort_interval; -1: its default.
+  int storage_sort_interval = -1;
   // dem-spheres under mpirun: the processes share the system (domain decomposition).
   MPI_Comm comm = MPI_COMM_NULL;
 };

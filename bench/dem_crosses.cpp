@@ -43,6 +43,7 @@ dem::DemSetup dem_crosses_setup(const BenchOptions& o) {
   s.gravity = {0.0, 0.0, -9.81};
   s.time_step = 2.5e-6;  // Table 3.1
   s.threads = o.threads;
+  if (o.storage_sort_interval >= 0) s.storage_sort_interval = o.storage_sort_interval;
   s.material_names = {"plastic", "acrylic"};
   // Table 3.1: kn 4.5e5 N/m, en 0.85, kt 3e2 N/m, gamma_t 1e3 1/s, mu 0.46 / 0.62.
   const auto table31 = [&](double reduced_mass, double friction) {

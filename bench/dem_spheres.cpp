@@ -4,8 +4,10 @@
 #include <cmath>
 #include <memory>
 #include <numbers>
+#include <numeric>
 #include <random>
 #include <sstream>
+#include <vector>
 #include <stdexcept>
 
 #include "benchmarks.hpp"
@@ -66,9 +68,14 @@ dem::DemSetup dem_spheres_setup(const BenchOptions& o) {
   std::mt19937_64 rng(o.seed);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   const double vmax = 0.1 / std::sqrt(3.0);
+  std::vector<std::int64_t> site(static_cast<std::size_t>(o.particles));
+  std::iota(site.begin(), site.end(), 0);
+  if (o.scatter) std::shuffle(site.begin(), site.end(), std::mt19937_64(o.seed + 1));
+  if (o.storage_sort_interval >= 0) s.storage_sort_interval = o.storage_sort_interval;
   for (std::int64_t n = 0; n < o.particles; ++n) {
-    const auto i = static_cast<double>(n % 20), j = static_cast<double>((n / 20) % 20),
-               k = static_cast<double>(n / per_layer);
+    const std::int64_t m = site[static_cast<std::size_t>(n)];
+    const auto i = static_cast<double>(m % 20), j = static_cast<double>((m / 20) % 20),
+               k = static_cast<double>(m / per_layer);
     const Vec3 x{(1 + 2 * i) * 1e-3, (1 + 2 * j) * 1e-3, (1 + 2 * k) * 1e-3};
     const Vec3 v{vmax * unit(rng), vmax * unit(rng), vmax * unit(rng)};
     s.particles.add_sphere(n, 0, radius, density, x, v, {});
@@ -107,7 +114,9 @@ std::string run_dem_spheres(const BenchOptions& o) {
        << ",\"steps\":" << o.steps << ",\"threads\":" << o.threads << ",\"processes\":" << ranks
        << ",\"seconds\":" << seconds << ",\"particle_steps_per_s\":"
        << static_cast<double>(o.particles) * static_cast<double>(o.steps) / seconds
-       << ",\"neighbor_rebuilds\":" << sim.neighbor_search().rebuild_count() - rebuilds_before;
+       << ",\"neighbor_rebuilds\":" << sim.neighbor_search().rebuild_count() - rebuilds_before
+       << ",\"scattered\":" << (o.scatter ? "true" : "false")
+       << ",\"storage_sort_interval\":" << sim.setup().storage_sort_interval;
   if (decomposition) {
     // Per process per step: the largest over the processes (the slowest sets the pace).
     double figures[3] = {

@@ -68,6 +68,7 @@ DemSimulation::DemSimulation(DemSetup setup)
       throw std::invalid_argument("a non-spherical particle has no shape in the species table");
     }
   }
+  sort_storage_if_due();  // a random fill leaves ids, and so storage, scattered in space
   rebuild_lists();
   compute_forces();
 }
