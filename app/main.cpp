@@ -257,9 +257,9 @@ int main(int argc, char** argv) {
                       "dem-spheres: fill the lattice in random order (ids scattered in space)");
   bench_cmd
       ->add_option("--storage-sort", bo.storage_sort_interval,
-                   "dem: re-sort particles along space every N list rebuilds (0: never; "
-                   "default: the solver's)")
-      ->check(CLI::Range(0, 1000000));
+                   "dem: re-sort particles along space every N steps (0: never; default: "
+                   "the solver's, 1000)")
+      ->check(CLI::Range(std::int64_t{0}, std::int64_t{1} << 40));
   std::string bench_case;
   bench_cmd->add_option("--case", bench_case,
                         "flow-adaptive: flow case file (default cases/flow/obstacle-wake.toml)");

@@ -27,7 +27,7 @@ struct BenchOptions {
   // until it is sorted) are scattered in space, as a random fill leaves them.
   bool scatter = false;
   // dem-spheres, dem-crosses: DemSetup::storage_sort_interval; -1: its default.
-  int storage_sort_interval = -1;
+  std::int64_t storage_sort_interval = -1;
   // dem-spheres under mpirun: the processes share the system (domain decomposition).
   MPI_Comm comm = MPI_COMM_NULL;
 };

@@ -130,7 +130,8 @@ std::string run_dem_crosses(const BenchOptions& o) {
        << ",\"element_pair_candidates\":" << candidates
        << ",\"element_contacts\":" << d.particle_contacts
        << ",\"wall_contacts\":" << d.wall_contacts
-       << ",\"max_overlap_over_radius\":" << d.max_overlap_ratio;
+       << ",\"max_overlap_over_radius\":" << d.max_overlap_ratio
+       << ",\"storage_sort_interval\":" << sim.setup().storage_sort_interval;
   if (decomposition) json << ",\"exchange_fraction\":" << exchange / seconds;
   json << ",\"peak_rss_mb\":" << static_cast<double>(peak_resident_bytes()) / 1048576.0
        << ",\"bytes_per_particle\":"

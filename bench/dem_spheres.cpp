@@ -7,8 +7,8 @@
 #include <numeric>
 #include <random>
 #include <sstream>
-#include <vector>
 #include <stdexcept>
+#include <vector>
 
 #include "benchmarks.hpp"
 #include "dem/domain_decomposition.hpp"

@@ -1,14 +1,11 @@
 #pragma once
-// Candidate contacts found by the broad phase (within cut-off + skin), each with the
-// memory of its contact (ContactHistory). A list holds local particle indices but is
-// sorted by the particles' ids, (id of first, id of second), and a pair's first particle
-// is the one with the smaller id: the order in which each particle sums its contacts,
-// and so every result, does not depend on where the particles are stored (the storage
-// is re-sorted along space, see DemSimulation). When the list is rebuilt the histories
-// of pairs that are still candidates are carried over, so a rebuild never erases
-// memory (see NeighborSearch::rebuild).
+// Candidate contacts found by the broad phase (within cut-off + skin), sorted by
+// (first, second) local index (first < second for pairs), each with the memory of its
+// contact (ContactHistory). When the list is rebuilt the histories of pairs that are
+// still candidates are carried over, so a rebuild never erases memory (see
+// NeighborSearch::rebuild). Local indices follow the storage order, which is the
+// particles' (sort key, id) order (ParticleStore::sort_key).
 #include <cstdint>
-#include <span>
 #include <tuple>
 #include <utility>
 #include <vector>
@@ -36,41 +33,23 @@ struct ContactList {
   }
 };
 
-// The sort key of contact k of a list: (id of first, id of second) for particle pairs,
-// (id of first, obstacle index) for particle-obstacle pairs (`pair_list` false).
-inline std::pair<std::int64_t, std::int64_t> contact_key(const std::vector<std::uint32_t>& first,
-                                                         const std::vector<std::uint32_t>& second,
-                                                         std::size_t k, const std::int64_t* id,
-                                                         bool pair_list) {
-  return {id[first[k]], pair_list ? id[second[k]] : std::int64_t{second[k]}};
-}
-
-// Copies the histories of `previous` into `fresh` for the keys present in both. Both
-// lists must be sorted by contact_key, and their indices refer to the same storage.
-inline void carry_history(const ContactList& previous, ContactList& fresh, const std::int64_t* id,
-                          bool pair_list) {
+// Copies the histories of `previous` into `fresh` for the keys present in both.
+// Both lists must be sorted by (first, second).
+inline void carry_history(const ContactList& previous, ContactList& fresh) {
   std::size_t p = 0;
   const std::size_t np = previous.size();
-  const auto old_key = [&](std::size_t q) {
-    return contact_key(previous.first, previous.second, q, id, pair_list);
-  };
   for (std::size_t k = 0; k < fresh.size() && p < np; ++k) {
-    const auto key = contact_key(fresh.first, fresh.second, k, id, pair_list);
-    while (p < np && old_key(p) < key) ++p;
-    if (p < np && old_key(p) == key) fresh.history[k] = previous.history[p];
+    const std::uint64_t key = (std::uint64_t{fresh.first[k]} << 32) | fresh.second[k];
+    while (p < np && ((std::uint64_t{previous.first[p]} << 32) | previous.second[p]) < key) ++p;
+    if (p < np && ((std::uint64_t{previous.first[p]} << 32) | previous.second[p]) == key) {
+      fresh.history[k] = previous.history[p];
+    }
   }
-}
-
-// The storage was reordered (ParticleStore::permute): particle i is now new_index[i].
-// The entries keep their order, which is by id.
-inline void renumber(std::vector<std::uint32_t>& particle_index,
-                     std::span<const std::uint32_t> new_index) {
-  for (std::uint32_t& i : particle_index) i = new_index[i];
 }
 
 // Candidate contacts involving non-spherical bodies, one entry per pair of convex
 // elements (two crosses touch at up to four points, each with its own memory),
-// sorted by (contact_key, element_first, element_second). For obstacle contacts
+// sorted by (first, second, element_first, element_second). For obstacle contacts
 // `second` is the obstacle index and `element_second` is 0.
 struct BodyContactList {
   std::vector<std::uint32_t> first, second;
@@ -95,22 +74,20 @@ struct BodyContactList {
     history.push_back({});
     warm.push_back({});
   }
-  // Sort key (contact_key, element_first, element_second), compared lexicographically.
-  std::tuple<std::int64_t, std::int64_t, std::uint32_t> key(std::size_t k, const std::int64_t* id,
-                                                            bool pair_list) const {
-    const auto [a, b] = contact_key(first, second, k, id, pair_list);
-    return {a, b, (std::uint32_t{element_first[k]} << 16) | element_second[k]};
+  // Sort key (first, second, element_first, element_second), compared lexicographically.
+  std::pair<std::uint64_t, std::uint32_t> key(std::size_t k) const {
+    return {(std::uint64_t{first[k]} << 32) | second[k],
+            (std::uint32_t{element_first[k]} << 16) | element_second[k]};
   }
 };
 
-inline void carry_history(const BodyContactList& previous, BodyContactList& fresh,
-                          const std::int64_t* id, bool pair_list) {
+inline void carry_history(const BodyContactList& previous, BodyContactList& fresh) {
   std::size_t p = 0;
   const std::size_t np = previous.size();
   for (std::size_t k = 0; k < fresh.size() && p < np; ++k) {
-    const auto key = fresh.key(k, id, pair_list);
-    while (p < np && previous.key(p, id, pair_list) < key) ++p;
-    if (p < np && previous.key(p, id, pair_list) == key) {
+    const auto key = fresh.key(k);
+    while (p < np && previous.key(p) < key) ++p;
+    if (p < np && previous.key(p) == key) {
       fresh.history[k] = previous.history[p];
       fresh.warm[k] = previous.warm[p];
     }
@@ -118,18 +95,43 @@ inline void carry_history(const BodyContactList& previous, BodyContactList& fres
 }
 
 // One contact and its memory keyed by particle ids instead of local indices, so that
-// it survives a renumbering of the particles (domain decomposition: particles move
-// between processes with the memories of their contacts).
+// it survives a renumbering of the particles: particles moving between processes
+// (domain decomposition) or re-sorted along space (DemSimulation). A pair's first
+// particle is the one stored first when the memory was taken; key() names the pair
+// whichever its order, and as_oriented() turns the memory round when the new storage
+// order puts the other particle first.
 struct ContactMemory {
   enum Kind : std::uint8_t { kSpherePair = 0, kSphereWall = 1, kBodyPair = 2, kBodyWall = 3 };
   std::uint8_t kind = kSpherePair;
   std::uint16_t element_first = 0, element_second = 0;
-  std::int64_t first_id = 0;   // particle id (the smaller one for pairs)
+  std::int64_t first_id = 0;   // particle id (the pair's first particle)
   std::int64_t second_id = 0;  // particle id, or obstacle index for walls
   ContactHistory history;
   geometry::GjkWarmStart warm;  // body contacts only
 
-  auto key() const { return std::tuple{kind, first_id, second_id, element_first, element_second}; }
+  bool is_pair() const { return kind == kSpherePair || kind == kBodyPair; }
+  // (kind, smaller id, larger id, element of the smaller, element of the larger) for
+  // pairs; (kind, particle id, obstacle, elements) for walls.
+  auto key() const {
+    if (is_pair() && second_id < first_id) {
+      return std::tuple{kind, second_id, first_id, element_second, element_first};
+    }
+    return std::tuple{kind, first_id, second_id, element_first, element_second};
+  }
+  // This memory as seen from a pair stored with `first` first. Turning a pair round
+  // negates what it stores relative to its first particle (eq. 2.8-2.10: the tangential
+  // spring, the rolling spring torque, the normal), exactly; the GJK simplex starts cold.
+  ContactMemory as_oriented(std::int64_t first) const {
+    if (!is_pair() || first == first_id) return *this;
+    ContactMemory m = *this;
+    std::swap(m.first_id, m.second_id);
+    std::swap(m.element_first, m.element_second);
+    m.history.tangential_displacement = -history.tangential_displacement;
+    m.history.rolling_spring_torque = -history.rolling_spring_torque;
+    m.history.normal = -history.normal;
+    m.warm = {};
+    return m;
+  }
 };
 
 }  // namespace sanguis::dem

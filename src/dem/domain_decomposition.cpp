@@ -14,6 +14,7 @@ namespace sanguis::dem {
 
 struct SlabDecomposition::ParticleRecord {
   std::int64_t id;
+  std::uint64_t sort_key;  // ParticleStore::sort_key
   std::int32_t material, species;
   std::uint8_t spherical;
   double radius, mass, inverse_mass;
@@ -30,27 +31,20 @@ static_assert(std::is_trivially_copyable_v<ContactMemory>);
 
 SlabDecomposition::ParticleRecord record_of(const ParticleStore& p, std::size_t i,
                                             const Vec3& half_velocity, const Vec3& half_angular) {
-  return {p.id[i],
-          p.material[i],
-          p.species[i],
-          p.spherical[i],
-          p.radius[i],
-          p.mass[i],
-          p.inverse_mass[i],
-          p.inertia_body[i],
-          p.inverse_inertia_body[i],
-          p.orientation[i],
-          p.position[i],
-          p.velocity[i],
-          p.angular_velocity[i],
-          half_velocity,
-          half_angular,
-          p.force[i],
-          p.torque[i]};
+  return {p.id[i],           p.sort_key[i],
+          p.material[i],     p.species[i],
+          p.spherical[i],    p.radius[i],
+          p.mass[i],         p.inverse_mass[i],
+          p.inertia_body[i], p.inverse_inertia_body[i],
+          p.orientation[i],  p.position[i],
+          p.velocity[i],     p.angular_velocity[i],
+          half_velocity,     half_angular,
+          p.force[i],        p.torque[i]};
 }
 
 void append_record(ParticleStore& store, const SlabDecomposition::ParticleRecord& r) {
   store.id.push_back(r.id);
+  store.sort_key.push_back(r.sort_key);
   store.material.push_back(r.material);
   store.radius.push_back(r.radius);
   store.mass.push_back(r.mass);
@@ -138,12 +132,28 @@ class ScopedTimer {
   std::chrono::steady_clock::time_point start_;
 };
 
-std::size_t index_of_id(const std::vector<std::int64_t>& ids, std::int64_t id) {
-  const auto it = std::lower_bound(ids.begin(), ids.end(), id);
-  if (it == ids.end() || *it != id) {
-    throw std::logic_error("domain decomposition: particle id not found");
+// Local index by particle id (the storage is in (sort key, id) order, not id order).
+class IdIndex {
+ public:
+  explicit IdIndex(const std::vector<std::int64_t>& ids) : order_(id_order(ids)), ids_(ids) {}
+  std::size_t operator()(std::int64_t id) const {
+    const auto it = std::lower_bound(order_.begin(), order_.end(), id,
+                                     [&](std::uint32_t k, std::int64_t v) { return ids_[k] < v; });
+    if (it == order_.end() || ids_[*it] != id) {
+      throw std::logic_error("domain decomposition: particle id not found");
+    }
+    return *it;
   }
-  return static_cast<std::size_t>(it - ids.begin());
+
+ private:
+  std::vector<std::uint32_t> order_;
+  const std::vector<std::int64_t>& ids_;
+};
+
+// Storage order: (sort key, id), as one process sorts (DemSimulation::rebuild_sorted).
+bool stored_before(const SlabDecomposition::ParticleRecord& a,
+                   const SlabDecomposition::ParticleRecord& b) {
+  return a.sort_key != b.sort_key ? a.sort_key < b.sort_key : a.id < b.id;
 }
 
 }  // namespace
@@ -324,11 +334,12 @@ void SlabDecomposition::redistribute(DemSimulation& simulation) {
   }
   // Contact memories to the new owners of both particles (walls: of the particle).
   std::vector<std::vector<ContactMemory>> contact_buckets(static_cast<std::size_t>(ranks_));
+  const IdIndex index_of_id(p.id);
   for (const ContactMemory& r : simulation.export_contacts()) {
-    const int a = owner_of(p.position[index_of_id(p.id, r.first_id)][axis_]);
+    const int a = owner_of(p.position[index_of_id(r.first_id)][axis_]);
     contact_buckets[static_cast<std::size_t>(a)].push_back(r);
-    if (r.kind == ContactMemory::kSpherePair || r.kind == ContactMemory::kBodyPair) {
-      const int b = owner_of(p.position[index_of_id(p.id, r.second_id)][axis_]);
+    if (r.is_pair()) {
+      const int b = owner_of(p.position[index_of_id(r.second_id)][axis_]);
       if (b != a) contact_buckets[static_cast<std::size_t>(b)].push_back(r);
     }
   }
@@ -343,13 +354,12 @@ void SlabDecomposition::redistribute(DemSimulation& simulation) {
   exchange_ghosts(simulation, std::move(owned), std::move(contacts));
 }
 
-// Sends copies of the owned particles near other slabs, merges owned and ghosts in id
-// order and hands everything to the simulation.
+// Sends copies of the owned particles near other slabs, merges owned and ghosts in
+// (sort key, id) order and hands everything to the simulation.
 void SlabDecomposition::exchange_ghosts(DemSimulation& simulation,
                                         std::vector<ParticleRecord> owned,
                                         std::vector<ContactMemory> contacts) {
-  const auto by_id = [](const ParticleRecord& a, const ParticleRecord& b) { return a.id < b.id; };
-  std::sort(owned.begin(), owned.end(), by_id);
+  std::sort(owned.begin(), owned.end(), stored_before);
   std::vector<std::vector<ParticleRecord>> buckets(static_cast<std::size_t>(ranks_));
   for (auto& list : send_lists_) list.clear();
   std::vector<std::vector<std::int64_t>> sent_ids(static_cast<std::size_t>(ranks_));
@@ -371,7 +381,7 @@ void SlabDecomposition::exchange_ghosts(DemSimulation& simulation,
   std::vector<std::size_t> order(all.size());
   std::iota(order.begin(), order.end(), 0);
   std::sort(order.begin(), order.end(),
-            [&](std::size_t a, std::size_t b) { return all[a].id < all[b].id; });
+            [&](std::size_t a, std::size_t b) { return stored_before(all[a], all[b]); });
 
   ParticleStore store;
   std::vector<std::uint8_t> ghost;
@@ -384,16 +394,17 @@ void SlabDecomposition::exchange_ghosts(DemSimulation& simulation,
     half_w.push_back(r.half_angular);
   }
   // Local indices of what goes out and comes in at each ghost refresh.
+  const IdIndex index_of_id(store.id);
   for (std::size_t d = 0; d < sent_ids.size(); ++d) {
     for (std::int64_t id : sent_ids[d]) {
-      send_lists_[d].push_back(static_cast<std::uint32_t>(index_of_id(store.id, id)));
+      send_lists_[d].push_back(static_cast<std::uint32_t>(index_of_id(id)));
     }
   }
   ghost_count_ = 0;
   for (std::size_t s = 0; s < received.size(); ++s) {
     receive_lists_[s].clear();
     for (const ParticleRecord& r : received[s]) {
-      receive_lists_[s].push_back(static_cast<std::uint32_t>(index_of_id(store.id, r.id)));
+      receive_lists_[s].push_back(static_cast<std::uint32_t>(index_of_id(r.id)));
     }
     ghost_count_ += static_cast<std::int64_t>(received[s].size());
   }
@@ -447,8 +458,7 @@ std::vector<SlabDecomposition::ParticleRecord> SlabDecomposition::gather_records
   for (auto& from : all_to_all(comm_, buckets, ignored)) {
     all.insert(all.end(), from.begin(), from.end());
   }
-  std::sort(all.begin(), all.end(),
-            [](const ParticleRecord& a, const ParticleRecord& b) { return a.id < b.id; });
+  std::sort(all.begin(), all.end(), stored_before);
   return all;
 }
 
@@ -472,9 +482,9 @@ void SlabDecomposition::save_checkpoint(const DemSimulation& simulation, DemSimu
   // Memories: each process sends those of the contacts whose first particle it owns (a
   // pair across a boundary is held by both, identically).
   std::vector<std::vector<ContactMemory>> buckets(static_cast<std::size_t>(ranks_));
-  const std::vector<std::int64_t>& id = simulation.particles().id;
+  const IdIndex index_of_id(simulation.particles().id);
   for (const ContactMemory& m : simulation.export_contacts()) {
-    if (!simulation.is_ghost(index_of_id(id, m.first_id))) buckets[0].push_back(m);
+    if (!simulation.is_ghost(index_of_id(m.first_id))) buckets[0].push_back(m);
   }
   std::int64_t ignored = 0;
   std::vector<ContactMemory> memories;

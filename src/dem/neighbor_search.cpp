@@ -80,68 +80,46 @@ bool NeighborSearch::has_bodies(const ParticleStore& particles) {
   return false;
 }
 
-std::array<std::int64_t, 3> NeighborSearch::cell_coordinates(const Vec3& x) const {
-  std::array<std::int64_t, 3> index{};
+std::int64_t NeighborSearch::cell_of(const Vec3& x) const {
+  std::int64_t index[3];
   for (int k = 0; k < 3; ++k) {
     const auto ku = static_cast<std::size_t>(k);
     double c = std::floor((x[k] - domain_.min[k]) / cell_size_[k]);
     // Outside a closed domain: clamp into the boundary cell (safe, see README).
     c = std::clamp(c, 0.0, static_cast<double>(cells_[ku] - 1));
-    index[ku] = static_cast<std::int64_t>(c);
+    index[k] = static_cast<std::int64_t>(c);
   }
-  return index;
-}
-
-std::int64_t NeighborSearch::cell_of(const Vec3& x) const {
-  const std::array<std::int64_t, 3> index = cell_coordinates(x);
   return (index[2] * cells_[1] + index[1]) * cells_[0] + index[0];
 }
 
 namespace {
 
-// Interleaves the bits of two cell coordinates (< 2^16 each): the Z-order curve.
-std::uint64_t morton2(std::uint64_t a, std::uint64_t b) {
-  std::uint64_t key = 0;
-  for (int bit = 0; bit < 16; ++bit) {
-    key |= ((a >> bit) & 1u) << (2 * bit);
-    key |= ((b >> bit) & 1u) << (2 * bit + 1);
-  }
-  return key;
+// Spreads the low 21 bits of v three apart (bit b goes to bit 3b).
+std::uint64_t spread_bits(std::uint64_t v) {
+  std::uint64_t out = 0;
+  for (int bit = 0; bit < 21; ++bit) out |= ((v >> bit) & 1u) << (3 * bit);
+  return out;
 }
 
 }  // namespace
 
-std::vector<std::uint32_t> NeighborSearch::space_order(const ParticleStore& particles,
-                                                       int axis) const {
-  struct Entry {
-    std::uint64_t cell;
-    std::int64_t id;
-    std::uint32_t index;
-  };
-  const std::size_t n = particles.size();
-  const auto along = static_cast<std::size_t>(axis);
-  const std::size_t u = (along + 1) % 3, v = (along + 2) % 3;
-  std::vector<Entry> entries(n);
-  for (std::size_t i = 0; i < n; ++i) {
+std::vector<std::uint64_t> NeighborSearch::space_keys(const ParticleStore& particles) const {
+  std::vector<std::uint64_t> keys(particles.size());
+  for (std::size_t i = 0; i < particles.size(); ++i) {
     Vec3 x = particles.position[i];
-    domain_.wrap(x);
-    const std::array<std::int64_t, 3> c = cell_coordinates(x);
-    const auto layer = static_cast<std::uint64_t>(c[along]);
-    entries[i] = {
-        (layer << 32) | morton2(static_cast<std::uint64_t>(c[u]), static_cast<std::uint64_t>(c[v])),
-        particles.id[i], static_cast<std::uint32_t>(i)};
+    domain_.wrap(x);  // as the list build will
+    double c[3];
+    for (int k = 0; k < 3; ++k) {
+      const auto ku = static_cast<std::size_t>(k);
+      c[k] = std::clamp(std::floor((x[k] - domain_.min[k]) / cell_size_[k]), 0.0,
+                        static_cast<double>(cells_[ku] - 1));
+      if (!(c[k] >= 0.0)) c[k] = 0.0;  // a non-finite position (the run stops at the check)
+    }
+    keys[i] = spread_bits(static_cast<std::uint64_t>(c[0])) |
+              (spread_bits(static_cast<std::uint64_t>(c[1])) << 1) |
+              (spread_bits(static_cast<std::uint64_t>(c[2])) << 2);
   }
-  std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
-    return a.cell != b.cell ? a.cell < b.cell : a.id < b.id;
-  });
-  std::vector<std::uint32_t> order(n);
-  for (std::size_t k = 0; k < n; ++k) order[k] = entries[k].index;
-  return order;
-}
-
-void NeighborSearch::permute(std::span<const std::uint32_t> order) {
-  apply_order(reference_, order);
-  apply_order(reference_orientation_, order);
+  return keys;
 }
 
 void NeighborSearch::bin(const ParticleStore& particles) {
@@ -163,19 +141,16 @@ void NeighborSearch::bin(const ParticleStore& particles) {
 void NeighborSearch::rebuild(ParticleStore& particles, const std::vector<Obstacle>& obstacles,
                              double time, ContactList& pairs, ContactList& walls,
                              const std::uint8_t* ghost) {
+  const std::size_t n = particles.size();
   for (auto& x : particles.position) domain_.wrap(x);
   bin(particles);
 
-  // Particle pairs: each particle, in id order, looks at the 27 surrounding cells and
-  // keeps the particles of larger id, so each pair appears once, and the list comes out
-  // sorted by (id, id) (contact_list.hpp).
-  const std::int64_t* id = particles.id.data();
-  visit_ = id_order(particles.id);
+  // Particle pairs: each particle looks at the 27 surrounding cells and keeps j > i,
+  // so each pair appears once, and the list comes out sorted by (i, j).
   scratch_.clear();
-  for (const std::uint32_t i : visit_) {
+  for (std::size_t i = 0; i < n; ++i) {
     const Vec3 xi = particles.position[i];
     const double ri = particles.radius[i];
-    const std::int64_t id_i = id[i];
     const bool fixed_i = particles.is_fixed(i);  // two glued particles never interact
     std::int64_t ci[3];
     for (int k = 0; k < 3; ++k) {
@@ -206,7 +181,7 @@ void NeighborSearch::rebuild(ParticleStore& particles, const std::vector<Obstacl
           const auto c = static_cast<std::size_t>((cz * cells_[1] + cy) * cells_[0] + cx);
           for (std::uint32_t m = cell_start_[c]; m < cell_start_[c + 1]; ++m) {
             const std::uint32_t j = cell_members_[m];
-            if (id[j] <= id_i || (ghost != nullptr && ghost[i] && ghost[j])) continue;
+            if (j <= i || (ghost != nullptr && ghost[i] && ghost[j])) continue;
             if (fixed_i && particles.is_fixed(j)) continue;
             const double cut = ri + particles.radius[j] + skin_;
             const Vec3 d = domain_.minimum_image(particles.position[j] - xi);
@@ -215,25 +190,26 @@ void NeighborSearch::rebuild(ParticleStore& particles, const std::vector<Obstacl
         }
       }
     }
-    std::sort(candidates_.begin(), candidates_.end(),
-              [id](std::uint32_t a, std::uint32_t b) { return id[a] < id[b]; });
-    for (std::uint32_t j : candidates_) scratch_.push(i, j, {});
+    std::sort(candidates_.begin(), candidates_.end());
+    for (std::uint32_t j : candidates_) scratch_.push(static_cast<std::uint32_t>(i), j, {});
   }
-  carry_history(pairs, scratch_, id, true);
+  carry_history(pairs, scratch_);
   std::swap(pairs, scratch_);
 
-  // Particle-obstacle pairs, sorted by (particle id, obstacle).
+  // Particle-obstacle pairs, sorted by (particle, obstacle).
   scratch_.clear();
-  for (const std::uint32_t i : visit_) {
+  for (std::size_t i = 0; i < n; ++i) {
     if ((ghost != nullptr && ghost[i]) || particles.is_fixed(i)) continue;  // glued: no force
     for (std::size_t o = 0; o < obstacles.size(); ++o) {
       if (!obstacles[o].active(time)) continue;
       const SphereObstacleGap gap =
           sphere_gap(obstacles[o], time, particles.position[i], particles.radius[i]);
-      if (gap.overlap > -skin_) scratch_.push(i, static_cast<std::uint32_t>(o), {});
+      if (gap.overlap > -skin_) {
+        scratch_.push(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(o), {});
+      }
     }
   }
-  carry_history(walls, scratch_, id, false);
+  carry_history(walls, scratch_);
   std::swap(walls, scratch_);
 
   reference_ = particles.position;

@@ -3,9 +3,7 @@
 // cut-off (largest diameter + skin) wide, building Verlet lists of particle pairs
 // and particle-obstacle pairs within cut-off + skin. Lists are rebuilt only when
 // some particle has moved more than half the skin since the last build.
-#include <array>
 #include <cstdint>
-#include <span>
 #include <vector>
 
 #include "dem/contact_list.hpp"
@@ -28,19 +26,16 @@ class NeighborSearch {
   bool needs_rebuild(const ParticleStore& particles, const std::vector<Obstacle>& obstacles,
                      double time, int threads = 1) const;
 
-  // Wraps periodic positions, bins particles and rebuilds both lists in id order
-  // (contact_list.hpp), carrying the contact histories over. Obstacles inactive at `time`
-  // get no entries. With `ghost` (one flag per particle), pairs of two ghosts and
-  // ghost-obstacle pairs are left out.
+  // Wraps periodic positions, bins particles and rebuilds both lists, carrying the
+  // contact histories over. Obstacles inactive at `time` get no entries. With `ghost`
+  // (one flag per particle), pairs of two ghosts and ghost-obstacle pairs are left out.
   void rebuild(ParticleStore& particles, const std::vector<Obstacle>& obstacles, double time,
                ContactList& pairs, ContactList& walls, const std::uint8_t* ghost = nullptr);
 
-  // A storage order along space: new particle k is old particle order[k]. Linked cells
-  // layer by layer along `axis` (the threads' slabs are cut along it, so each becomes
-  // a range of storage), along a Z-order (Morton) curve within a layer, then by id.
-  std::vector<std::uint32_t> space_order(const ParticleStore& particles, int axis) const;
-  // The particles were reordered (ParticleStore::permute with the same `order`).
-  void permute(std::span<const std::uint32_t> order);
+  // Each particle's place along a space-filling curve: the Z-order (Morton) code of its
+  // linked cell, periodic positions wrapped. Sorting the storage by (key, id) puts
+  // neighbours next to each other in memory (DemSimulation::sort_storage).
+  std::vector<std::uint64_t> space_keys(const ParticleStore& particles) const;
 
   std::int64_t rebuild_count() const { return rebuilds_; }
   double skin() const { return skin_; }
@@ -48,13 +43,13 @@ class NeighborSearch {
   std::vector<Vec3>& reference_positions() { return reference_; }
   std::int64_t& rebuild_counter() { return rebuilds_; }
   double& reference_time() { return reference_time_; }
+  double reference_time() const { return reference_time_; }  // of the last build [s]
   std::vector<Quaternion>& reference_orientations() { return reference_orientation_; }
   const Domain& domain() const { return domain_; }
 
  private:
   void bin(const ParticleStore& particles);
   std::int64_t cell_of(const Vec3& x) const;
-  std::array<std::int64_t, 3> cell_coordinates(const Vec3& x) const;
   double obstacle_travel(const Obstacle& o, double t0, double t1) const;
   static bool has_bodies(const ParticleStore& particles);
 
@@ -70,7 +65,7 @@ class NeighborSearch {
   std::int64_t rebuilds_ = 0;
   double reference_time_ = 0.0;  // time of the last rebuild [s]
   ContactList scratch_;
-  std::vector<std::uint32_t> candidates_, visit_;
+  std::vector<std::uint32_t> candidates_;
 };
 
 }  // namespace sanguis::dem

@@ -22,6 +22,7 @@ std::size_t ParticleStore::add_body(std::int64_t particle_id, std::int32_t mater
                                     const Vec3& inertia, const Quaternion& q, const Vec3& x,
                                     const Vec3& v, const Vec3& w) {
   id.push_back(particle_id);
+  sort_key.push_back(0);
   material.push_back(material_index);
   radius.push_back(bounding_radius);
   mass.push_back(m);
@@ -49,6 +50,7 @@ void ParticleStore::fix(std::size_t i) {
 
 void ParticleStore::append_from(const ParticleStore& o, std::size_t i) {
   id.push_back(o.id[i]);
+  sort_key.push_back(o.sort_key[i]);
   material.push_back(o.material[i]);
   radius.push_back(o.radius[i]);
   mass.push_back(o.mass[i]);
@@ -68,6 +70,7 @@ void ParticleStore::append_from(const ParticleStore& o, std::size_t i) {
 
 void ParticleStore::permute(std::span<const std::uint32_t> order) {
   apply_order(id, order);
+  apply_order(sort_key, order);
   apply_order(material, order);
   apply_order(radius, order);
   apply_order(mass, order);

@@ -14,7 +14,12 @@
 namespace sanguis::dem {
 
 struct ParticleStore {
-  std::vector<std::int64_t> id;            // stable identifier (output, checkpoints)
+  std::vector<std::int64_t> id;  // stable identifier (output, checkpoints)
+  // Place along space at the last storage sort (NeighborSearch::space_keys); particles
+  // are stored in (sort_key, id) order, the order in which contacts are listed and
+  // summed, so that every process of a decomposed run orders them as one process does.
+  // 0 until sorted; a particle poured since the last sort has the largest key.
+  std::vector<std::uint64_t> sort_key;
   std::vector<std::int32_t> material;      // index into the material table
   std::vector<double> radius;              // bounding radius about the centroid [m]
   std::vector<double> mass;                // [kg]
@@ -40,7 +45,7 @@ struct ParticleStore {
   bool is_fixed(std::size_t i) const { return inverse_mass[i] == 0.0; }
 
   // Reorders the particles: the new particle k is the old particle order[k] (`order` is a
-  // permutation of 0..size()-1). The storage sort of DemSimulation uses it.
+  // permutation of 0..size()-1).
   void permute(std::span<const std::uint32_t> order);
 
   // Appends particle i of `other`, every field as it is.
@@ -70,7 +75,7 @@ void apply_order(std::vector<T>& values, std::span<const std::uint32_t> order) {
 }
 
 // Storage indices in increasing id order: 0, 1, 2, ... when the ids increase with the
-// index (the order particles are created and read in), else sorted by id.
+// index, else sorted by id (outputs list particles by id whatever the storage order).
 std::vector<std::uint32_t> id_order(const std::vector<std::int64_t>& id);
 
 }  // namespace sanguis::dem

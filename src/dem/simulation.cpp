@@ -7,6 +7,7 @@
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <numeric>
 #include <sstream>
 #include <stdexcept>
 #include <type_traits>
@@ -68,8 +69,12 @@ DemSimulation::DemSimulation(DemSetup setup)
       throw std::invalid_argument("a non-spherical particle has no shape in the species table");
     }
   }
-  sort_storage_if_due();  // a random fill leaves ids, and so storage, scattered in space
-  rebuild_lists();
+  // Sorted at once: a random fill leaves ids, and so storage, scattered in space.
+  if (sort_due()) {
+    rebuild_sorted();
+  } else {
+    rebuild_lists();
+  }
   compute_forces();
 }
 
@@ -85,8 +90,9 @@ void DemSimulation::step() {
   integrator_.advance(p, setup_.gravity, dt);
   ++step_;
   if (exchange_ == nullptr) {
-    if (search_.needs_rebuild(p, setup_.obstacles, time(), threads_)) {
-      sort_storage_if_due();
+    if (sort_due()) {
+      rebuild_sorted();
+    } else if (search_.needs_rebuild(p, setup_.obstacles, time(), threads_)) {
       rebuild_lists();
     }
     compute_forces();
@@ -97,7 +103,10 @@ void DemSimulation::step() {
   // Ghosts first take their owners' drifted state, so every process sees the same
   // displacements and all rebuild at the step a single process would.
   exchange_->refresh_ghosts(*this);
-  if (exchange_->any(search_.needs_rebuild(p, setup_.obstacles, time(), threads_))) {
+  const bool sort = sort_due();  // the same on every process
+  if (exchange_->any(sort || search_.needs_rebuild(p, setup_.obstacles, time(), threads_))) {
+    // The processes sort their particles by the new keys as they exchange them.
+    if (sort) assign_sort_keys();
     exchange_->redistribute(*this);
   }
   // A blow-up seen by one process stops them all (none may wait in a collective).
@@ -157,6 +166,8 @@ void DemSimulation::pour_particles() {
           p.add_body(id, src.material, src.species, sh.bounding_radius, src.density * sh.volume,
                      src.density * sh.inertia_per_density, q, x, src.velocity, {});
         }
+        // Stored last, so last in (sort key, id) order until the next sort.
+        p.sort_key.back() = std::numeric_limits<std::uint64_t>::max();
         placed = true;
         ++src.inserted;
       }
@@ -558,27 +569,49 @@ void DemSimulation::rebuild_lists() {
   build_incidence();
 }
 
-void DemSimulation::sort_storage_if_due() {
-  const int interval = setup_.storage_sort_interval;
-  if (interval <= 0 || exchange_ != nullptr || search_.rebuild_count() % interval != 0) return;
-  const ParticleStore& p = setup_.particles;
-  const int axis = longest_axis(p.position, setup_.domain.min, setup_.domain.max).axis;
-  permute_storage(search_.space_order(p, axis));
+bool DemSimulation::sort_due() const {
+  const std::int64_t interval = setup_.storage_sort_interval;
+  if (interval <= 0) return false;
+  // When the simulation is built, then at fixed steps (with a list rebuild there): a
+  // schedule that does not depend on when the lists happen to be rebuilt, which differs
+  // after a restart, so that a restarted run sorts where the first run did.
+  return search_.rebuild_count() == 0 || step_ % interval == 0;
 }
 
-void DemSimulation::permute_storage(std::span<const std::uint32_t> order) {
-  std::vector<std::uint32_t> new_index(order.size());
-  for (std::size_t k = 0; k < order.size(); ++k)
-    new_index[order[k]] = static_cast<std::uint32_t>(k);
-  setup_.particles.permute(order);
-  integrator_.permute(order);
-  search_.permute(order);
-  apply_order(ghost_, order);
-  for (auto* list : {&pairs_.first, &pairs_.second, &walls_.first, &body_pairs_.first,
-                     &body_pairs_.second, &body_walls_.first}) {
-    renumber(*list, new_index);
+void DemSimulation::assign_sort_keys() {
+  setup_.particles.sort_key = search_.space_keys(setup_.particles);
+}
+
+void DemSimulation::sort_storage() {
+  if (exchange_ != nullptr) {
+    throw std::logic_error("sort_storage: a process of a decomposed run sorts as it exchanges");
   }
-  build_incidence();
+  rebuild_sorted();  // the forces stay valid: they moved with their particles
+}
+
+// New keys, the storage sorted by (key, id), the lists rebuilt, and every memory carried
+// over by particle ids (turned round where the new order puts the other particle first):
+// the steps a decomposed run takes when it exchanges its particles, in one process.
+void DemSimulation::rebuild_sorted() {
+  ParticleStore& p = setup_.particles;
+  assign_sort_keys();
+  std::vector<ContactMemory> memories = export_contacts();
+  std::sort(memories.begin(), memories.end(),
+            [](const ContactMemory& a, const ContactMemory& b) { return a.key() < b.key(); });
+  std::vector<std::uint32_t> order(p.size());
+  std::iota(order.begin(), order.end(), 0u);
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+    return p.sort_key[a] != p.sort_key[b] ? p.sort_key[a] < p.sort_key[b] : p.id[a] < p.id[b];
+  });
+  p.permute(order);
+  integrator_.permute(order);
+  apply_order(ghost_, order);
+  pairs_.clear();
+  walls_.clear();
+  body_pairs_.clear();
+  body_walls_.clear();
+  rebuild_lists();
+  import_contacts(memories);
 }
 
 // Moves the candidate pairs that involve a non-spherical body from the sphere lists to
@@ -649,7 +682,7 @@ void DemSimulation::split_body_contacts() {
     }
   }
   pairs_ = std::move(spheres_only);
-  carry_history(body_pairs_, fresh, p.id.data(), true);
+  carry_history(body_pairs_, fresh);
   body_pairs_ = std::move(fresh);
 
   ContactList sphere_walls;
@@ -684,7 +717,7 @@ void DemSimulation::split_body_contacts() {
     }
   }
   walls_ = std::move(sphere_walls);
-  carry_history(body_walls_, fresh_walls, p.id.data(), false);
+  carry_history(body_walls_, fresh_walls);
   body_walls_ = std::move(fresh_walls);
 }
 
@@ -925,9 +958,10 @@ void DemSimulation::import_contacts(std::span<const ContactMemory> contacts) {
           contacts.begin(), contacts.end(), probe,
           [](const ContactMemory& a, const ContactMemory& b) { return a.key() < b.key(); });
       if (it == contacts.end() || it->key() != probe.key()) continue;
-      list.history[k] = it->history;
+      const ContactMemory m = it->as_oriented(probe.first_id);
+      list.history[k] = m.history;
       if constexpr (std::is_same_v<std::decay_t<decltype(list)>, BodyContactList>) {
-        list.warm[k] = it->warm;
+        list.warm[k] = m.warm;
       }
     }
   };
@@ -946,9 +980,12 @@ void DemSimulation::replace_particles(ParticleStore particles, std::vector<std::
     throw std::invalid_argument("replace_particles: per-particle arrays differ in size");
   }
   for (std::size_t i = 1; i < n; ++i) {
-    // Pairs are oriented by local index; increasing ids orient them as one process would.
-    if (particles.id[i] <= particles.id[i - 1]) {
-      throw std::invalid_argument("replace_particles: particles not in increasing id order");
+    // Pairs are oriented by local index; the (sort key, id) order orients them as one
+    // process would.
+    const auto& key = particles.sort_key;
+    if (key[i] < key[i - 1] || (key[i] == key[i - 1] && particles.id[i] <= particles.id[i - 1])) {
+      throw std::invalid_argument(
+          "replace_particles: particles not in increasing (sort key, id) order");
     }
   }
   setup_.particles = std::move(particles);
@@ -969,7 +1006,9 @@ void DemSimulation::replace_particles(ParticleStore particles, std::vector<std::
 
 namespace {
 
-constexpr char kMagic[16] = "SANGUIS-DEM-CK1";
+constexpr char kMagic[16] = "SANGUIS-DEM-CK2";
+// Before the storage sort: no sort keys (the particles were in id order, keys 0).
+constexpr char kMagicWithoutSortKeys[16] = "SANGUIS-DEM-CK1";
 
 template <typename T>
 void put(std::ostream& out, const T& value) {
@@ -1062,15 +1101,6 @@ void for_each_particle_array(ParticleStore& p, F&& f) {
 }  // namespace
 
 void DemSimulation::save_checkpoint(const std::filesystem::path& file) const {
-  // Written in id order whatever the storage order: the same file for any storage sort
-  // and thread count, and as a decomposed run writes it.
-  const std::vector<std::int64_t>& ids = setup_.particles.id;
-  if (!std::is_sorted(ids.begin(), ids.end())) {
-    DemSimulation in_id_order(*this);
-    in_id_order.permute_storage(id_order(ids));
-    in_id_order.save_checkpoint(file);
-    return;
-  }
   io::write_file_atomically(file, [&](std::ostream& out) {
     out.write(kMagic, sizeof(kMagic));
     put(out, setup_.time_step);
@@ -1103,6 +1133,7 @@ void DemSimulation::save_checkpoint(const std::filesystem::path& file) const {
     put(out, max_overlap_ratio_);
     put(out, touching_pairs_);
     put(out, touching_walls_);
+    put(out, setup_.particles.sort_key);
   });
 }
 
@@ -1112,7 +1143,9 @@ void DemSimulation::load_checkpoint(const std::filesystem::path& file) {
   try {
     char magic[sizeof(kMagic)] = {};
     in.read(magic, sizeof(magic));
-    if (!in || std::memcmp(magic, kMagic, sizeof(kMagic)) != 0) {
+    const bool without_keys =
+        in && std::memcmp(magic, kMagicWithoutSortKeys, sizeof(kMagicWithoutSortKeys)) == 0;
+    if (!in || (!without_keys && std::memcmp(magic, kMagic, sizeof(kMagic)) != 0)) {
       throw std::runtime_error("not a sanguis DEM checkpoint");
     }
     double dt = 0.0;
@@ -1151,6 +1184,13 @@ void DemSimulation::load_checkpoint(const std::filesystem::path& file) {
     get(in, max_overlap_ratio_);
     get(in, touching_pairs_);
     get(in, touching_walls_);
+    ParticleStore& p = setup_.particles;
+    if (without_keys) {
+      p.sort_key.assign(p.size(), 0);
+    } else {
+      get(in, p.sort_key);
+      if (p.sort_key.size() != p.size()) throw std::runtime_error("checkpoint is inconsistent");
+    }
     choose_threads();
     build_incidence();
   } catch (const std::runtime_error& e) {

@@ -70,12 +70,14 @@ struct DemSetup {
   double skin = 0.0;               // Verlet skin [m]; 0 -> 0.1 x smallest diameter
   double max_overlap_ratio = 0.5;  // overlap / R beyond which the run stops as unstable
   int threads = 1;                 // OpenMP threads; results are bitwise the same for any count
-  // Every this many list rebuilds the particles are re-sorted in memory along space
-  // (NeighborSearch::space_order), so that each thread's slab is one range of storage
-  // and neighbours share cache lines; 0: never. The results are the same bits with any
-  // value (the contact lists keep id order), and outputs and checkpoints are written in
-  // id order. Single-process runs only: a process of a decomposed run keeps id order.
-  int storage_sort_interval = 10;
+  // The particles are re-sorted in memory along a space-filling curve (Z-order of the
+  // linked cells, NeighborSearch::space_keys) when the simulation is built and every
+  // this many steps (with a list rebuild); 0: never. Contacts are listed and
+  // summed in storage order, so neighbours share cache lines and each thread's slab
+  // its own stretch of memory. Results are the same bits for any thread count and
+  // process count (a decomposed run sorts at the same steps); a different interval gives
+  // a different, equally valid summation order. Outputs list particles by id.
+  std::int64_t storage_sort_interval = 1000;
   std::size_t particles_per_thread =
       0;  // fewer per thread: fewer threads (0: 500 with bodies, 4000 spheres)
   std::vector<std::string> material_names;
@@ -148,6 +150,12 @@ class DemSimulation {
   // Loads a checkpoint written by a simulation built from the same setup.
   void load_checkpoint(const std::filesystem::path& file);
 
+  // Sorts the particles along space now (what the run does at the first list rebuild of
+  // every storage_sort_interval steps): new keys, storage in (key, id) order, lists
+  // rebuilt, every memory carried over. One process only (a decomposed run sorts as it
+  // exchanges particles). Local indices change: find particles by id.
+  void sort_storage();
+
   // Recomputes forces at the current state (after the state was edited by hand).
   void refresh_forces();
 
@@ -184,10 +192,9 @@ class DemSimulation {
   void pour_particles();
   void check_state() const;
   void import_contacts(std::span<const ContactMemory> contacts);
-  // Reorders the particles (new particle k is old particle order[k]) with everything
-  // kept per particle; the contact lists keep their (id) order.
-  void permute_storage(std::span<const std::uint32_t> order);
-  void sort_storage_if_due();
+  bool sort_due() const;
+  void assign_sort_keys();
+  void rebuild_sorted();
 
   DemSetup setup_;
   ParticleExchange* exchange_ = nullptr;
