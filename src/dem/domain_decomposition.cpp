@@ -252,6 +252,9 @@ DemSetup SlabDecomposition::local_setup(const DemSetup& full) {
 
 void SlabDecomposition::attach(DemSimulation& simulation) {
   simulation.set_exchange(this);
+  // The keys the process computed alone follow its own particles' extent: take those
+  // of the whole system, as one process does.
+  simulation.assign_sort_keys();
   ParticleStore& p = simulation.particles();
   std::vector<ParticleRecord> owned(p.size());
   for (std::size_t i = 0; i < p.size(); ++i) {
@@ -267,6 +270,14 @@ bool SlabDecomposition::any(bool local) {
   int flag = local ? 1 : 0;
   MPI_Allreduce(MPI_IN_PLACE, &flag, 1, MPI_INT, MPI_LOR, comm_);
   return flag != 0;
+}
+
+void SlabDecomposition::bounds(Vec3& low, Vec3& high) {
+  const ScopedTimer timer(exchange_seconds_);
+  double values[6] = {low.x, low.y, low.z, -high.x, -high.y, -high.z};
+  MPI_Allreduce(MPI_IN_PLACE, values, 6, MPI_DOUBLE, MPI_MIN, comm_);
+  low = {values[0], values[1], values[2]};
+  high = {-values[3], -values[4], -values[5]};
 }
 
 void SlabDecomposition::refresh_ghosts(DemSimulation& simulation) {

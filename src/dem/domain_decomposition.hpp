@@ -60,6 +60,7 @@ class SlabDecomposition final : public ParticleExchange {
                        const std::filesystem::path& file) const;
 
   bool any(bool local) override;
+  void bounds(Vec3& low, Vec3& high) override;
   void refresh_ghosts(DemSimulation& simulation) override;
   void redistribute(DemSimulation& simulation) override;
 

@@ -94,30 +94,35 @@ std::int64_t NeighborSearch::cell_of(const Vec3& x) const {
 
 namespace {
 
-// Spreads the low 21 bits of v three apart (bit b goes to bit 3b).
-std::uint64_t spread_bits(std::uint64_t v) {
+// Interleaves the low 21 bits of a and b (bit k of a to bit 2k, of b to bit 2k + 1).
+std::uint64_t interleave(std::uint64_t a, std::uint64_t b) {
   std::uint64_t out = 0;
-  for (int bit = 0; bit < 21; ++bit) out |= ((v >> bit) & 1u) << (3 * bit);
+  for (int bit = 0; bit < 21; ++bit) {
+    out |= ((a >> bit) & 1u) << (2 * bit);
+    out |= ((b >> bit) & 1u) << (2 * bit + 1);
+  }
   return out;
 }
 
 }  // namespace
 
-std::vector<std::uint64_t> NeighborSearch::space_keys(const ParticleStore& particles) const {
+std::vector<std::uint64_t> NeighborSearch::space_keys(const ParticleStore& particles,
+                                                      int axis) const {
+  const auto along = static_cast<std::size_t>(axis);
+  const std::size_t u = (along + 1) % 3, v = (along + 2) % 3;
   std::vector<std::uint64_t> keys(particles.size());
   for (std::size_t i = 0; i < particles.size(); ++i) {
     Vec3 x = particles.position[i];
     domain_.wrap(x);  // as the list build will
-    double c[3];
-    for (int k = 0; k < 3; ++k) {
-      const auto ku = static_cast<std::size_t>(k);
-      c[k] = std::clamp(std::floor((x[k] - domain_.min[k]) / cell_size_[k]), 0.0,
-                        static_cast<double>(cells_[ku] - 1));
-      if (!(c[k] >= 0.0)) c[k] = 0.0;  // a non-finite position (the run stops at the check)
+    std::uint64_t c[3];
+    for (std::size_t k = 0; k < 3; ++k) {
+      const double cell =
+          std::clamp(std::floor((x[static_cast<int>(k)] - domain_.min[static_cast<int>(k)]) /
+                                cell_size_[static_cast<int>(k)]),
+                     0.0, static_cast<double>(cells_[k] - 1));
+      c[k] = cell >= 0.0 ? static_cast<std::uint64_t>(cell) : 0;  // NaN: a blown-up particle
     }
-    keys[i] = spread_bits(static_cast<std::uint64_t>(c[0])) |
-              (spread_bits(static_cast<std::uint64_t>(c[1])) << 1) |
-              (spread_bits(static_cast<std::uint64_t>(c[2])) << 2);
+    keys[i] = (c[along] << 42) | interleave(c[u], c[v]);
   }
   return keys;
 }

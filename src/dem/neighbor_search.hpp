@@ -32,10 +32,12 @@ class NeighborSearch {
   void rebuild(ParticleStore& particles, const std::vector<Obstacle>& obstacles, double time,
                ContactList& pairs, ContactList& walls, const std::uint8_t* ghost = nullptr);
 
-  // Each particle's place along a space-filling curve: the Z-order (Morton) code of its
-  // linked cell, periodic positions wrapped. Sorting the storage by (key, id) puts
-  // neighbours next to each other in memory (DemSimulation::sort_storage).
-  std::vector<std::uint64_t> space_keys(const ParticleStore& particles) const;
+  // Each particle's place along a space-filling curve through the linked cells: the
+  // layers of cells along `axis` one after the other, a Z-order (Morton) curve within
+  // each layer; periodic positions wrapped. Sorting the storage by (key, id) puts
+  // neighbours next to each other in memory, and the threads' slabs, cut along the same
+  // axis, each in its own stretch of it (DemSimulation::sort_storage).
+  std::vector<std::uint64_t> space_keys(const ParticleStore& particles, int axis) const;
 
   std::int64_t rebuild_count() const { return rebuilds_; }
   double skin() const { return skin_; }

@@ -579,7 +579,19 @@ bool DemSimulation::sort_due() const {
 }
 
 void DemSimulation::assign_sort_keys() {
-  setup_.particles.sort_key = search_.space_keys(setup_.particles);
+  if (setup_.storage_sort_interval <= 0) return;
+  ParticleStore& p = setup_.particles;
+  // The extent of the owned particles, wrapped, over every process: each computes the
+  // keys one process would.
+  Extent extent = Extent::empty_in(setup_.domain.min, setup_.domain.max);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (is_ghost(i)) continue;
+    Vec3 x = p.position[i];
+    setup_.domain.wrap(x);
+    extent.add(x);
+  }
+  if (exchange_ != nullptr) exchange_->bounds(extent.low, extent.high);
+  p.sort_key = search_.space_keys(p, extent.longest_axis());
 }
 
 void DemSimulation::sort_storage() {
@@ -790,8 +802,10 @@ void DemSimulation::build_blocks() {
   const ParticleStore& p = setup_.particles;
   const std::size_t n = p.size();
   const auto blocks = static_cast<std::size_t>(threads_);
-  const auto [axis, lo, hi] = longest_axis(p.position, setup_.domain.min, setup_.domain.max);
-  const double span = std::max(hi - lo, 1e-300);
+  Extent extent = Extent::empty_in(setup_.domain.min, setup_.domain.max);
+  for (const Vec3& x : p.position) extent.add(x);
+  const int axis = extent.longest_axis();
+  const double lo = extent.low[axis], span = std::max(extent.high[axis] - lo, 1e-300);
   std::vector<std::uint32_t> bin(n);
   for (std::size_t i = 0; i < n; ++i) {
     bin[i] = static_cast<std::uint32_t>(axis_bin(p.position[i][axis], lo, span, kBins));

@@ -155,6 +155,10 @@ class DemSimulation {
   // rebuilt, every memory carried over. One process only (a decomposed run sorts as it
   // exchanges particles). Local indices change: find particles by id.
   void sort_storage();
+  // New sort keys (NeighborSearch::space_keys) for the particles, layered along the
+  // longest axis of all the particles' extent (collective in a decomposed run, where the
+  // processes then exchange particles in key order); a no-op when the sort is off.
+  void assign_sort_keys();
 
   // Recomputes forces at the current state (after the state was edited by hand).
   void refresh_forces();
@@ -193,7 +197,6 @@ class DemSimulation {
   void check_state() const;
   void import_contacts(std::span<const ContactMemory> contacts);
   bool sort_due() const;
-  void assign_sort_keys();
   void rebuild_sorted();
 
   DemSetup setup_;

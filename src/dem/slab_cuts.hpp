@@ -20,28 +20,26 @@ inline std::size_t axis_bin(double coordinate, double lo, double length, std::si
   return u >= static_cast<double>(bins - 1) ? bins - 1 : static_cast<std::size_t>(u);
 }
 
-// The axis along which the points spread furthest (a column in a long channel is cut
-// across its height, not along the empty channel), with the points' range along it.
-struct LongestAxis {
-  int axis = 0;
-  double low = 0.0, high = 0.0;
-};
-
-inline LongestAxis longest_axis(const std::vector<Vec3>& points, const Vec3& box_min,
-                                const Vec3& box_max) {
-  Vec3 low = box_max, high = box_min;
-  for (const Vec3& x : points) {
+// The box around points, and the axis along which they spread furthest (a column in a
+// long channel is cut across its height, not along the empty channel).
+struct Extent {
+  Vec3 low, high;
+  // Empty: low above high (the first point sets both).
+  static Extent empty_in(const Vec3& box_min, const Vec3& box_max) { return {box_max, box_min}; }
+  void add(const Vec3& x) {
     for (int k = 0; k < 3; ++k) {
       low[k] = std::min(low[k], x[k]);
       high[k] = std::max(high[k], x[k]);
     }
   }
-  int axis = 0;
-  for (int k = 1; k < 3; ++k) {
-    if (high[k] - low[k] > high[axis] - low[axis]) axis = k;
+  int longest_axis() const {
+    int axis = 0;
+    for (int k = 1; k < 3; ++k) {
+      if (high[k] - low[k] > high[axis] - low[axis]) axis = k;
+    }
+    return axis;
   }
-  return {axis, low[axis], high[axis]};
-}
+};
 
 // parts + 1 bin indices: part k holds the bins [cut[k], cut[k + 1]), each part about
 // 1 / parts of the histogram's weight (a part ends after the bin that reaches its share).

@@ -273,7 +273,7 @@ TEST(StorageSort, TurningAContactRoundNegatesItsMemoryAndItsForce) {
   EXPECT_EQ(wall.as_oriented(9).first_id, 4);
 }
 
-TEST(StorageSort, SpaceKeysFollowTheZOrderOfTheCells) {
+TEST(StorageSort, SpaceKeysRunLayerByLayerAlongTheAxisAndInZOrderWithin) {
   Domain domain{{0.0, 0.0, 0.0}, {0.1, 0.1, 0.1}, {false, true, false}};
   NeighborSearch search(domain, 0.0, 0.005);  // cut-off 0.01: 10 x 10 x 10 cells
   ParticleStore p;
@@ -284,8 +284,14 @@ TEST(StorageSort, SpaceKeysFollowTheZOrderOfTheCells) {
     p.add_sphere(static_cast<std::int64_t>(p.size()), 0, 0.004, 1000.0,
                  {(c.x + 0.5) * h, (c.y + 0.5) * h, (c.z + 0.5) * h}, {}, {});
   }
-  const std::vector<std::uint64_t> keys = search.space_keys(p);
-  EXPECT_EQ(keys, (std::vector<std::uint64_t>{0, 1, 2, 3, 4, 7, 8, 63, 0}));
+  const std::uint64_t layer = std::uint64_t{1} << 42;
+  // Layers along z, Z-order of (x, y) within.
+  EXPECT_EQ(search.space_keys(p, 2),
+            (std::vector<std::uint64_t>{0, 1, 2, 3, layer, layer + 3, 4, 3 * layer + 15, 0}));
+  // Layers along x, Z-order of (y, z) within.
+  EXPECT_EQ(search.space_keys(p, 0),
+            (std::vector<std::uint64_t>{0, layer, 1, layer + 1, 2, layer + 3, 2 * layer,
+                                        3 * layer + 15, 0}));
 }
 
 TEST(StorageSort, CheckpointsWrittenBeforeSortKeysStillLoad) {
