@@ -5,8 +5,11 @@
 // still candidates are carried over, so a rebuild never erases memory (see
 // NeighborSearch::rebuild). Local indices follow the storage order, which is the
 // particles' (sort key, id) order (ParticleStore::sort_key).
+#include <algorithm>
 #include <cstdint>
+#include <span>
 #include <tuple>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -94,6 +97,14 @@ inline void carry_history(const BodyContactList& previous, BodyContactList& fres
   }
 }
 
+// The memory of a contact seen from its other particle: what it stores relative to its
+// first particle (eq. 2.8-2.10: the tangential spring, the rolling spring torque, the
+// normal) is negated, exactly, and so are the forces it then gives (every operation of
+// evaluate_contact is mirrored).
+inline ContactHistory turned_round(const ContactHistory& h) {
+  return {-h.tangential_displacement, -h.rolling_spring_torque, -h.normal};
+}
+
 // One contact and its memory keyed by particle ids instead of local indices, so that
 // it survives a renumbering of the particles: particles moving between processes
 // (domain decomposition) or re-sorted along space (DemSimulation). A pair's first
@@ -118,20 +129,63 @@ struct ContactMemory {
     }
     return std::tuple{kind, first_id, second_id, element_first, element_second};
   }
-  // This memory as seen from a pair stored with `first` first. Turning a pair round
-  // negates what it stores relative to its first particle (eq. 2.8-2.10: the tangential
-  // spring, the rolling spring torque, the normal), exactly; the GJK simplex starts cold.
+  // This memory as seen from a pair stored with `first` first (turned_round); the GJK
+  // simplex then starts cold.
   ContactMemory as_oriented(std::int64_t first) const {
     if (!is_pair() || first == first_id) return *this;
     ContactMemory m = *this;
     std::swap(m.first_id, m.second_id);
     std::swap(m.element_first, m.element_second);
-    m.history.tangential_displacement = -history.tangential_displacement;
-    m.history.rolling_spring_torque = -history.rolling_spring_torque;
-    m.history.normal = -history.normal;
+    m.history = turned_round(history);
     m.warm = {};
     return m;
   }
 };
+
+// The storage was reordered: particle i is now new_index[i]. Each entry keeps its
+// memory; a pair whose order flips is turned round as ContactMemory::as_oriented does
+// (so one process ends up as a decomposed run that exchanged the memories); the list
+// is sorted again. `pair_list` false: `second` is an obstacle, never renumbered.
+template <typename List>
+void renumber(List& list, std::span<const std::uint32_t> new_index, bool pair_list) {
+  constexpr bool kBodies = std::is_same_v<List, BodyContactList>;
+  const std::size_t n = list.size();
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> key(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    std::uint32_t a = new_index[list.first[k]];
+    std::uint32_t b = pair_list ? new_index[list.second[k]] : list.second[k];
+    if (pair_list && b < a) {
+      std::swap(a, b);
+      list.history[k] = turned_round(list.history[k]);
+      if constexpr (kBodies) {
+        std::swap(list.element_first[k], list.element_second[k]);
+        list.warm[k] = {};
+      }
+    }
+    list.first[k] = a;
+    list.second[k] = b;
+    std::uint32_t elements = 0;
+    if constexpr (kBodies)
+      elements = (std::uint32_t{list.element_first[k]} << 16) | list.element_second[k];
+    key[k] = {(std::uint64_t{a} << 32) | b, elements};
+  }
+  std::vector<std::uint32_t> order(n);
+  for (std::size_t k = 0; k < n; ++k) order[k] = static_cast<std::uint32_t>(k);
+  std::sort(order.begin(), order.end(),
+            [&](std::uint32_t x, std::uint32_t y) { return key[x] < key[y]; });
+  const auto gather = [&](auto& values) {
+    auto sorted = values;
+    for (std::size_t k = 0; k < n; ++k) sorted[k] = values[order[k]];
+    values.swap(sorted);
+  };
+  gather(list.first);
+  gather(list.second);
+  gather(list.history);
+  if constexpr (kBodies) {
+    gather(list.element_first);
+    gather(list.element_second);
+    gather(list.warm);
+  }
+}
 
 }  // namespace sanguis::dem

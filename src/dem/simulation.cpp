@@ -601,15 +601,12 @@ void DemSimulation::sort_storage() {
   rebuild_sorted();  // the forces stay valid: they moved with their particles
 }
 
-// New keys, the storage sorted by (key, id), the lists rebuilt, and every memory carried
-// over by particle ids (turned round where the new order puts the other particle first):
-// the steps a decomposed run takes when it exchanges its particles, in one process.
+// New keys, the storage sorted by (key, id), the lists renumbered (pairs turned round
+// where the new order puts the other particle first) and rebuilt: what a decomposed run
+// does when it exchanges its particles with their memories, in one process.
 void DemSimulation::rebuild_sorted() {
   ParticleStore& p = setup_.particles;
   assign_sort_keys();
-  std::vector<ContactMemory> memories = export_contacts();
-  std::sort(memories.begin(), memories.end(),
-            [](const ContactMemory& a, const ContactMemory& b) { return a.key() < b.key(); });
   std::vector<std::uint32_t> order(p.size());
   std::iota(order.begin(), order.end(), 0u);
   std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
@@ -618,12 +615,14 @@ void DemSimulation::rebuild_sorted() {
   p.permute(order);
   integrator_.permute(order);
   apply_order(ghost_, order);
-  pairs_.clear();
-  walls_.clear();
-  body_pairs_.clear();
-  body_walls_.clear();
+  std::vector<std::uint32_t> new_index(order.size());
+  for (std::size_t k = 0; k < order.size(); ++k)
+    new_index[order[k]] = static_cast<std::uint32_t>(k);
+  renumber(pairs_, new_index, true);
+  renumber(walls_, new_index, false);
+  renumber(body_pairs_, new_index, true);
+  renumber(body_walls_, new_index, false);
   rebuild_lists();
-  import_contacts(memories);
 }
 
 // Moves the candidate pairs that involve a non-spherical body from the sphere lists to
