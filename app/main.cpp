@@ -258,7 +258,7 @@ int main(int argc, char** argv) {
   bench_cmd
       ->add_option("--storage-sort", bo.storage_sort_interval,
                    "dem: re-sort particles along space every N steps (0: never; default: "
-                   "the solver's, 1000)")
+                   "the solver's, 2000)")
       ->check(CLI::Range(std::int64_t{0}, std::int64_t{1} << 40));
   std::string bench_case;
   bench_cmd->add_option("--case", bench_case,

@@ -77,7 +77,7 @@ struct DemSetup {
   // its own stretch of memory. Results are the same bits for any thread count and
   // process count (a decomposed run sorts at the same steps); a different interval gives
   // a different, equally valid summation order. Outputs list particles by id.
-  std::int64_t storage_sort_interval = 1000;
+  std::int64_t storage_sort_interval = 2000;
   std::size_t particles_per_thread =
       0;  // fewer per thread: fewer threads (0: 500 with bodies, 4000 spheres)
   std::vector<std::string> material_names;
