@@ -755,7 +755,7 @@ void pair_incidence(const std::vector<std::uint32_t>& first,
   }
 }
 
-// For a list whose entries of each particle are adjacent (walls, sorted by particle id),
+// For a list whose entries of each particle are adjacent (walls, sorted by particle),
 // each particle's range of entries [begin[i], end[i]).
 void particle_ranges(const std::vector<std::uint32_t>& first, std::size_t n,
                      std::vector<std::uint32_t>& begin, std::vector<std::uint32_t>& end) {

@@ -16,7 +16,7 @@
 
 #include "core/config.hpp"
 #include "dem/dem_case.hpp"
-#include "geometry/mass_properties.hpp"
+#include "falling_crosses.hpp"
 
 namespace sanguis::dem {
 namespace {
@@ -40,43 +40,16 @@ std::string file_bytes(const std::filesystem::path& file) {
 // 36 crosses (element contacts by GJK, body-wall contacts) on a floor, their ids a
 // permutation that does not follow space, and 300 spheres poured over them.
 DemSetup crosses_and_spheres(int threads, std::int64_t sort_interval, IntegratorKind kind) {
-  DemSetup s;
-  s.shapes.push_back(
-      make_particle_shape("cross", geometry::cross_particle(0.027, 0.002, 0.003), 1e-4));
-  const ParticleShape& cross = s.shapes.back();
-  s.domain = {{0.0, 0.0, 0.0}, {0.09, 0.09, 0.1}, {true, false, false}};
-  s.gravity = {0.0, 0.0, -9.81};
-  s.time_step = 2.5e-6;
+  DemSetup s = testing::falling_crosses(threads, [](int n) { return (7 * n) % 36; });
+  s.domain.periodic[0] = true;
   s.integrator = kind;
-  s.threads = threads;
-  s.particles_per_thread = 1;  // threads on this small system
   s.storage_sort_interval = sort_interval;
-  ContactParameters p;
-  p.normal_stiffness = 4.5e5;
-  p.normal_damping = 0.05;
-  p.tangential_stiffness = 3e2;
-  p.tangential_damping = 0.02;
-  p.friction = 0.5;
+  ContactParameters p = s.contacts.get(0, 0);
   p.rolling_stiffness = 3e-4;  // rolling memory in play too
   p.rolling_damping = 2e-8;
   p.rolling_friction = 0.05;
-  s.contacts = ContactTable(2);
   s.contacts.set(0, 0, p);
   s.contacts.set(0, 1, p);
-  Obstacle floor;
-  floor.material = 1;
-  floor.shape = PlaneShape{{0, 0, 0}, {0, 0, 1}};
-  s.obstacles.push_back(floor);
-  const Quaternion axes =
-      geometry::composite_mass_properties(geometry::cross_particle(0.027, 0.002, 0.003))
-          .principal_axes;
-  for (int n = 0; n < 36; ++n) {
-    const Vec3 x{0.015 + 0.03 * (n % 3), 0.015 + 0.03 * ((n / 3) % 3), 0.002 + 0.0035 * (n / 9)};
-    const Quaternion q = Quaternion::from_axis_angle({0.0, 0.0, 1.0}, 0.7 * n) * axes;
-    s.particles.add_body((7 * n) % 36, 0, 0, cross.bounding_radius, 770.0 * cross.volume,
-                         770.0 * cross.inertia_per_density, normalized(q), x, {0.0, 0.0, -0.3},
-                         {0.0, 0.0, 0.5 * (n % 5)});
-  }
   PourSource rain;
   rain.radius = 1.5e-3;
   rain.density = 2500.0;
