@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/permutation.hpp"
 #include "dem/contact_law.hpp"
 #include "geometry/gjk.hpp"
 
@@ -150,7 +151,6 @@ template <typename List>
 void renumber(List& list, std::span<const std::uint32_t> new_index, bool pair_list) {
   constexpr bool kBodies = std::is_same_v<List, BodyContactList>;
   const std::size_t n = list.size();
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> key(n);
   for (std::size_t k = 0; k < n; ++k) {
     std::uint32_t a = new_index[list.first[k]];
     std::uint32_t b = pair_list ? new_index[list.second[k]] : list.second[k];
@@ -164,27 +164,26 @@ void renumber(List& list, std::span<const std::uint32_t> new_index, bool pair_li
     }
     list.first[k] = a;
     list.second[k] = b;
-    std::uint32_t elements = 0;
-    if constexpr (kBodies)
-      elements = (std::uint32_t{list.element_first[k]} << 16) | list.element_second[k];
-    key[k] = {(std::uint64_t{a} << 32) | b, elements};
   }
+  const auto key = [&](std::uint32_t k) {
+    std::uint32_t elements = 0;
+    if constexpr (kBodies) {
+      elements = (std::uint32_t{list.element_first[k]} << 16) | list.element_second[k];
+    }
+    return std::pair{(std::uint64_t{list.first[k]} << 32) | list.second[k], elements};
+  };
   std::vector<std::uint32_t> order(n);
   for (std::size_t k = 0; k < n; ++k) order[k] = static_cast<std::uint32_t>(k);
   std::sort(order.begin(), order.end(),
-            [&](std::uint32_t x, std::uint32_t y) { return key[x] < key[y]; });
-  const auto gather = [&](auto& values) {
-    auto sorted = values;
-    for (std::size_t k = 0; k < n; ++k) sorted[k] = values[order[k]];
-    values.swap(sorted);
-  };
-  gather(list.first);
-  gather(list.second);
-  gather(list.history);
+            [&](std::uint32_t x, std::uint32_t y) { return key(x) < key(y); });
+  std::vector<std::uint8_t> visited;
+  permute_in_place(list.first, order, visited);
+  permute_in_place(list.second, order, visited);
+  permute_in_place(list.history, order, visited);
   if constexpr (kBodies) {
-    gather(list.element_first);
-    gather(list.element_second);
-    gather(list.warm);
+    permute_in_place(list.element_first, order, visited);
+    permute_in_place(list.element_second, order, visited);
+    permute_in_place(list.warm, order, visited);
   }
 }
 

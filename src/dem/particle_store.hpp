@@ -8,6 +8,7 @@
 #include <span>
 #include <vector>
 
+#include "core/permutation.hpp"
 #include "core/quaternion.hpp"
 #include "core/vec3.hpp"
 
@@ -64,14 +65,13 @@ struct ParticleStore {
                        const Vec3& w);
 };
 
-// values[k] = old values[order[k]] for a per-particle array; an array of another length
-// (an empty history) is left as it is.
+// values[k] = old values[order[k]] for a per-particle array, in place; an array of
+// another length (an empty history) is left as it is.
 template <typename T>
 void apply_order(std::vector<T>& values, std::span<const std::uint32_t> order) {
   if (values.size() != order.size()) return;
-  std::vector<T> ordered(values.size());
-  for (std::size_t k = 0; k < order.size(); ++k) ordered[k] = values[order[k]];
-  values.swap(ordered);
+  std::vector<std::uint8_t> visited;
+  permute_in_place(values, order, visited);
 }
 
 // Storage indices in increasing id order: 0, 1, 2, ... when the ids increase with the
