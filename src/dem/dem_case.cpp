@@ -554,6 +554,9 @@ DemCase load_dem_case(const ConfigTable& cfg, const std::filesystem::path& sourc
   const std::int64_t threads = sim.get_int("threads", 0);
   if (threads < 0 || threads > 1024) sim.fail("threads", "must be 0 (all cores) or 1..1024");
   s.threads = threads == 0 ? std::max(1, omp_get_num_procs()) : static_cast<int>(threads);
+  const std::int64_t sort_steps = sim.get_int("storage_sort_steps", s.storage_sort_interval);
+  if (sort_steps < 0) sim.fail("storage_sort_steps", "must be >= 0 (0: never sort)");
+  s.storage_sort_interval = sort_steps;
   const bool allow_large_dt = sim.get_bool("allow_large_time_step", false);
   const bool dt_given = sim.has("time_step_s");
   const double dt_value = dt_given ? sim.get_positive("time_step_s") : 0.0;
@@ -791,6 +794,12 @@ std::string describe(const DemCase& c) {
   o << "obstacles       " << s.obstacles.size() << "\n";
   o << "threads         " << s.threads
     << " requested (small systems use fewer; results do not depend on it)\n";
+  o << "storage sort    ";
+  if (s.storage_sort_interval > 0) {
+    o << "along space every " << s.storage_sort_interval << " steps\n";
+  } else {
+    o << "off (particles stay in the order they were created)\n";
+  }
   o << "integrator      " << to_string(s.integrator) << " (order " << order_of(s.integrator)
     << ")\n";
   o << "time step       " << s.time_step << " s  = Tc / " << c.smallest_contact_time / s.time_step

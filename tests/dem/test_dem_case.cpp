@@ -274,7 +274,8 @@ TEST(DemCase, OptionalSimulationKeysAndTables) {
 integrator = "adams_bashforth_3"
 gravity_m_s2 = [0.0, -1.0, 0.0]
 skin_m = 2e-4
-abort_overlap_ratio = 0.2)");
+abort_overlap_ratio = 0.2
+storage_sort_steps = 0)");
   text += R"(
 [output]
 interval_s = 0.002
@@ -290,6 +291,8 @@ check_after_s = 0.003
   EXPECT_EQ(c.setup.gravity, (Vec3{0.0, -1.0, 0.0}));
   EXPECT_EQ(c.setup.skin, 2e-4);
   EXPECT_EQ(c.setup.max_overlap_ratio, 0.2);
+  EXPECT_EQ(c.setup.storage_sort_interval, 0);
+  EXPECT_EQ(load(kValidCase).setup.storage_sort_interval, 2000);  // the default
   EXPECT_EQ(c.output.interval, 0.002);
   EXPECT_FALSE(c.output.vtk);
   EXPECT_EQ(c.output.checkpoint_interval, 0.005);
@@ -395,6 +398,11 @@ TEST(DemCaseErrors, MissingRequiredKey) {
                     "interaction[0].max_impact_velocity_m_s", "required key is missing");
   expect_case_error(replaced(kValidCase, "[domain]", "[domainn]"), "domain",
                     "required table is missing");
+}
+
+TEST(DemCaseErrors, NegativeStorageSortInterval) {
+  expect_case_error(replaced(kValidCase, "seed = 3", "seed = 3\nstorage_sort_steps = -5"),
+                    "simulation.storage_sort_steps", "must be >= 0");
 }
 
 TEST(DemCaseErrors, NegativeOrZeroRadius) {
