@@ -372,6 +372,16 @@ std::vector<ContactRecord> touching_contacts(const DemSimulation& sim) {
             r);
     out.push_back(r);
   }
+  // A pair is reported from its particle of smaller id: the storage order, which orients
+  // the lists, changes at each storage sort, and outputs must not flip with it.
+  for (ContactRecord& r : out) {
+    const bool pair = r.kind == ContactKind::kSpherePair || r.kind == ContactKind::kBodyPair;
+    if (!pair || p.id[r.first] < p.id[r.second]) continue;
+    std::swap(r.first, r.second);
+    std::swap(r.first_centre, r.second_centre);  // the same segment, the other way
+    r.normal = -r.normal;
+    r.force = -r.force;
+  }
   return out;
 }
 

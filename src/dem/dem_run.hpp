@@ -74,7 +74,7 @@ enum class ContactKind : std::int32_t {
 // One touching contact at the current state of a simulation.
 struct ContactRecord {
   ContactKind kind = ContactKind::kSpherePair;
-  std::uint32_t first = 0;    // particle index
+  std::uint32_t first = 0;    // particle index (for pairs: the smaller id)
   std::uint32_t second = 0;   // particle index, or obstacle index for walls
   Vec3 point;                 // contact point (space frame; periodic: near the first particle)
   Vec3 normal;                // unit, from the first body towards the second

@@ -13,9 +13,10 @@
 // leapfrog mid-step velocities and the memories of their contacts (keyed by
 // particle ids), and the ghosts are rebuilt.
 //
-// Particles are kept in increasing id order on every process, so each contact
-// is oriented (smaller id first) and each particle's contacts are summed in the
-// same order as in a single-process run from the same state: the particle
+// Particles are kept in increasing (sort key, id) order on every process, as one
+// process stores them (ParticleStore::sort_key), so each contact is oriented and
+// each particle's contacts are summed in the same order as in a single-process run
+// from the same state: the particle
 // states are bitwise those of one process (checked by tests/dem/dem_mpi_check).
 // Only the reductions of the diagnostics change with the process count.
 //

@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <stdexcept>
 #include <vector>
 
 #include "core/permutation.hpp"
@@ -65,11 +66,14 @@ struct ParticleStore {
                        const Vec3& w);
 };
 
-// values[k] = old values[order[k]] for a per-particle array, in place; an array of
-// another length (an empty history) is left as it is.
+// values[k] = old values[order[k]] for a per-particle array, in place; an empty array
+// (a history not started, no ghosts) is left as it is.
 template <typename T>
 void apply_order(std::vector<T>& values, std::span<const std::uint32_t> order) {
-  if (values.size() != order.size()) return;
+  if (values.empty()) return;
+  if (values.size() != order.size()) {
+    throw std::logic_error("apply_order: a per-particle array has the wrong length");
+  }
   std::vector<std::uint8_t> visited;
   permute_in_place(values, order, visited);
 }

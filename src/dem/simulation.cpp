@@ -579,7 +579,10 @@ bool DemSimulation::sort_due() const {
 }
 
 void DemSimulation::assign_sort_keys() {
-  if (setup_.storage_sort_interval <= 0) return;
+  if (setup_.storage_sort_interval > 0) compute_sort_keys();
+}
+
+void DemSimulation::compute_sort_keys() {
   ParticleStore& p = setup_.particles;
   // The extent of the owned particles, wrapped, over every process: each computes the
   // keys one process would.
@@ -606,7 +609,7 @@ void DemSimulation::sort_storage() {
 // does when it exchanges its particles with their memories, in one process.
 void DemSimulation::rebuild_sorted() {
   ParticleStore& p = setup_.particles;
-  assign_sort_keys();
+  compute_sort_keys();
   std::vector<std::uint32_t> order(p.size());
   std::iota(order.begin(), order.end(), 0u);
   std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
@@ -793,8 +796,8 @@ void DemSimulation::build_incidence() {
 // equal work in each (a contact belongs to the slab of its first particle; an element
 // pair weighs as kElementPairWeight sphere contacts, for its GJK), lists each slab's
 // contacts in increasing index, and marks the particles with a pair in another slab as
-// shared. Slabs, not index ranges: particles are stored in id order, which follows
-// space only for ordered inputs (a random fill scatters ids).
+// shared. Slabs, not index ranges: between two storage sorts the particles move away
+// from their place in memory (and with the sort off, storage follows creation order).
 void DemSimulation::build_blocks() {
   constexpr std::uint32_t kElementPairWeight = 8;
   constexpr std::size_t kBins = 4096;
@@ -1020,7 +1023,7 @@ void DemSimulation::replace_particles(ParticleStore particles, std::vector<std::
 namespace {
 
 constexpr char kMagic[16] = "SANGUIS-DEM-CK2";
-// Before the storage sort: no sort keys (the particles were in id order, keys 0).
+// Before the storage sort: no sort keys (particles in the order of their creation).
 constexpr char kMagicWithoutSortKeys[16] = "SANGUIS-DEM-CK1";
 
 template <typename T>
@@ -1199,7 +1202,9 @@ void DemSimulation::load_checkpoint(const std::filesystem::path& file) {
     get(in, touching_walls_);
     ParticleStore& p = setup_.particles;
     if (without_keys) {
-      p.sort_key.assign(p.size(), 0);
+      // Storage order was the order of creation: keys that keep it the (key, id) order.
+      p.sort_key.resize(p.size());
+      std::iota(p.sort_key.begin(), p.sort_key.end(), std::uint64_t{0});
     } else {
       get(in, p.sort_key);
       if (p.sort_key.size() != p.size()) throw std::runtime_error("checkpoint is inconsistent");

@@ -179,7 +179,7 @@ class DemSimulation {
   // Every contact with its memory, keyed by particle ids.
   std::vector<ContactMemory> export_contacts() const;
   // Replaces the particles mid-step (between the drift and the forces): the new set must
-  // be in increasing id order, `half_velocity` / `half_angular` are leapfrog's mid-step
+  // be in increasing (sort key, id) order, `half_velocity` / `half_angular` are leapfrog's mid-step
   // values per particle; the lists are rebuilt and each contact takes its memory from
   // `contacts` (sorted by ContactMemory::key) when found there.
   void replace_particles(ParticleStore particles, std::vector<std::uint8_t> ghost,
@@ -197,6 +197,7 @@ class DemSimulation {
   void check_state() const;
   void import_contacts(std::span<const ContactMemory> contacts);
   bool sort_due() const;
+  void compute_sort_keys();
   void rebuild_sorted();
 
   DemSetup setup_;
