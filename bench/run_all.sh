@@ -69,6 +69,13 @@ fi
 run dem-spheres-1thread "$sanguis" bench dem-spheres "${spheres[@]}" --threads 1
 run dem-spheres-2threads "$sanguis" bench dem-spheres "${spheres[@]}" --threads 2
 run dem-spheres-2proc "${mpirun_cmd[@]}" -np 2 "$sanguis" bench dem-spheres "${spheres[@]}"
+# The storage sort (docs/performance.md): ids scattered in space, sorted and never sorted.
+for sort in 2000 0; do
+  for t in 1 2; do
+    run "dem-spheres-scattered-sort${sort}-${t}threads" "$sanguis" bench dem-spheres \
+      "${spheres[@]}" --scatter --storage-sort "$sort" --threads "$t"
+  done
+done
 run dem-spheres-memory "$sanguis" bench dem-spheres "${big[@]}" --threads 1
 run dem-crosses-1thread "$sanguis" bench dem-crosses "${crosses[@]}" --threads 1
 run dem-crosses-2threads "$sanguis" bench dem-crosses "${crosses[@]}" --threads 2
