@@ -212,8 +212,7 @@ io::PolyMesh body_mesh(const std::vector<ParticleShape>& shapes, const ParticleS
 ParticleStore owned_particles(const DemSimulation& sim) {
   // In id order, whatever the storage order (see DemSetup::storage_sort_interval).
   const ParticleStore& p = sim.particles();
-  const bool in_order = std::is_sorted(p.id.begin(), p.id.end());
-  if (sim.ghost_flags().empty() && in_order) return p;
+  if (sim.ghost_flags().empty() && std::is_sorted(p.id.begin(), p.id.end())) return p;
   ParticleStore owned;
   for (const std::uint32_t i : id_order(p.id)) {
     if (!sim.is_ghost(i)) owned.append_from(p, i);

@@ -508,11 +508,10 @@ void DemSimulation::compute_forces() {
             ++count;
           }
         };
-        const auto add_walls = [&](const std::vector<std::uint32_t>& begin,
-                                   const std::vector<std::uint32_t>& end,
+        const auto add_walls = [&](const std::vector<std::uint32_t>& offset,
                                    const std::vector<ContactOutcome>& outcomes,
                                    const std::vector<std::uint8_t>& touching) {
-          for (std::uint32_t k = begin[i]; k < end[i]; ++k) {
+          for (std::uint32_t k = offset[i]; k < offset[i + 1]; ++k) {
             if (!touching[k]) continue;
             force += outcomes[k].force;
             torque += outcomes[k].torque_first;
@@ -523,10 +522,8 @@ void DemSimulation::compute_forces() {
         if (has_bodies_) {
           add_pairs(body_incident_offset_, body_incident_, body_pair_buffer_, body_pair_touching_);
         }
-        add_walls(wall_begin_, wall_end_, wall_buffer_, wall_touching_);
-        if (has_bodies_) {
-          add_walls(body_wall_begin_, body_wall_end_, body_wall_buffer_, body_wall_touching_);
-        }
+        add_walls(wall_offset_, wall_buffer_, wall_touching_);
+        if (has_bodies_) add_walls(body_wall_offset_, body_wall_buffer_, body_wall_touching_);
         f[i] = force;
         tq[i] = torque;
         coord[i] = count;
@@ -758,16 +755,12 @@ void pair_incidence(const std::vector<std::uint32_t>& first,
   }
 }
 
-// For a list whose entries of each particle are adjacent (walls, sorted by particle),
-// each particle's range of entries [begin[i], end[i]).
+// For a list sorted by particle (walls), each particle's range of entries.
 void particle_ranges(const std::vector<std::uint32_t>& first, std::size_t n,
-                     std::vector<std::uint32_t>& begin, std::vector<std::uint32_t>& end) {
-  begin.assign(n, 0);
-  end.assign(n, 0);
-  for (std::size_t k = 0; k < first.size(); ++k) {
-    if (k == 0 || first[k] != first[k - 1]) begin[first[k]] = static_cast<std::uint32_t>(k);
-    end[first[k]] = static_cast<std::uint32_t>(k + 1);
-  }
+                     std::vector<std::uint32_t>& offset) {
+  offset.assign(n + 1, 0);
+  for (std::uint32_t i : first) ++offset[i + 1];
+  for (std::size_t i = 0; i < n; ++i) offset[i + 1] += offset[i];
 }
 
 }  // namespace
@@ -777,10 +770,10 @@ void DemSimulation::build_incidence() {
   // What the threaded gather reads (see compute_forces).
   const std::size_t n = setup_.particles.size();
   pair_incidence(pairs_.first, pairs_.second, n, incident_offset_, incident_, incident_fill_);
-  particle_ranges(walls_.first, n, wall_begin_, wall_end_);
+  particle_ranges(walls_.first, n, wall_offset_);
   pair_incidence(body_pairs_.first, body_pairs_.second, n, body_incident_offset_, body_incident_,
                  incident_fill_);
-  particle_ranges(body_walls_.first, n, body_wall_begin_, body_wall_end_);
+  particle_ranges(body_walls_.first, n, body_wall_offset_);
   pair_buffer_.resize(pairs_.size());
   wall_buffer_.resize(walls_.size());
   body_pair_buffer_.resize(body_pairs_.size());

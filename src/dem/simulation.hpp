@@ -213,7 +213,7 @@ class DemSimulation {
   // Threaded force gather (see compute_forces): per-contact outcomes and, per particle,
   // its contacts in increasing index. Rebuilt with the lists, not part of the state.
   std::vector<ContactOutcome> pair_buffer_, wall_buffer_;
-  std::vector<std::uint32_t> incident_offset_, incident_, incident_fill_, wall_begin_, wall_end_;
+  std::vector<std::uint32_t> incident_offset_, incident_, incident_fill_, wall_offset_;
   // Contacts involving non-spherical bodies, element by element (body_contacts.hpp).
   bool has_bodies_ = false;
   BodyContactList body_pairs_, body_walls_;
@@ -222,8 +222,7 @@ class DemSimulation {
   // particles, the only ones the gather reads; the outcome only when it touched).
   std::vector<std::uint8_t> pair_touching_, wall_touching_, body_pair_touching_,
       body_wall_touching_;
-  std::vector<std::uint32_t> body_incident_offset_, body_incident_, body_wall_begin_,
-      body_wall_end_;
+  std::vector<std::uint32_t> body_incident_offset_, body_incident_, body_wall_offset_;
   // Threads (see compute_forces): space cut into one slab per thread, each with its
   // contacts of every list; `shared_` marks the particles with a contact in another
   // slab, summed by the gather, while every other particle accumulates directly in its
