@@ -82,4 +82,14 @@ void apply_order(std::vector<T>& values, std::span<const std::uint32_t> order) {
 // index, else sorted by id (outputs list particles by id whatever the storage order).
 std::vector<std::uint32_t> id_order(const std::vector<std::int64_t>& id);
 
+// A per-particle array listed in increasing id order (two runs whose storage orders
+// differ, e.g. sorted at different steps, compare value by value).
+template <typename T>
+std::vector<T> in_id_order(const std::vector<T>& values, const std::vector<std::int64_t>& id) {
+  std::vector<T> out;
+  out.reserve(values.size());
+  for (const std::uint32_t i : id_order(id)) out.push_back(values[i]);
+  return out;
+}
+
 }  // namespace sanguis::dem

@@ -23,9 +23,7 @@ namespace {
 
 // Per-particle values rearranged into id order (storage order differs between runs).
 std::vector<Vec3> by_id(const std::vector<Vec3>& values, const ParticleStore& p) {
-  std::vector<Vec3> out;
-  for (const std::uint32_t i : id_order(p.id)) out.push_back(values[i]);
-  return out;
+  return in_id_order(values, p.id);
 }
 
 bool same_bits(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
@@ -350,6 +348,7 @@ TEST(StorageSort, PermuteMovesEveryFieldOfAParticleTogether) {
   }
   EXPECT_TRUE(p.is_fixed(0));  // old particle 2
   EXPECT_EQ(id_order(p.id), (std::vector<std::uint32_t>{1, 3, 0, 2}));
+  EXPECT_EQ(in_id_order(p.material, p.id), (std::vector<std::int32_t>{0, 1, 2, 3}));
 }
 
 }  // namespace

@@ -117,9 +117,7 @@ bool same_bytes(const std::vector<T>& a, const std::vector<T>& b) {
 // sorted at different steps (DemSetup::storage_sort_interval).
 template <typename T>
 std::vector<T> by_id(const std::vector<T>& values, const ParticleStore& p) {
-  std::vector<T> out;
-  for (const std::uint32_t i : id_order(p.id)) out.push_back(values[i]);
-  return out;
+  return in_id_order(values, p.id);
 }
 
 void expect_identical(const DemSimulation& a, const DemSimulation& b) {
