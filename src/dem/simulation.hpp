@@ -109,6 +109,15 @@ struct DemDiagnostics {
   std::int64_t mobile_particles = 0;          // the means' population (fixed ones excluded)
 };
 
+// A stretch of one block's sphere-pair group (positions [begin, end) in
+// BlockContacts::of(b)). `direct`: the contacts are consecutive in the pair list and
+// touch no shared particle, so the block sums them as the serial loop does, without the
+// per-contact shared-particle tests and index lookups (compute_forces).
+struct PairRun {
+  std::uint32_t begin = 0, end = 0;
+  bool direct = false;
+};
+
 // The contacts of one list grouped by thread block, each group in increasing contact
 // index (CSR layout).
 struct BlockContacts {
@@ -141,6 +150,8 @@ class DemSimulation {
   const BodyContactList& body_wall_contacts() const { return body_walls_; }
   TimeIntegrator& integrator() { return integrator_; }
   const NeighborSearch& neighbor_search() const { return search_; }
+  // How the thread blocks walk their sphere pairs (empty on one thread), for tests.
+  const std::vector<PairRun>& pair_runs() const { return pair_runs_; }
   int threads() const { return threads_; }  // threads in use (small systems run serially)
 
   DemDiagnostics diagnostics() const;
@@ -192,6 +203,7 @@ class DemSimulation {
   void rebuild_lists();
   void build_incidence();
   void build_blocks();
+  void build_pair_runs();
   void split_body_contacts();
   void pour_particles();
   void check_state() const;
@@ -230,6 +242,10 @@ class DemSimulation {
   BlockContacts block_pairs_, block_walls_, block_body_pairs_, block_body_walls_;
   std::vector<std::uint32_t> shared_list_;
   std::vector<std::uint8_t> shared_;
+  // The sphere-pair group of block b as runs pair_runs_[pair_run_offset_[b] ..
+  // pair_run_offset_[b + 1]), in order (build_pair_runs).
+  std::vector<PairRun> pair_runs_;
+  std::vector<std::uint32_t> pair_run_offset_;
   std::int64_t deep_contacts_ = 0;
   std::mt19937_64 pour_rng_;  // element contacts whose overlap exceeded the crusts
 };

@@ -5,6 +5,7 @@
 
 #include <omp.h>
 
+#include <algorithm>
 #include <cstring>
 #include <vector>
 
@@ -88,6 +89,13 @@ Snapshot run(int threads, IntegratorKind kind) {
   }
   EXPECT_GT(contacts_seen, 200);
   EXPECT_GT(sim.neighbor_search().rebuild_count(), 5);
+  if (threads > 1) {  // both ways of walking a slab's sphere pairs are exercised
+    const std::vector<PairRun>& runs = sim.pair_runs();
+    const auto direct =
+        std::count_if(runs.begin(), runs.end(), [](const PairRun& r) { return r.direct; });
+    EXPECT_GT(direct, 0) << threads << " threads";
+    EXPECT_LT(direct, static_cast<std::ptrdiff_t>(runs.size())) << threads << " threads";
+  }
   const ParticleStore& p = sim.particles();
   return {p.position, p.velocity, p.angular_velocity, p.force};
 }
