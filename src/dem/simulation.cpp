@@ -791,7 +791,10 @@ void particle_ranges(const std::vector<std::uint32_t>& first, std::size_t n,
 }  // namespace
 
 void DemSimulation::build_incidence() {
-  if (threads_ <= 1) return;
+  if (threads_ <= 1) {
+    pair_runs_.clear();  // the serial loop needs no slabs
+    return;
+  }
   // What the threaded gather reads (see compute_forces).
   const std::size_t n = setup_.particles.size();
   pair_incidence(pairs_.first, pairs_.second, n, incident_offset_, incident_, incident_fill_);

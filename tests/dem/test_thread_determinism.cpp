@@ -95,6 +95,15 @@ Snapshot run(int threads, IntegratorKind kind) {
         std::count_if(runs.begin(), runs.end(), [](const PairRun& r) { return r.direct; });
     EXPECT_GT(direct, 0) << threads << " threads";
     EXPECT_LT(direct, static_cast<std::ptrdiff_t>(runs.size())) << threads << " threads";
+    std::size_t covered = 0;  // the runs cover every sphere pair once
+    for (const PairRun& r : runs) {
+      EXPECT_LT(r.begin, r.end);
+      if (r.direct) {
+        EXPECT_GE(r.end - r.begin, 32u);
+      }
+      covered += r.end - r.begin;
+    }
+    EXPECT_EQ(covered, sim.particle_contacts().size()) << threads << " threads";
   }
   const ParticleStore& p = sim.particles();
   return {p.position, p.velocity, p.angular_velocity, p.force};
