@@ -359,6 +359,16 @@ void DemSimulation::compute_forces() {
   const std::size_t n_walls = walls_.size();
   double worst = 0.0;
   std::int64_t touching_pairs = 0, touching_walls = 0;
+  // A touching pair's outcome added to both particles.
+  const auto add_to_both = [f, tq, coord](const ContactOutcome& o, std::uint32_t i,
+                                          std::uint32_t j) {
+    f[i] += o.force;
+    f[j] -= o.force;
+    tq[i] += o.torque_first;
+    tq[j] += o.torque_second;
+    ++coord[i];
+    ++coord[j];
+  };
 
   if (threads_ <= 1) {
     // Serial: accumulate directly, contacts in list order.
@@ -367,12 +377,7 @@ void DemSimulation::compute_forces() {
     std::fill(p.coordination.begin(), p.coordination.end(), 0);
     const auto add_pair = [&](const ContactOutcome& o, std::uint32_t i, std::uint32_t j) {
       if (!o.touching) return;
-      f[i] += o.force;
-      f[j] -= o.force;
-      tq[i] += o.torque_first;
-      tq[j] += o.torque_second;
-      ++coord[i];
-      ++coord[j];
+      add_to_both(o, i, j);
       ++touching_pairs;
       deep += o.deep;
       worst = std::max(worst, o.overlap_ratio);
@@ -474,14 +479,7 @@ void DemSimulation::compute_forces() {
                 sphere_pairs, [k0](std::size_t e) { return k0 + e; }, count, lanes,
                 [&](std::size_t k, const ContactOutcome& o) {
                   tally(o, touching_pairs);
-                  if (!o.touching) return;
-                  const std::uint32_t i = pairs_.first[k], j = pairs_.second[k];
-                  f[i] += o.force;
-                  f[j] -= o.force;
-                  tq[i] += o.torque_first;
-                  tq[j] += o.torque_second;
-                  ++coord[i];
-                  ++coord[j];
+                  if (o.touching) add_to_both(o, pairs_.first[k], pairs_.second[k]);
                 });
           } else {
             const std::uint32_t* ks = block.data() + run.begin;
