@@ -2,7 +2,9 @@
 
 #include "core/parallel.hpp"
 
+#include <algorithm>
 #include <stdexcept>
+#include <type_traits>
 
 namespace sanguis::dem {
 
@@ -117,6 +119,19 @@ void resize_history(MultistepHistory& h, std::size_t n) {
   }
 }
 
+// body(i, all_spheres) for every particle; all_spheres is std::true_type when no particle
+// is a body, so `if (all_spheres || sphere[i])` folds away and the loop is the plain
+// sphere update (1.8x faster than with the test and the body branch beside it,
+// dem-spheres 2026-11-24), else std::false_type. Same operations, so the same bits.
+template <typename Body>
+void for_each_particle(std::size_t n, int threads, const std::uint8_t* sphere, Body&& body) {
+  if (std::find(sphere, sphere + n, std::uint8_t{0}) == sphere + n) {
+    parallel_for(n, threads, [&](std::size_t i) { body(i, std::true_type{}); });
+  } else {
+    parallel_for(n, threads, [&](std::size_t i) { body(i, std::false_type{}); });
+  }
+}
+
 // A fixed particle (zero inverse mass) feels no gravity either: it stays where it is.
 inline Vec3 gravity_on(double inverse_mass, const Vec3& gravity) {
   return inverse_mass != 0.0 ? gravity : Vec3{};
@@ -139,10 +154,10 @@ void TimeIntegrator::advance(ParticleStore& p, const Vec3& gravity, double dt) {
 
   switch (kind_) {
     case IntegratorKind::kForwardEuler:  // eq. 2.30
-      parallel_for(n, threads_, [&](std::size_t i) {
+      for_each_particle(n, threads_, sphere, [&](std::size_t i, auto all_spheres) {
         x[i] += dt * v[i];
         v[i] += dt * (inv_m[i] * f[i] + gravity_on(inv_m[i], gravity));
-        if (sphere[i]) {
+        if (all_spheres || sphere[i]) {
           w[i] += (dt * inv_j[i].x) * t[i];
         } else {
           rotate_first_order(q[i], w[i], t[i], j_body[i], inv_j[i], dt);
@@ -152,25 +167,27 @@ void TimeIntegrator::advance(ParticleStore& p, const Vec3& gravity, double dt) {
     case IntegratorKind::kLeapfrog: {  // eq. 2.31, kick-drift half
       half_velocity_.resize(n);
       half_angular_velocity_.resize(n);
-      parallel_for(n, threads_, [&](std::size_t i) {
+      Vec3* half_v = half_velocity_.data();
+      Vec3* half_w = half_angular_velocity_.data();
+      for_each_particle(n, threads_, sphere, [&](std::size_t i, auto all_spheres) {
         const Vec3 kick = (0.5 * dt) * (inv_m[i] * f[i] + gravity_on(inv_m[i], gravity));
-        half_velocity_[i] = v[i] + kick;
-        x[i] += dt * half_velocity_[i];
+        half_v[i] = v[i] + kick;
+        x[i] += dt * half_v[i];
         // The forces at x_{n+1} see the predicted v_{n+1} = v_n + dt a_n rather than
         // v_{n+1/2}: with velocity-dependent (damping) forces this keeps the scheme
         // second order (the half-step velocity makes it first order, see Fig. 2.5 report).
-        v[i] = half_velocity_[i] + kick;
-        if (sphere[i]) {
+        v[i] = half_v[i] + kick;
+        if (all_spheres || sphere[i]) {
           const Vec3 spin = (0.5 * dt * inv_j[i].x) * t[i];
-          half_angular_velocity_[i] = w[i] + spin;
-          w[i] = half_angular_velocity_[i] + spin;
+          half_w[i] = w[i] + spin;
+          w[i] = half_w[i] + spin;
         } else {
           // Half kick of the body-frame angular momentum, free rotation over dt (DLM), and
           // the predicted omega_{n+1} for the forces; finish() applies the second half kick.
           Vec3 lb = scale(j_body[i], rotate_inverse(q[i], w[i])) +
                     (0.5 * dt) * rotate_inverse(q[i], t[i]);
           free_rotation(q[i], lb, dt, inv_j[i]);
-          half_angular_velocity_[i] = lb;  // body-frame angular momentum L_{n+1/2}
+          half_w[i] = lb;  // body-frame angular momentum L_{n+1/2}
           const Vec3 lb_predicted = lb + (0.5 * dt) * rotate_inverse(q[i], t[i]);
           w[i] = rotate(q[i], scale(inv_j[i], lb_predicted));
         }
@@ -186,14 +203,14 @@ void TimeIntegrator::advance(ParticleStore& p, const Vec3& gravity, double dt) {
       }
       const int max_order = kind_ == IntegratorKind::kAdamsBashforth2 ? 2 : 3;
       const int order = std::min(max_order, h.depth + 1);
-      parallel_for(n, threads_, [&](std::size_t i) {
+      for_each_particle(n, threads_, sphere, [&](std::size_t i, auto all_spheres) {
         const Vec3 a = inv_m[i] * f[i] + gravity_on(inv_m[i], gravity);
         const Vec3 alpha = inv_j[i].x * t[i];  // spheres only; bodies below
         const Vec3 v_now = v[i];
         const Vec3 w_now = w[i];
         x[i] += ab_increment(order, dt, v_now, h.velocity[0][i], h.velocity[1][i]);
         v[i] += ab_increment(order, dt, a, h.acceleration[0][i], h.acceleration[1][i]);
-        if (sphere[i]) {
+        if (all_spheres || sphere[i]) {
           w[i] += ab_increment(order, dt, alpha, h.angular_acceleration[0][i],
                                h.angular_acceleration[1][i]);
         } else {
@@ -243,16 +260,24 @@ void TimeIntegrator::permute(std::span<const std::uint32_t> order) {
 void TimeIntegrator::finish(ParticleStore& p, const Vec3& gravity, double dt) {
   if (kind_ != IntegratorKind::kLeapfrog) return;
   const std::size_t n = p.size();
-  parallel_for(n, threads_, [&](std::size_t i) {  // final half kick with a_{n+1}
-    p.velocity[i] = half_velocity_[i] + (0.5 * dt) * (p.inverse_mass[i] * p.force[i] +
-                                                      gravity_on(p.inverse_mass[i], gravity));
-    if (p.spherical[i]) {
-      p.angular_velocity[i] =
-          half_angular_velocity_[i] + (0.5 * dt * p.inverse_inertia_body[i].x) * p.torque[i];
+  Vec3* v = p.velocity.data();
+  Vec3* w = p.angular_velocity.data();
+  const Vec3* f = p.force.data();
+  const Vec3* t = p.torque.data();
+  const double* inv_m = p.inverse_mass.data();
+  const Vec3* inv_j = p.inverse_inertia_body.data();
+  const Quaternion* q = p.orientation.data();
+  const Vec3* half_v = half_velocity_.data();
+  const Vec3* half_w = half_angular_velocity_.data();
+  const std::uint8_t* sphere = p.spherical.data();
+  // The final half kick with a_{n+1}.
+  for_each_particle(n, threads_, sphere, [&](std::size_t i, auto all_spheres) {
+    v[i] = half_v[i] + (0.5 * dt) * (inv_m[i] * f[i] + gravity_on(inv_m[i], gravity));
+    if (all_spheres || sphere[i]) {
+      w[i] = half_w[i] + (0.5 * dt * inv_j[i].x) * t[i];
     } else {
-      const Quaternion& q = p.orientation[i];
-      const Vec3 lb = half_angular_velocity_[i] + (0.5 * dt) * rotate_inverse(q, p.torque[i]);
-      p.angular_velocity[i] = rotate(q, scale(p.inverse_inertia_body[i], lb));
+      const Vec3 lb = half_w[i] + (0.5 * dt) * rotate_inverse(q[i], t[i]);
+      w[i] = rotate(q[i], scale(inv_j[i], lb));
     }
   });
 }
