@@ -166,6 +166,36 @@ def run_gate_seed(exe, gate, seed, threads, reuse):
     return pour, out, table31
 
 
+def storage_sort_of(run):
+    """The storage sort a run used, as its run.log states it ("along space every N
+    steps", "off"), or None for a run made before the sort existed (2026-11-23)."""
+    path = os.path.join(run, "run.log")
+    if not os.path.exists(path):
+        return None
+    for line in open(path):
+        if line.startswith("storage sort"):
+            return line[len("storage sort"):].strip()
+    return None
+
+
+def storage_note(gate, seeds):
+    """Which pours of one gate ran before the particle storage sort (their bits come back
+    with storage_sort_steps = 0) and which with it."""
+    groups = {}
+    for seed in seeds:
+        pour, out, _ = folders(gate, seed)
+        groups.setdefault(storage_sort_of(out) or storage_sort_of(pour), []).append(seed)
+    if None not in groups and len(groups) == 1:
+        return None  # every pour with the same sort: nothing to tell apart
+    parts = []
+    for setting, group in groups.items():
+        names = f"seed{'s' if len(group) > 1 else ''} {', '.join(str(x) for x in group)}"
+        parts.append(f"{names} ran before the particle storage sort (the code gives them bit "
+                     "for bit with `--set simulation.storage_sort_steps=0`)" if setting is None
+                     else f"{names} with the storage sort ({setting})")
+    return f"Gate {gate} cm: " + "; ".join(parts) + "."
+
+
 def seeds_note(gate, seeds, summaries):
     """What the pours of one gate show together (more than one seed)."""
     ks = [s["runout_ratio"] / s["aspect_ratio_H0_over_L0"] for s in summaries]
@@ -274,6 +304,10 @@ def main():
         for gate in args.gates:
             notes.append(seeds_note(gate, args.seeds,
                                     [summaries[(gate, x)][0] for x in args.seeds]))
+    for gate in args.gates:
+        note = storage_note(gate, args.seeds)
+        if note:
+            notes.append(note)
     if reference:
         rows.append(run_row("4 (calibration run)", CROSSES[4], reference, "—", None))
     notes.append("The parameters were fitted on the 4 cm gate only (crosses_recalibrated); "
@@ -313,7 +347,7 @@ def main():
     a1.set_xlabel(r"$a = H_0/L_0$")
     a1.set_ylabel(r"$(L_\infty - L_0)/L_0$")
     a1.set_title(f"kt {KT:g} N/m, γt {GAMMA_T:g} 1/s", fontsize=9)
-    a1.legend(fontsize=8)
+    a1.legend(fontsize=8, loc="upper left")  # the 8 cm points sit bottom right
     draw_velocity_bands(a2)
     fig.tight_layout()
     fig.savefig(FIGURE, dpi=130)
