@@ -132,6 +132,33 @@ void for_each_particle(std::size_t n, int threads, const std::uint8_t* sphere, B
   }
 }
 
+// Plain pointers to the per-particle arrays the integrators use, taken once per pass.
+struct MotionArrays {
+  Vec3* x;
+  Vec3* v;
+  Vec3* w;
+  Quaternion* q;
+  const Vec3* f;
+  const Vec3* t;
+  const double* inv_m;
+  const Vec3* inv_j;
+  const Vec3* j_body;
+  const std::uint8_t* sphere;
+};
+
+MotionArrays motion_arrays(ParticleStore& p) {
+  return {p.position.data(),
+          p.velocity.data(),
+          p.angular_velocity.data(),
+          p.orientation.data(),
+          p.force.data(),
+          p.torque.data(),
+          p.inverse_mass.data(),
+          p.inverse_inertia_body.data(),
+          p.inertia_body.data(),
+          p.spherical.data()};
+}
+
 // A fixed particle (zero inverse mass) feels no gravity either: it stays where it is.
 inline Vec3 gravity_on(double inverse_mass, const Vec3& gravity) {
   return inverse_mass != 0.0 ? gravity : Vec3{};
@@ -141,16 +168,7 @@ inline Vec3 gravity_on(double inverse_mass, const Vec3& gravity) {
 
 void TimeIntegrator::advance(ParticleStore& p, const Vec3& gravity, double dt) {
   const std::size_t n = p.size();
-  Vec3* x = p.position.data();
-  Vec3* v = p.velocity.data();
-  Vec3* w = p.angular_velocity.data();
-  const Vec3* f = p.force.data();
-  const Vec3* t = p.torque.data();
-  const double* inv_m = p.inverse_mass.data();
-  const Vec3* inv_j = p.inverse_inertia_body.data();
-  const Vec3* j_body = p.inertia_body.data();
-  const std::uint8_t* sphere = p.spherical.data();
-  Quaternion* q = p.orientation.data();
+  const auto [x, v, w, q, f, t, inv_m, inv_j, j_body, sphere] = motion_arrays(p);
 
   switch (kind_) {
     case IntegratorKind::kForwardEuler:  // eq. 2.30
@@ -260,16 +278,9 @@ void TimeIntegrator::permute(std::span<const std::uint32_t> order) {
 void TimeIntegrator::finish(ParticleStore& p, const Vec3& gravity, double dt) {
   if (kind_ != IntegratorKind::kLeapfrog) return;
   const std::size_t n = p.size();
-  Vec3* v = p.velocity.data();
-  Vec3* w = p.angular_velocity.data();
-  const Vec3* f = p.force.data();
-  const Vec3* t = p.torque.data();
-  const double* inv_m = p.inverse_mass.data();
-  const Vec3* inv_j = p.inverse_inertia_body.data();
-  const Quaternion* q = p.orientation.data();
+  const auto [x, v, w, q, f, t, inv_m, inv_j, j_body, sphere] = motion_arrays(p);
   const Vec3* half_v = half_velocity_.data();
   const Vec3* half_w = half_angular_velocity_.data();
-  const std::uint8_t* sphere = p.spherical.data();
   // The final half kick with a_{n+1}.
   for_each_particle(n, threads_, sphere, [&](std::size_t i, auto all_spheres) {
     v[i] = half_v[i] + (0.5 * dt) * (inv_m[i] * f[i] + gravity_on(inv_m[i], gravity));
