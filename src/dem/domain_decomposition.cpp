@@ -151,9 +151,9 @@ class IdIndex {
 };
 
 // Storage order: (sort key, id), as one process sorts (DemSimulation::rebuild_sorted).
-bool stored_before(const SlabDecomposition::ParticleRecord& a,
-                   const SlabDecomposition::ParticleRecord& b) {
-  return a.sort_key != b.sort_key ? a.sort_key < b.sort_key : a.id < b.id;
+bool record_stored_before(const SlabDecomposition::ParticleRecord& a,
+                          const SlabDecomposition::ParticleRecord& b) {
+  return stored_before(a.sort_key, a.id, b.sort_key, b.id);
 }
 
 }  // namespace
@@ -370,7 +370,7 @@ void SlabDecomposition::redistribute(DemSimulation& simulation) {
 void SlabDecomposition::exchange_ghosts(DemSimulation& simulation,
                                         std::vector<ParticleRecord> owned,
                                         std::vector<ContactMemory> contacts) {
-  std::sort(owned.begin(), owned.end(), stored_before);
+  std::sort(owned.begin(), owned.end(), record_stored_before);
   std::vector<std::vector<ParticleRecord>> buckets(static_cast<std::size_t>(ranks_));
   for (auto& list : send_lists_) list.clear();
   std::vector<std::vector<std::int64_t>> sent_ids(static_cast<std::size_t>(ranks_));
@@ -392,7 +392,7 @@ void SlabDecomposition::exchange_ghosts(DemSimulation& simulation,
   std::vector<std::size_t> order(all.size());
   std::iota(order.begin(), order.end(), 0);
   std::sort(order.begin(), order.end(),
-            [&](std::size_t a, std::size_t b) { return stored_before(all[a], all[b]); });
+            [&](std::size_t a, std::size_t b) { return record_stored_before(all[a], all[b]); });
 
   ParticleStore store;
   std::vector<std::uint8_t> ghost;
@@ -469,7 +469,7 @@ std::vector<SlabDecomposition::ParticleRecord> SlabDecomposition::gather_records
   for (auto& from : all_to_all(comm_, buckets, ignored)) {
     all.insert(all.end(), from.begin(), from.end());
   }
-  std::sort(all.begin(), all.end(), stored_before);
+  std::sort(all.begin(), all.end(), record_stored_before);
   return all;
 }
 

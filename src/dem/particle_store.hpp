@@ -78,6 +78,13 @@ void apply_order(std::vector<T>& values, std::span<const std::uint32_t> order) {
   permute_in_place(values, order, visited);
 }
 
+// The storage order of particles: by sort key, then by id. One process sorts into it
+// (DemSimulation::rebuild_sorted); the processes of a decomposed run keep it.
+inline bool stored_before(std::uint64_t key_a, std::int64_t id_a, std::uint64_t key_b,
+                          std::int64_t id_b) {
+  return key_a != key_b ? key_a < key_b : id_a < id_b;
+}
+
 // Storage indices in increasing id order: 0, 1, 2, ... when the ids increase with the
 // index, else sorted by id (outputs list particles by id whatever the storage order).
 std::vector<std::uint32_t> id_order(const std::vector<std::int64_t>& id);

@@ -633,7 +633,7 @@ void DemSimulation::rebuild_sorted() {
   std::vector<std::uint32_t> order(p.size());
   std::iota(order.begin(), order.end(), 0u);
   std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
-    return p.sort_key[a] != p.sort_key[b] ? p.sort_key[a] < p.sort_key[b] : p.id[a] < p.id[b];
+    return stored_before(p.sort_key[a], p.id[a], p.sort_key[b], p.id[b]);
   });
   p.permute(order);
   integrator_.permute(order);
@@ -1054,7 +1054,7 @@ void DemSimulation::replace_particles(ParticleStore particles, std::vector<std::
     // Pairs are oriented by local index; the (sort key, id) order orients them as one
     // process would.
     const auto& key = particles.sort_key;
-    if (key[i] < key[i - 1] || (key[i] == key[i - 1] && particles.id[i] <= particles.id[i - 1])) {
+    if (!stored_before(key[i - 1], particles.id[i - 1], key[i], particles.id[i])) {
       throw std::invalid_argument(
           "replace_particles: particles not in increasing (sort key, id) order");
     }

@@ -161,8 +161,8 @@ class DemSimulation {
   // Loads a checkpoint written by a simulation built from the same setup.
   void load_checkpoint(const std::filesystem::path& file);
 
-  // Sorts the particles along space now (what the run does at the first list rebuild of
-  // every storage_sort_interval steps): new keys, storage in (key, id) order, lists
+  // Sorts the particles along space now (what the run does every storage_sort_interval
+  // steps): new keys, storage in (key, id) order, lists
   // rebuilt, every memory carried over. One process only (a decomposed run sorts as it
   // exchanges particles). Local indices change: find particles by id.
   void sort_storage();
