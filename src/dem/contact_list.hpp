@@ -35,6 +35,8 @@ struct ContactList {
     second.push_back(b);
     history.push_back(h);
   }
+  // Sort key (first, second) as one number.
+  std::uint64_t key(std::size_t k) const { return (std::uint64_t{first[k]} << 32) | second[k]; }
 };
 
 // Copies the histories of `previous` into `fresh` for the keys present in both.
@@ -43,11 +45,9 @@ inline void carry_history(const ContactList& previous, ContactList& fresh) {
   std::size_t p = 0;
   const std::size_t np = previous.size();
   for (std::size_t k = 0; k < fresh.size() && p < np; ++k) {
-    const std::uint64_t key = (std::uint64_t{fresh.first[k]} << 32) | fresh.second[k];
-    while (p < np && ((std::uint64_t{previous.first[p]} << 32) | previous.second[p]) < key) ++p;
-    if (p < np && ((std::uint64_t{previous.first[p]} << 32) | previous.second[p]) == key) {
-      fresh.history[k] = previous.history[p];
-    }
+    const std::uint64_t key = fresh.key(k);
+    while (p < np && previous.key(p) < key) ++p;
+    if (p < np && previous.key(p) == key) fresh.history[k] = previous.history[p];
   }
 }
 
@@ -165,17 +165,10 @@ void renumber(List& list, std::span<const std::uint32_t> new_index, bool pair_li
     list.first[k] = a;
     list.second[k] = b;
   }
-  const auto key = [&](std::uint32_t k) {
-    std::uint32_t elements = 0;
-    if constexpr (kBodies) {
-      elements = (std::uint32_t{list.element_first[k]} << 16) | list.element_second[k];
-    }
-    return std::pair{(std::uint64_t{list.first[k]} << 32) | list.second[k], elements};
-  };
   std::vector<std::uint32_t> order(n);
   for (std::size_t k = 0; k < n; ++k) order[k] = static_cast<std::uint32_t>(k);
   std::sort(order.begin(), order.end(),
-            [&](std::uint32_t x, std::uint32_t y) { return key(x) < key(y); });
+            [&](std::uint32_t x, std::uint32_t y) { return list.key(x) < list.key(y); });
   std::vector<std::uint8_t> visited;
   permute_in_place(list.first, order, visited);
   permute_in_place(list.second, order, visited);

@@ -80,15 +80,20 @@ bool NeighborSearch::has_bodies(const ParticleStore& particles) {
   return false;
 }
 
-std::int64_t NeighborSearch::cell_of(const Vec3& x) const {
-  std::int64_t index[3];
+std::array<std::int64_t, 3> NeighborSearch::cell_coordinates(const Vec3& x) const {
+  std::array<std::int64_t, 3> index{};
   for (int k = 0; k < 3; ++k) {
     const auto ku = static_cast<std::size_t>(k);
     double c = std::floor((x[k] - domain_.min[k]) / cell_size_[k]);
     // Outside a closed domain: clamp into the boundary cell (safe, see README).
     c = std::clamp(c, 0.0, static_cast<double>(cells_[ku] - 1));
-    index[k] = static_cast<std::int64_t>(c);
+    index[ku] = c >= 0.0 ? static_cast<std::int64_t>(c) : 0;  // NaN: a blown-up particle
   }
+  return index;
+}
+
+std::int64_t NeighborSearch::cell_of(const Vec3& x) const {
+  const std::array<std::int64_t, 3> index = cell_coordinates(x);
   return (index[2] * cells_[1] + index[1]) * cells_[0] + index[0];
 }
 
@@ -114,15 +119,9 @@ std::vector<std::uint64_t> NeighborSearch::space_keys(const ParticleStore& parti
   for (std::size_t i = 0; i < particles.size(); ++i) {
     Vec3 x = particles.position[i];
     domain_.wrap(x);  // as the list build will
-    std::uint64_t c[3];
-    for (std::size_t k = 0; k < 3; ++k) {
-      const double cell =
-          std::clamp(std::floor((x[static_cast<int>(k)] - domain_.min[static_cast<int>(k)]) /
-                                cell_size_[static_cast<int>(k)]),
-                     0.0, static_cast<double>(cells_[k] - 1));
-      c[k] = cell >= 0.0 ? static_cast<std::uint64_t>(cell) : 0;  // NaN: a blown-up particle
-    }
-    keys[i] = (c[along] << 42) | interleave(c[u], c[v]);
+    const std::array<std::int64_t, 3> c = cell_coordinates(x);
+    const auto cell = [&c](std::size_t k) { return static_cast<std::uint64_t>(c[k]); };
+    keys[i] = (cell(along) << 42) | interleave(cell(u), cell(v));
   }
   return keys;
 }

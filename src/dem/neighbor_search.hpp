@@ -3,6 +3,7 @@
 // cut-off (largest diameter + skin) wide, building Verlet lists of particle pairs
 // and particle-obstacle pairs within cut-off + skin. Lists are rebuilt only when
 // some particle has moved more than half the skin since the last build.
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -52,6 +53,8 @@ class NeighborSearch {
  private:
   void bin(const ParticleStore& particles);
   std::int64_t cell_of(const Vec3& x) const;
+  // The cell of x along each axis, clamped into the grid (a NaN coordinate gives 0).
+  std::array<std::int64_t, 3> cell_coordinates(const Vec3& x) const;
   double obstacle_travel(const Obstacle& o, double t0, double t1) const;
   static bool has_bodies(const ParticleStore& particles);
 
