@@ -171,10 +171,6 @@ io::PolyMesh obstacle_mesh(const DemSetup& s, double time) {
   return mesh;
 }
 
-bool has_non_spherical(const ParticleStore& p) {
-  return std::any_of(p.spherical.begin(), p.spherical.end(), [](std::uint8_t s) { return s == 0; });
-}
-
 // Whether the run has (or will have, by pouring) non-spherical particles: then it
 // writes bodies.pvd from its first frame, so that every particle frame has its
 // body surfaces.

@@ -53,9 +53,6 @@ io::PointCloud particle_cloud(const ParticleStore& p);
 // domain's diagonal centred on the domain centre's projection. Cell data `obstacle`.
 io::PolyMesh obstacle_mesh(const DemSetup& s, double time);
 
-// True when some particle is not a sphere (the run then writes body surfaces).
-bool has_non_spherical(const ParticleStore& p);
-
 // The particles the simulation owns (all of them when it runs alone).
 ParticleStore owned_particles(const DemSimulation& sim);
 

@@ -73,13 +73,6 @@ bool NeighborSearch::needs_rebuild(const ParticleStore& particles, int threads) 
   return parallel_any(n, threads, moved_too_far);
 }
 
-bool NeighborSearch::has_bodies(const ParticleStore& particles) {
-  for (std::uint8_t s : particles.spherical) {
-    if (!s) return true;
-  }
-  return false;
-}
-
 std::array<std::int64_t, 3> NeighborSearch::cell_coordinates(const Vec3& x) const {
   std::array<std::int64_t, 3> index{};
   for (int k = 0; k < 3; ++k) {
@@ -217,7 +210,7 @@ void NeighborSearch::rebuild(ParticleStore& particles, const std::vector<Obstacl
   std::swap(walls, scratch_);
 
   reference_ = particles.position;
-  if (has_bodies(particles)) {
+  if (has_non_spherical(particles)) {
     reference_orientation_ = particles.orientation;
   } else {
     reference_orientation_.clear();

@@ -56,7 +56,6 @@ class NeighborSearch {
   // The cell of x along each axis, clamped into the grid (a NaN coordinate gives 0).
   std::array<std::int64_t, 3> cell_coordinates(const Vec3& x) const;
   double obstacle_travel(const Obstacle& o, double t0, double t1) const;
-  static bool has_bodies(const ParticleStore& particles);
 
   Domain domain_;
   double skin_ = 0.0;

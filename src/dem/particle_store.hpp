@@ -3,6 +3,7 @@
 // indexed by the particle's local index, so that kernels stream through memory.
 // Spheres and rigid bodies of any shape: a body carries an orientation and its
 // principal moments of inertia (body frame = principal axes, origin = centroid).
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -76,6 +77,11 @@ void apply_order(std::vector<T>& values, std::span<const std::uint32_t> order) {
   }
   std::vector<std::uint8_t> visited;
   permute_in_place(values, order, visited);
+}
+
+// True when some particle is not a sphere (a rigid body of elements).
+inline bool has_non_spherical(const ParticleStore& p) {
+  return std::find(p.spherical.begin(), p.spherical.end(), std::uint8_t{0}) != p.spherical.end();
 }
 
 // The storage order of particles: by sort key, then by id. One process sorts into it

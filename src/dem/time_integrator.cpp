@@ -124,8 +124,9 @@ void resize_history(MultistepHistory& h, std::size_t n) {
 // sphere update (1.8x faster than with the test and the body branch beside it,
 // dem-spheres 2026-11-24), else std::false_type. Same operations, so the same bits.
 template <typename Body>
-void for_each_particle(std::size_t n, int threads, const std::uint8_t* sphere, Body&& body) {
-  if (std::find(sphere, sphere + n, std::uint8_t{0}) == sphere + n) {
+void for_each_particle(const ParticleStore& p, int threads, Body&& body) {
+  const std::size_t n = p.size();
+  if (!has_non_spherical(p)) {
     parallel_for(n, threads, [&](std::size_t i) { body(i, std::true_type{}); });
   } else {
     parallel_for(n, threads, [&](std::size_t i) { body(i, std::false_type{}); });
@@ -172,7 +173,7 @@ void TimeIntegrator::advance(ParticleStore& p, const Vec3& gravity, double dt) {
 
   switch (kind_) {
     case IntegratorKind::kForwardEuler:  // eq. 2.30
-      for_each_particle(n, threads_, sphere, [&](std::size_t i, auto all_spheres) {
+      for_each_particle(p, threads_, [&](std::size_t i, auto all_spheres) {
         x[i] += dt * v[i];
         v[i] += dt * (inv_m[i] * f[i] + gravity_on(inv_m[i], gravity));
         if (all_spheres || sphere[i]) {
@@ -187,7 +188,7 @@ void TimeIntegrator::advance(ParticleStore& p, const Vec3& gravity, double dt) {
       half_angular_velocity_.resize(n);
       Vec3* half_v = half_velocity_.data();
       Vec3* half_w = half_angular_velocity_.data();
-      for_each_particle(n, threads_, sphere, [&](std::size_t i, auto all_spheres) {
+      for_each_particle(p, threads_, [&](std::size_t i, auto all_spheres) {
         const Vec3 kick = (0.5 * dt) * (inv_m[i] * f[i] + gravity_on(inv_m[i], gravity));
         half_v[i] = v[i] + kick;
         x[i] += dt * half_v[i];
@@ -221,7 +222,7 @@ void TimeIntegrator::advance(ParticleStore& p, const Vec3& gravity, double dt) {
       }
       const int max_order = kind_ == IntegratorKind::kAdamsBashforth2 ? 2 : 3;
       const int order = std::min(max_order, h.depth + 1);
-      for_each_particle(n, threads_, sphere, [&](std::size_t i, auto all_spheres) {
+      for_each_particle(p, threads_, [&](std::size_t i, auto all_spheres) {
         const Vec3 a = inv_m[i] * f[i] + gravity_on(inv_m[i], gravity);
         const Vec3 alpha = inv_j[i].x * t[i];  // spheres only; bodies below
         const Vec3 v_now = v[i];
@@ -277,12 +278,11 @@ void TimeIntegrator::permute(std::span<const std::uint32_t> order) {
 
 void TimeIntegrator::finish(ParticleStore& p, const Vec3& gravity, double dt) {
   if (kind_ != IntegratorKind::kLeapfrog) return;
-  const std::size_t n = p.size();
   const auto [x, v, w, q, f, t, inv_m, inv_j, j_body, sphere] = motion_arrays(p);
   const Vec3* half_v = half_velocity_.data();
   const Vec3* half_w = half_angular_velocity_.data();
   // The final half kick with a_{n+1}.
-  for_each_particle(n, threads_, sphere, [&](std::size_t i, auto all_spheres) {
+  for_each_particle(p, threads_, [&](std::size_t i, auto all_spheres) {
     v[i] = half_v[i] + (0.5 * dt) * (inv_m[i] * f[i] + gravity_on(inv_m[i], gravity));
     if (all_spheres || sphere[i]) {
       w[i] = half_w[i] + (0.5 * dt * inv_j[i].x) * t[i];
