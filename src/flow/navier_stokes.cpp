@@ -36,6 +36,55 @@ inline double bcg_face_value(const double* f, double source, double un, double d
   return value;
 }
 
+/// h^2 times the transverse Laplacian, at the d-face below cell c, of the
+/// cell-centred point values g(q): the mean of the two cells' second
+/// differences across the face's two tangential directions. The mean of a
+/// smooth field over a face of side h is its centre value plus 1/24 of this.
+template <typename Values>
+inline double transverse_second_differences(Values&& g, int d, std::ptrdiff_t c, const Strides& s) {
+  const std::ptrdiff_t lo = c - s[D(d)];
+  double sum = 0.0;
+  for (int t = 0; t < 3; ++t) {
+    if (t == d) continue;
+    const std::ptrdiff_t st = s[D(t)];
+    sum += (g(c + st) - 2.0 * g(c) + g(c - st)) + (g(lo + st) - 2.0 * g(lo) + g(lo - st));
+  }
+  return 0.5 * sum;
+}
+
+/// Mean over the d-face below cell c of the cell-centred field f, to O(h^4):
+/// the cubic through the four cells along d, plus the transverse correction.
+/// A coarse face beside finer blocks takes the mean of the fine faces (the
+/// fine faces win), which is a face mean; the plain average of two cells is
+/// a point value, O(h^2) off the face mean, and the difference divided by h
+/// left an O(h) divergence in the coarse cells along every coarse-fine face
+/// (issue #7). Needs two ghost layers along d, one across.
+/// `cubic` false: the plain average along d; `transverse` false: no correction.
+inline double face_mean(const double* f, int d, std::ptrdiff_t c, const Strides& s, bool cubic,
+                        bool transverse) {
+  const std::ptrdiff_t n = s[D(d)];
+  const double along = cubic ? (9.0 * (f[c] + f[c - n]) - (f[c + n] + f[c - 2 * n])) / 16.0
+                             : 0.5 * (f[c] + f[c - n]);
+  if (!transverse) return along;
+  return along +
+         transverse_second_differences([f](std::ptrdiff_t q) { return f[q]; }, d, c, s) / 24.0;
+}
+
+/// Whether every cell of face_mean's stencil at the d-face below c is fluid
+/// (solid cells hold u = 0, not a smooth extension of the flow).
+inline bool face_mean_stencil_is_fluid(const double* solid, int d, std::ptrdiff_t c,
+                                       const Strides& s) {
+  const std::ptrdiff_t n = s[D(d)];
+  for (std::ptrdiff_t q : {c - 2 * n, c - n, c, c + n})
+    if (solid[q] != 0.0) return false;
+  for (int t = 0; t < 3; ++t) {
+    if (t == d) continue;
+    for (std::ptrdiff_t q : {c + s[D(t)], c - s[D(t)], c - n + s[D(t)], c - n - s[D(t)]})
+      if (solid[q] != 0.0) return false;
+  }
+  return true;
+}
+
 /// Viscosity on the face between two cells: the harmonic mean, so that a
 /// viscosity jump on a face passes the shear stress exactly (layered Couette).
 inline double face_viscosity(double left, double right) {
@@ -352,7 +401,7 @@ void NavierStokes::sample_solid() {
     });
   }
   has_solids_ = forest_.max(any ? 1.0 : 0.0) > 0.0;
-  fill_scalar_neumann(solid_, 1);
+  fill_scalar_neumann(solid_, 2);  // face_mean's stencil reaches two cells out
   forest_.for_each_block([&](int blk) {
     const BlockLayout L = solid_.layout();
     const double* sb = solid_.block(blk);
@@ -514,7 +563,18 @@ void NavierStokes::set_boundary_faces(FaceField& uf) const {
               Vec3 x{};
               for (int e = 0; e < 3; ++e) x[e] = block.lower[e] + (idx[D(e)] + 0.5) * h;
               x[d] = block.lower[d] + idx[D(d)] * h;
+              // The face mean of the profile, as face_mean gives the
+              // interior faces (its centre value plus the transverse correction).
               value = fb.inflow(x, bc_time_)[d];
+              double second_differences = 0.0;
+              for (int t = 0; t < 3; ++t) {
+                if (t == d) continue;
+                Vec3 step{};
+                step[t] = h;
+                second_differences += fb.inflow(x + step, bc_time_)[d] - 2.0 * value +
+                                      fb.inflow(x - step, bc_time_)[d];
+              }
+              value += second_differences / 24.0;
             }
             uf[D(d)](blk, idx[0], idx[1], idx[2]) = value;
           }
@@ -604,7 +664,8 @@ void NavierStokes::predict_face_velocity(double dt) {
 
 void NavierStokes::advect(double dt) {
   for (int comp = 0; comp < 3; ++comp) {
-    advect_field(u_[D(comp)], &g_[D(comp)], velocity_bc_[D(comp)].kind, scratch_[D(comp)], dt);
+    advect_field(u_[D(comp)], &g_[D(comp)], velocity_bc_[D(comp)].kind, true, scratch_[D(comp)],
+                 dt);
   }
 }
 
@@ -618,7 +679,7 @@ void NavierStokes::advect_scalar(BlockField& c, double dt) {
   fill_face_ghosts(uf_);
   set_boundary_faces(uf_);
   BlockField out(forest_.local_blocks(), forest_.block_cells());
-  advect_field(c, nullptr, uniform_kinds(forest_, BcKind::Neumann), out, dt);
+  advect_field(c, nullptr, uniform_kinds(forest_, BcKind::Neumann), false, out, dt);
   const int b = forest_.block_cells();
   forest_.for_each_block([&](int blk) {
     for_each_cell(b, [&](int i, int j, int k) { c(blk, i, j, k) = out(blk, i, j, k); });
@@ -676,7 +737,8 @@ void NavierStokes::update_from_face_fluxes(BlockFluxes&& block_fluxes, UpperFlux
 }
 
 void NavierStokes::advect_field(const BlockField& field, const BlockField* source,
-                                const std::array<BcKind, 6>& kinds, BlockField& out, double dt) {
+                                const std::array<BcKind, 6>& kinds, bool face_mean_fluxes,
+                                BlockField& out, double dt) {
   const int b = forest_.block_cells();
   const BlockLayout L = field.layout();
   const Strides s{L.stride(0), L.stride(1), L.stride(2)};
@@ -704,7 +766,19 @@ void NavierStokes::advect_field(const BlockField& field, const BlockField* sourc
           source ? 0.25 * dt * (source->block(blk)[c] + source->block(blk)[c - s[D(d)]]) : 0.0;
       value = bcg_face_value(f, src, un, dt, h, d, c, s, vt);
     }
-    return value * un;
+    double flux = value * un;
+    // The face mean of the flux (see face_mean): the transverse correction of
+    // f u_d from the cell values, on open faces whose normal velocity is not
+    // prescribed by a boundary.
+    const bool boundary = (n == 0 && dirichlet_lo) || (n == b && dirichlet_hi);
+    if (face_mean_fluxes && !boundary && open_[D(d)].block(blk)[c] != 0.0 &&
+        (!has_solids_ || face_mean_stencil_is_fluid(solid_.block(blk), d, c, s))) {
+      const double* ud = u_[D(d)].block(blk);
+      flux += transverse_second_differences([f, ud](std::ptrdiff_t q) { return f[q] * ud[q]; }, d,
+                                            c, s) /
+              24.0;
+    }
+    return flux;
   };
   // Fluxes of all faces 0..b of one block along d into fl.
   auto block_fluxes = [&](int blk, int d, double* fl) {
@@ -924,16 +998,40 @@ void NavierStokes::viscous_step(double dt, StepReport& report) {
 
 void NavierStokes::face_average_plus_acceleration(double dt) {
   const int b = forest_.block_cells();
-  fill_velocity_ghosts(u_, 1);
+  fill_velocity_ghosts(u_, 2);
+  const BlockLayout L = u_[0].layout();
+  const Strides s{L.stride(0), L.stride(1), L.stride(2)};
   forest_.for_each_block([&](int blk) {
+    const Block& block = forest_.block(blk);
+    const double* solid = solid_.block(blk);
     for (int d = 0; d < 3; ++d) {
-      const std::ptrdiff_t s = u_[0].layout().stride(d);
+      // u here lacks the pressure gradient (u* of the projection), so it
+      // breaks its own wall condition by dt g: the ghosts of a wall or an
+      // inflow, closed on the wall value, make a kink there. face_mean's
+      // stencil stays off them: the plain average along d within two cells
+      // of such a face, no transverse correction in the cells beside one.
+      std::array<bool, 6> prescribed{};
+      for (int f = 0; f < 6; ++f) {
+        prescribed[D(f)] =
+            on_boundary(block, f / 2, f % 2) && velocity_bc_[D(d)].kind[D(f)] == BcKind::Dirichlet;
+      }
       const double* u = u_[D(d)].block(blk);
       const double* a = accel_[D(d)].block(blk);
       double* out = uf_[D(d)].block(blk);
       for_each_face(b, d, [&](int i, int j, int k) {
-        const std::ptrdiff_t c = u_[0].layout().index(i, j, k);
-        out[c] = 0.5 * (u[c] + u[c - s]) + dt * a[c];
+        const std::array<int, 3> n{i, j, k};
+        const std::ptrdiff_t c = L.index(i, j, k);
+        bool normal = !(n[D(d)] <= 1 && prescribed[D(face_index(d, 0))]) &&
+                      !(n[D(d)] >= b - 1 && prescribed[D(face_index(d, 1))]);
+        bool transverse = true;
+        for (int t = 0; t < 3; ++t) {
+          if (t == d) continue;
+          transverse = transverse && !(n[D(t)] == 0 && prescribed[D(face_index(t, 0))]) &&
+                       !(n[D(t)] == b - 1 && prescribed[D(face_index(t, 1))]);
+        }
+        // Beside solids (u = 0 in them) the plain average; the closure follows.
+        if (has_solids_ && !face_mean_stencil_is_fluid(solid, d, c, s)) normal = transverse = false;
+        out[c] = face_mean(u, d, c, s, normal, transverse) + dt * a[c];
       });
     }
   });

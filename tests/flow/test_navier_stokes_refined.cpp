@@ -225,17 +225,20 @@ TEST(FlowRefinedNavierStokes, TaylorGreenWithARefinedCentreConvergesAtSecondOrde
   // for the max, 2.04 for the RMS error).
   EXPECT_GT(std::log2(refined.max / refined2.max), 1.8);
   EXPECT_GT(std::log2(refined.rms / refined2.rms), 1.8);
-  // Not better than the uniform coarse grid (issue #7, open): the
-  // approximate projection of the cell-centred velocity is not exact at
-  // coarse-fine faces (the face average of a coarse cell and the mean of the
-  // fine faces across differ by O(h^2) u'', a layer of O(h) divergence whose
-  // O(h^2) pressure correction exceeds the coarse grid's own error; the
-  // exact Taylor-Green field, divergence-free to the last bit on a uniform
-  // grid, is already changed by 1.4e-3 by the first projection). Measured
-  // 7.5x the coarse max error and 3.4x its RMS error; these bounds hold the
-  // measurement so that a regression shows, they are not a target.
-  EXPECT_LT(refined.max, 9.0 * coarse.max);
-  EXPECT_LT(refined.rms, 4.0 * coarse.rms);
+  // Not better than the uniform coarse grid (issue #7, open). The face
+  // velocities of the projection and the momentum fluxes are face means
+  // (face_mean), so a coarse face taking the mean of the fine faces across
+  // agrees with the coarse cell's other faces to O(h^4); with point values
+  // (the plain average of two cells) they differed by O(h^2), an O(h)
+  // divergence in every coarse cell along the interface, and the first
+  // projection changed the exact field by 1.4e-3 there (now 1.2e-4). What
+  // remains is in the gradient fluxes of the two multigrid operators
+  // (pressure and viscosity), still point values at coarse-fine faces.
+  // Measured 4.6x the coarse max error and 2.3x its RMS error (7.5x and
+  // 3.4x with point values); these bounds hold the measurement so that a
+  // regression shows, they are not a target.
+  EXPECT_LT(refined.max, 5.5 * coarse.max);
+  EXPECT_LT(refined.rms, 2.6 * coarse.rms);
   EXPECT_GT(refined.max, fine.max);
 }
 
@@ -466,15 +469,20 @@ TEST(FlowRefinedNavierStokes, VariableViscosityShearFlowWithARefinedCentreConver
   // Second order on the uniform grids.
   EXPECT_GT(coarse.max / fine.max, 3.5);
   EXPECT_GT(coarse.rms / fine.rms, 3.5);
-  // The refined centre is within 10 % of the coarse grid it refines: the
-  // level jumps add no error of lower order (measured 0.91x in the max norm,
-  // 1.02x RMS; the largest errors sit at the refined square's corners, as
-  // in the Taylor-Green test). The error of the steady state is global, so
+  // The level jumps add no error of lower order: the refined centre stays
+  // near the coarse grid it refines (measured 0.94x in the max norm, 1.19x
+  // RMS; the largest errors sit at the refined square's corners, as in the
+  // Taylor-Green test). The error of the steady state is global, so
   // refining a quarter does not buy a quarter's worth. With the grad u^T
   // fluxes evaluated by each block on its own side of the coarse-fine faces
   // (not matched), the refined run was 2.6x (max) and 5.7x (RMS) worse.
+  // Before the projection took face means (face_mean) the ratios were 0.91x
+  // and 1.02x: every error fell (coarse 3.95e-2 / 1.74e-2 -> 3.29e-2 /
+  // 1.46e-2, refined 3.58e-2 / 1.78e-2 -> 3.11e-2 / 1.74e-2), the uniform
+  // grid's most, and the viscous operator's point-valued fluxes at the
+  // coarse-fine faces (issue #7, open) now show in the RMS ratio.
   EXPECT_LT(refined.max, 1.1 * coarse.max);
-  EXPECT_LT(refined.rms, 1.1 * coarse.rms);
+  EXPECT_LT(refined.rms, 1.25 * coarse.rms);
 }
 
 }  // namespace
