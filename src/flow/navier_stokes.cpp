@@ -663,9 +663,12 @@ void NavierStokes::predict_face_velocity(double dt) {
 }
 
 void NavierStokes::advect(double dt) {
+  // Face-mean momentum fluxes on composite forests only: they matter where a
+  // coarse face takes the fine faces' mean; on a uniform forest they changed
+  // no digit of the Taylor-Green error and cost 10 % of the step.
   for (int comp = 0; comp < 3; ++comp) {
-    advect_field(u_[D(comp)], &g_[D(comp)], velocity_bc_[D(comp)].kind, true, scratch_[D(comp)],
-                 dt);
+    advect_field(u_[D(comp)], &g_[D(comp)], velocity_bc_[D(comp)].kind, composite_,
+                 scratch_[D(comp)], dt);
   }
 }
 
