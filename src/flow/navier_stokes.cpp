@@ -663,12 +663,8 @@ void NavierStokes::predict_face_velocity(double dt) {
 }
 
 void NavierStokes::advect(double dt) {
-  // Face-mean momentum fluxes on composite forests only: they matter where a
-  // coarse face takes the fine faces' mean; on a uniform forest they changed
-  // no digit of the Taylor-Green error and cost 10 % of the step.
   for (int comp = 0; comp < 3; ++comp) {
-    advect_field(u_[D(comp)], &g_[D(comp)], velocity_bc_[D(comp)].kind, composite_,
-                 scratch_[D(comp)], dt);
+    advect_field(u_[D(comp)], &g_[D(comp)], velocity_bc_[D(comp)].kind, scratch_[D(comp)], dt);
   }
 }
 
@@ -682,7 +678,7 @@ void NavierStokes::advect_scalar(BlockField& c, double dt) {
   fill_face_ghosts(uf_);
   set_boundary_faces(uf_);
   BlockField out(forest_.local_blocks(), forest_.block_cells());
-  advect_field(c, nullptr, uniform_kinds(forest_, BcKind::Neumann), false, out, dt);
+  advect_field(c, nullptr, uniform_kinds(forest_, BcKind::Neumann), out, dt);
   const int b = forest_.block_cells();
   forest_.for_each_block([&](int blk) {
     for_each_cell(b, [&](int i, int j, int k) { c(blk, i, j, k) = out(blk, i, j, k); });
@@ -740,8 +736,7 @@ void NavierStokes::update_from_face_fluxes(BlockFluxes&& block_fluxes, UpperFlux
 }
 
 void NavierStokes::advect_field(const BlockField& field, const BlockField* source,
-                                const std::array<BcKind, 6>& kinds, bool face_mean_fluxes,
-                                BlockField& out, double dt) {
+                                const std::array<BcKind, 6>& kinds, BlockField& out, double dt) {
   const int b = forest_.block_cells();
   const BlockLayout L = field.layout();
   const Strides s{L.stride(0), L.stride(1), L.stride(2)};
@@ -771,15 +766,6 @@ void NavierStokes::advect_field(const BlockField& field, const BlockField* sourc
     }
     return value * un;
   };
-  // The face mean of the flux (see face_mean): the transverse correction of
-  // f u_d from the cell values, on open faces whose normal velocity is not
-  // prescribed by a boundary.
-  auto takes_face_mean = [&](int blk, int d, std::ptrdiff_t c, int n, bool dirichlet_lo,
-                             bool dirichlet_hi) {
-    const bool boundary = (n == 0 && dirichlet_lo) || (n == b && dirichlet_hi);
-    return face_mean_fluxes && !boundary && open_[D(d)].block(blk)[c] != 0.0 &&
-           (!has_solids_ || face_mean_stencil_is_fluid(solid_.block(blk), d, c, s));
-  };
   // Fluxes of all faces 0..b of one block along d into fl.
   auto block_fluxes = [&](int blk, int d, double* fl) {
     const Block& block = forest_.block(blk);
@@ -787,42 +773,10 @@ void NavierStokes::advect_field(const BlockField& field, const BlockField* sourc
         on_boundary(block, d, 0) && kinds[D(face_index(d, 0))] == BcKind::Dirichlet;
     const bool dirichlet_hi =
         on_boundary(block, d, 1) && kinds[D(face_index(d, 1))] == BcKind::Dirichlet;
-    // The cells' transverse second differences of f u_d, once per cell (the
-    // cells -1..b along d that the faces 0..b need); a face takes the mean
-    // of its two cells' (transverse_second_differences).
-    thread_local std::vector<double> flux_product, across;
-    if (face_mean_fluxes) {
-      flux_product.resize(static_cast<std::size_t>(L.size()));
-      across.resize(static_cast<std::size_t>(L.size()));
-      const double* f = field.block(blk);
-      const double* ud = u_[D(d)].block(blk);
-      // Cells -1..b along d, widened by `widen` cells across.
-      auto for_cells = [&](int widen, auto&& body) {
-        std::array<int, 3> lo{-widen, -widen, -widen}, hi{b + widen, b + widen, b + widen};
-        lo[D(d)] = -1;
-        hi[D(d)] = b + 1;
-        for (int k = lo[2]; k < hi[2]; ++k)
-          for (int j = lo[1]; j < hi[1]; ++j)
-            for (int i = lo[0]; i < hi[0]; ++i) body(L.index(i, j, k));
-      };
-      for_cells(
-          1, [&](std::ptrdiff_t c) { flux_product[static_cast<std::size_t>(c)] = f[c] * ud[c]; });
-      const double* F = flux_product.data();
-      const std::ptrdiff_t t1 = s[D((d + 1) % 3)], t2 = s[D((d + 2) % 3)];
-      for_cells(0, [&](std::ptrdiff_t c) {
-        across[static_cast<std::size_t>(c)] =
-            (F[c + t1] + F[c - t1]) + (F[c + t2] + F[c - t2]) - 4.0 * F[c];
-      });
-    }
     for_each_face(b, d, [&](int i, int j, int k) {
       const std::ptrdiff_t c = L.index(i, j, k);
       const int n = d == 0 ? i : (d == 1 ? j : k);
       fl[c] = face_flux(blk, d, c, n, dirichlet_lo, dirichlet_hi);
-      if (takes_face_mean(blk, d, c, n, dirichlet_lo, dirichlet_hi)) {
-        fl[c] +=
-            (across[static_cast<std::size_t>(c)] + across[static_cast<std::size_t>(c - s[D(d)])]) /
-            48.0;
-      }
     });
   };
   // out = f - dt div(flux) / h on one block.
@@ -842,16 +796,7 @@ void NavierStokes::advect_field(const BlockField& field, const BlockField* sourc
       [&](int blk, int d, std::ptrdiff_t f) {
         const bool dirichlet_hi = on_boundary(forest_.block(blk), d, 1) &&
                                   kinds[D(face_index(d, 1))] == BcKind::Dirichlet;
-        double flux = face_flux(blk, d, f, b, false, dirichlet_hi);
-        if (takes_face_mean(blk, d, f, b, false, dirichlet_hi)) {
-          const double* field_block = field.block(blk);
-          const double* ud = u_[D(d)].block(blk);
-          flux +=
-              transverse_second_differences(
-                  [field_block, ud](std::ptrdiff_t q) { return field_block[q] * ud[q]; }, d, f, s) /
-              24.0;
-        }
-        return flux;
+        return face_flux(blk, d, f, b, false, dirichlet_hi);
       },
       update);
 }

@@ -212,20 +212,15 @@ class NavierStokes {
   void advect(double dt);
   /// out = f - dt div(uf f_{n+1/2}), BCG face values with the cell source
   /// `source` (nullptr: none) and the boundary kinds of f (Dirichlet faces take
-  /// the boundary value); f's ghosts must be filled. face_mean_fluxes: the
-  /// fluxes are face means (the transverse correction of f u_d, for the
-  /// momentum, whose coarse faces take the fine faces' mean); off for
-  /// tracers, whose limited BCG values the correction could push past their
-  /// bounds.
+  /// the boundary value); f's ghosts must be filled.
   void advect_field(const BlockField& f, const BlockField* source,
-                    const std::array<BcKind, 6>& kinds, bool face_mean_fluxes, BlockField& out,
-                    double dt);
+                    const std::array<BcKind, 6>& kinds, BlockField& out, double dt);
   /// Composite grids: the coarse block's faces at coarse-fine faces get the
   /// mean of the 4 fine faces across (the fine faces win).
   void synchronise_coarse_faces(FaceField& uf);
   void viscous_step(double dt, StepReport& report);
   /// uf = the face mean of u (face_mean, fourth order; the plain average
-  /// beside solids) + dt a, before the projection.
+  /// near walls, inflows and solids) + dt a, before the projection.
   void face_average_plus_acceleration(double dt);
   MultigridReport project(BlockField& phi);
   void set_boundary_faces(FaceField& uf) const;
