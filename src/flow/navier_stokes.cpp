@@ -542,6 +542,43 @@ void NavierStokes::fill_scalar_neumann(BlockField& f, int width) {
   fill_boundary_ghosts(forest_, f, uniform_kinds(forest_, BcKind::Neumann), width);
 }
 
+double NavierStokes::inflow_face_mean(const FlowBoundary& inflow, const Block& block, Vec3 x,
+                                      const std::array<int, 3>& cell, int d, double h) const {
+  // The face mean of the profile, as face_mean gives the interior faces: the
+  // centre value plus 1/24 of the transverse second differences, left out
+  // (as there) beside a wall or another inflow, where the profile need not
+  // extend smoothly; across a periodic seam the profile is taken one period
+  // over, so it is only read inside the domain.
+  const int b = forest_.block_cells();
+  const ForestSpec& spec = forest_.spec();
+  const Vec3 extent = forest_.extent();
+  const auto profile = [&](Vec3 at) {
+    for (int e = 0; e < 3; ++e) {
+      if (!spec.periodic[D(e)]) continue;
+      if (at[e] < spec.origin[e]) at[e] += extent[e];
+      if (at[e] > spec.origin[e] + extent[e]) at[e] -= extent[e];
+    }
+    return inflow.inflow(at, bc_time_)[d];
+  };
+  const double centre = profile(x);
+  double second_differences = 0.0;
+  for (int t = 0; t < 3; ++t) {
+    if (t == d) continue;
+    bool beside_prescribed = false;
+    for (int side = 0; side < 2; ++side) {
+      const FlowBoundaryKind kind = boundaries_[D(face_index(t, side))].kind;
+      beside_prescribed = beside_prescribed ||
+                          (cell[D(t)] == (side == 0 ? 0 : b - 1) && on_boundary(block, t, side) &&
+                           (kind == FlowBoundaryKind::Wall || kind == FlowBoundaryKind::Inflow));
+    }
+    if (beside_prescribed) continue;
+    Vec3 step{};
+    step[t] = h;
+    second_differences += profile(x + step) - 2.0 * centre + profile(x - step);
+  }
+  return centre + second_differences / 24.0;
+}
+
 void NavierStokes::set_boundary_faces(FaceField& uf) const {
   const int b = forest_.block_cells();
   forest_.for_each_block([&](int blk) {
@@ -563,18 +600,7 @@ void NavierStokes::set_boundary_faces(FaceField& uf) const {
               Vec3 x{};
               for (int e = 0; e < 3; ++e) x[e] = block.lower[e] + (idx[D(e)] + 0.5) * h;
               x[d] = block.lower[d] + idx[D(d)] * h;
-              // The face mean of the profile, as face_mean gives the
-              // interior faces (its centre value plus the transverse correction).
-              value = fb.inflow(x, bc_time_)[d];
-              double second_differences = 0.0;
-              for (int t = 0; t < 3; ++t) {
-                if (t == d) continue;
-                Vec3 step{};
-                step[t] = h;
-                second_differences += fb.inflow(x + step, bc_time_)[d] - 2.0 * value +
-                                      fb.inflow(x - step, bc_time_)[d];
-              }
-              value += second_differences / 24.0;
+              value = inflow_face_mean(fb, block, x, idx, d, h);
             }
             uf[D(d)](blk, idx[0], idx[1], idx[2]) = value;
           }

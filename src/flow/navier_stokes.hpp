@@ -17,7 +17,8 @@
 //   3. viscosity: (rho/dt - theta div(mu grad)) u** = rho/dt (u* + dt g) +
 //      (1 - theta) div(mu grad u), then u** -= dt g (theta = 1 backward
 //      Euler, 1/2 Crank-Nicolson), solved by multigrid;
-//   4. acceleration: uf = face average of u** + dt a (a = f_b / rho on faces);
+//   4. acceleration: uf = face mean of u** (fourth order) + dt a (a = f_b / rho
+//      on faces);
 //   5. projection (Chorin 1968): div((dt/rho) grad p) = div uf,
 //      uf -= (dt/rho) grad p, g = cell average of (a - grad p / rho),
 //      u = u** + dt g.
@@ -224,6 +225,10 @@ class NavierStokes {
   void face_average_plus_acceleration(double dt);
   MultigridReport project(BlockField& phi);
   void set_boundary_faces(FaceField& uf) const;
+  /// The mean over an inflow face (component d, centre x, beside cell
+  /// `cell` of `block`) of the prescribed profile, as face_mean takes it.
+  [[nodiscard]] double inflow_face_mean(const FlowBoundary& inflow, const Block& block, Vec3 x,
+                                        const std::array<int, 3>& cell, int d, double h) const;
   void fill_face_ghosts(FaceField& uf);
   void fill_scalar_neumann(BlockField& f, int width);
   void update_viscous_coefficients(double dt);

@@ -228,7 +228,7 @@ TEST(FlowRefinedNavierStokes, TaylorGreenWithARefinedCentreConvergesAtSecondOrde
   // Not better than the uniform coarse grid (issue #7, open). The
   // projection's face velocity is a face mean (face_mean), so a coarse face
   // taking the mean of the fine faces across agrees with the coarse cell's
-  // other faces to O(h^4); with point values (the plain average of two
+  // other faces to higher order; with point values (the plain average of two
   // cells) they differed by O(h^2), an O(h) divergence in every coarse cell
   // along the interface, and the first projection changed the exact field
   // by 1.4e-3 there (now 1.2e-4). What remains is in the fluxes that are
