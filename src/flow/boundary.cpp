@@ -25,8 +25,27 @@ std::array<int, 3> along(int d, int n, int t1, int t2) {
   return c;
 }
 
-void fill_face(const Block& block, BlockField& field, int blk, int d, int side, BcKind kind,
-               const FaceValue* value, int width) {
+/// x moved into the domain across the face's transverse directions e1, e2:
+/// wrapped one period over where the domain is periodic, onto the boundary
+/// where it is not. The ghosts at a block's edges lie beyond the face; a
+/// boundary value (an inflow profile) is read only inside the domain.
+Vec3 into_domain(const Forest& forest, Vec3 x, int e1, int e2) {
+  const ForestSpec& spec = forest.spec();
+  const Vec3 extent = forest.extent();
+  for (const int e : {e1, e2}) {
+    const double lo = spec.origin[e], hi = spec.origin[e] + extent[e];
+    if (spec.periodic[static_cast<std::size_t>(e)]) {
+      if (x[e] < lo) x[e] += extent[e];
+      if (x[e] > hi) x[e] -= extent[e];
+    } else {
+      x[e] = std::clamp(x[e], lo, hi);
+    }
+  }
+  return x;
+}
+
+void fill_face(const Forest& forest, const Block& block, BlockField& field, int blk, int d,
+               int side, BcKind kind, const FaceValue* value, int width) {
   const BlockLayout& L = field.layout();
   const int b = L.cells;
   double* data = field.block(blk);
@@ -59,7 +78,7 @@ void fill_face(const Block& block, BlockField& field, int blk, int d, int side, 
             x[e1] += (t1 + 0.5) * h;
             x[e2] += (t2 + 0.5) * h;
             x[d] += side == 0 ? 0.0 : block.length;
-            g = (*value)(x);
+            g = (*value)(into_domain(forest, x, e1, e2));
           }
           // Quadratic through the face value and the two first cells: exact
           // for parabolic profiles (third-order boundary closure).
@@ -87,7 +106,8 @@ void fill_block_boundary_ghosts(const Forest& forest, BlockField& field, int blk
     for (int side = 0; side < 2; ++side) {
       if (block.neighbours[face_neighbour_slot(d, side)].link != Link::Boundary) continue;
       const auto f = static_cast<std::size_t>(face_index(d, side));
-      fill_face(block, field, blk, d, side, kinds[f], values ? &(*values)[f] : nullptr, width);
+      fill_face(forest, block, field, blk, d, side, kinds[f], values ? &(*values)[f] : nullptr,
+                width);
     }
   }
 }

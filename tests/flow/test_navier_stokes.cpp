@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "flow/navier_stokes.hpp"
 #include "navier_stokes_problems.hpp"
@@ -439,6 +440,48 @@ TEST(FlowNavierStokes, ParabolicInflowAndOutflowKeepFullyDevelopedChannelFlow) {
   EXPECT_LT(u16, 5e-3);                  // 0.5 % of the mean velocity, at the inlet
   EXPECT_LT(p16, 0.24);                  // 1 % of the inlet pressure
   EXPECT_GT(std::log2(u16 / u32), 0.9);  // the inlet error shrinks with h
+}
+
+/// The inflow faces take the mean of the profile over the face
+/// (inflow_face_mean), which reads the profile beside the face centre; it
+/// must read it only inside the domain: not beyond the walls, and across the
+/// periodic seam one period over. A profile that is NaN outside the channel
+/// would otherwise poison the run.
+TEST(FlowNavierStokes, InflowFaceMeanReadsTheProfileOnlyInsideTheDomain) {
+  ForestSpec spec;
+  spec.trees = {2, 2, 1};
+  spec.tree_length = 0.5;
+  spec.periodic = {false, false, true};
+  const Forest forest(spec);
+  std::array<FlowBoundary, 6> bcs{};
+  bcs[face_index(0, 0)].kind = FlowBoundaryKind::Inflow;
+  int outside = 0;
+  bcs[face_index(0, 0)].inflow = [&outside](const Vec3& x, double) {
+    const bool inside = x.y >= 0.0 && x.y <= 1.0 && x.z >= 0.0 && x.z <= 0.5;
+    if (!inside) ++outside;
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    return inside
+               ? Vec3{6.0 * x.y * (1.0 - x.y) * (1.0 + 0.1 * std::sin(4.0 * kPi * x.z)), 0.0, 0.0}
+               : Vec3{nan, nan, nan};
+  };
+  bcs[face_index(0, 1)].kind = FlowBoundaryKind::Outflow;
+  bcs[face_index(2, 0)].kind = bcs[face_index(2, 1)].kind = FlowBoundaryKind::Periodic;
+  NavierStokesOptions options;
+  options.dt_max = 0.01;
+  NavierStokes ns(forest, bcs, Fluid{1.0, 1.0}, options);
+  ns.set_velocity([](const Vec3&) { return Vec3{}; });
+  for (int s = 0; s < 3; ++s) ns.step(0.01);
+  EXPECT_EQ(outside, 0);
+  bool finite = true;
+  const int b = forest.block_cells();
+  for (int blk = 0; blk < forest.local_blocks(); ++blk)
+    for (int k = 0; k < b; ++k)
+      for (int j = 0; j < b; ++j)
+        for (int i = 0; i < b; ++i)
+          for (int c = 0; c < 3; ++c)
+            finite =
+                finite && std::isfinite(ns.velocity()[static_cast<std::size_t>(c)](blk, i, j, k));
+  EXPECT_TRUE(finite);
 }
 
 }  // namespace
