@@ -4,6 +4,17 @@
 
 namespace sanguis::flow {
 
+Vec3 wrap_periodic(const Forest& forest, Vec3 x) {
+  const ForestSpec& spec = forest.spec();
+  const Vec3 extent = forest.extent();
+  for (int e = 0; e < 3; ++e) {
+    if (!spec.periodic[static_cast<std::size_t>(e)]) continue;
+    if (x[e] < spec.origin[e]) x[e] += extent[e];
+    if (x[e] > spec.origin[e] + extent[e]) x[e] -= extent[e];
+  }
+  return x;
+}
+
 std::array<BcKind, 6> uniform_kinds(const Forest& forest, BcKind kind) {
   std::array<BcKind, 6> kinds{};
   for (int d = 0; d < 3; ++d) {
@@ -30,16 +41,12 @@ std::array<int, 3> along(int d, int n, int t1, int t2) {
 /// where it is not. The ghosts at a block's edges lie beyond the face; a
 /// boundary value (an inflow profile) is read only inside the domain.
 Vec3 into_domain(const Forest& forest, Vec3 x, int e1, int e2) {
+  x = wrap_periodic(forest, x);
   const ForestSpec& spec = forest.spec();
   const Vec3 extent = forest.extent();
   for (const int e : {e1, e2}) {
-    const double lo = spec.origin[e], hi = spec.origin[e] + extent[e];
-    if (spec.periodic[static_cast<std::size_t>(e)]) {
-      if (x[e] < lo) x[e] += extent[e];
-      if (x[e] > hi) x[e] -= extent[e];
-    } else {
-      x[e] = std::clamp(x[e], lo, hi);
-    }
+    if (spec.periodic[static_cast<std::size_t>(e)]) continue;
+    x[e] = std::clamp(x[e], spec.origin[e], spec.origin[e] + extent[e]);
   }
   return x;
 }

@@ -39,6 +39,10 @@ struct ScalarBoundary {
   std::array<FaceValue, 6> value{};  ///< Dirichlet value per face; empty means 0
 };
 
+/// x with its coordinates along the periodic directions brought into the
+/// domain (one period over); the others are left as they are.
+Vec3 wrap_periodic(const Forest& forest, Vec3 x);
+
 /// Boundary kinds all equal to `kind` except the periodic directions.
 std::array<BcKind, 6> uniform_kinds(const Forest& forest, BcKind kind);
 

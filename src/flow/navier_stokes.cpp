@@ -85,6 +85,13 @@ inline bool face_mean_stencil_is_fluid(const double* solid, int d, std::ptrdiff_
   return true;
 }
 
+/// Whether cell number n (0..b-1) along t lies beside one of the block's
+/// faces across t that `prescribed` marks.
+inline bool beside_prescribed(const std::array<bool, 6>& prescribed, int t, int n, int b) {
+  return (n == 0 && prescribed[D(face_index(t, 0))]) ||
+         (n == b - 1 && prescribed[D(face_index(t, 1))]);
+}
+
 /// Viscosity on the face between two cells: the harmonic mean, so that a
 /// viscosity jump on a face passes the shear stress exactly (layered Couette).
 inline double face_viscosity(double left, double right) {
@@ -542,36 +549,31 @@ void NavierStokes::fill_scalar_neumann(BlockField& f, int width) {
   fill_boundary_ghosts(forest_, f, uniform_kinds(forest_, BcKind::Neumann), width);
 }
 
-double NavierStokes::inflow_face_mean(const FlowBoundary& inflow, const Block& block, Vec3 x,
+std::array<bool, 6> NavierStokes::prescribed_faces(const Block& block) const {
+  std::array<bool, 6> prescribed{};
+  for (int f = 0; f < 6; ++f) {
+    const FlowBoundaryKind kind = boundaries_[D(f)].kind;
+    prescribed[D(f)] = on_boundary(block, f / 2, f % 2) &&
+                       (kind == FlowBoundaryKind::Wall || kind == FlowBoundaryKind::Inflow);
+  }
+  return prescribed;
+}
+
+double NavierStokes::inflow_face_mean(const FlowBoundary& inflow,
+                                      const std::array<bool, 6>& prescribed, Vec3 x,
                                       const std::array<int, 3>& cell, int d, double h) const {
   // The face mean of the profile, as face_mean gives the interior faces: the
   // centre value plus 1/24 of the transverse second differences, left out
   // (as there) beside a wall or another inflow, where the profile need not
   // extend smoothly; across a periodic seam the profile is taken one period
   // over, so it is only read inside the domain.
-  const int b = forest_.block_cells();
-  const ForestSpec& spec = forest_.spec();
-  const Vec3 extent = forest_.extent();
-  const auto profile = [&](Vec3 at) {
-    for (int e = 0; e < 3; ++e) {
-      if (!spec.periodic[D(e)]) continue;
-      if (at[e] < spec.origin[e]) at[e] += extent[e];
-      if (at[e] > spec.origin[e] + extent[e]) at[e] -= extent[e];
-    }
-    return inflow.inflow(at, bc_time_)[d];
+  const auto profile = [&](const Vec3& at) {
+    return inflow.inflow(wrap_periodic(forest_, at), bc_time_)[d];
   };
   const double centre = profile(x);
   double second_differences = 0.0;
   for (int t = 0; t < 3; ++t) {
-    if (t == d) continue;
-    bool beside_prescribed = false;
-    for (int side = 0; side < 2; ++side) {
-      const FlowBoundaryKind kind = boundaries_[D(face_index(t, side))].kind;
-      beside_prescribed = beside_prescribed ||
-                          (cell[D(t)] == (side == 0 ? 0 : b - 1) && on_boundary(block, t, side) &&
-                           (kind == FlowBoundaryKind::Wall || kind == FlowBoundaryKind::Inflow));
-    }
-    if (beside_prescribed) continue;
+    if (t == d || beside_prescribed(prescribed, t, cell[D(t)], forest_.block_cells())) continue;
     Vec3 step{};
     step[t] = h;
     second_differences += profile(x + step) - 2.0 * centre + profile(x - step);
@@ -584,11 +586,11 @@ void NavierStokes::set_boundary_faces(FaceField& uf) const {
   forest_.for_each_block([&](int blk) {
     const Block& block = forest_.block(blk);
     const double h = block.length / b;
+    const std::array<bool, 6> prescribed = prescribed_faces(block);
     for (int d = 0; d < 3; ++d) {
       for (int side = 0; side < 2; ++side) {
         const FlowBoundary& fb = boundaries_[D(face_index(d, side))];
-        if (!on_boundary(block, d, side)) continue;
-        if (fb.kind != FlowBoundaryKind::Wall && fb.kind != FlowBoundaryKind::Inflow) continue;
+        if (!prescribed[D(face_index(d, side))]) continue;
         for (int t2 = 0; t2 < b; ++t2)
           for (int t1 = 0; t1 < b; ++t1) {
             std::array<int, 3> idx{};
@@ -600,7 +602,7 @@ void NavierStokes::set_boundary_faces(FaceField& uf) const {
               Vec3 x{};
               for (int e = 0; e < 3; ++e) x[e] = block.lower[e] + (idx[D(e)] + 0.5) * h;
               x[d] = block.lower[d] + idx[D(d)] * h;
-              value = inflow_face_mean(fb, block, x, idx, d, h);
+              value = inflow_face_mean(fb, prescribed, x, idx, d, h);
             }
             uf[D(d)](blk, idx[0], idx[1], idx[2]) = value;
           }
@@ -1014,7 +1016,7 @@ void NavierStokes::face_average_plus_acceleration(double dt) {
   const BlockLayout L = u_[0].layout();
   const Strides s{L.stride(0), L.stride(1), L.stride(2)};
   forest_.for_each_block([&](int blk) {
-    const Block& block = forest_.block(blk);
+    const std::array<bool, 6> prescribed = prescribed_faces(forest_.block(blk));
     const double* solid = solid_.block(blk);
     for (int d = 0; d < 3; ++d) {
       // u here lacks the pressure gradient (u* of the projection), so it
@@ -1022,11 +1024,6 @@ void NavierStokes::face_average_plus_acceleration(double dt) {
       // inflow, closed on the wall value, make a kink there. face_mean's
       // stencil stays off them: the plain average along d within two cells
       // of such a face, no transverse correction in the cells beside one.
-      std::array<bool, 6> prescribed{};
-      for (int f = 0; f < 6; ++f) {
-        prescribed[D(f)] =
-            on_boundary(block, f / 2, f % 2) && velocity_bc_[D(d)].kind[D(f)] == BcKind::Dirichlet;
-      }
       const double* u = u_[D(d)].block(blk);
       const double* a = accel_[D(d)].block(blk);
       double* out = uf_[D(d)].block(blk);
@@ -1037,9 +1034,7 @@ void NavierStokes::face_average_plus_acceleration(double dt) {
                       !(n[D(d)] >= b - 1 && prescribed[D(face_index(d, 1))]);
         bool transverse = true;
         for (int t = 0; t < 3; ++t) {
-          if (t == d) continue;
-          transverse = transverse && !(n[D(t)] == 0 && prescribed[D(face_index(t, 0))]) &&
-                       !(n[D(t)] == b - 1 && prescribed[D(face_index(t, 1))]);
+          if (t != d) transverse = transverse && !beside_prescribed(prescribed, t, n[D(t)], b);
         }
         // Beside solids (u = 0 in them) the plain average; the closure follows.
         if (has_solids_ && !face_mean_stencil_is_fluid(solid, d, c, s)) normal = transverse = false;
@@ -1166,14 +1161,7 @@ StepReport NavierStokes::step(double dt) {
     // Faces where the velocity is prescribed (walls, inflow): the pressure
     // condition there (Neumann) only keeps uf fixed; their gradient is not
     // the fluid's, so g comes from the interior face beside them.
-    std::array<bool, 6> prescribed{};
-    for (int d = 0; d < 3; ++d)
-      for (int side = 0; side < 2; ++side) {
-        const FlowBoundaryKind kind = boundaries_[D(face_index(d, side))].kind;
-        prescribed[D(face_index(d, side))] =
-            on_boundary(block, d, side) &&
-            (kind == FlowBoundaryKind::Wall || kind == FlowBoundaryKind::Inflow);
-      }
+    const std::array<bool, 6> prescribed = prescribed_faces(block);
     for_each_cell(b, [&](int i, int j, int k) {
       const std::ptrdiff_t c = L.index(i, j, k);
       const std::array<int, 3> n{i, j, k};

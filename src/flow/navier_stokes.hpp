@@ -225,9 +225,14 @@ class NavierStokes {
   void face_average_plus_acceleration(double dt);
   MultigridReport project(BlockField& phi);
   void set_boundary_faces(FaceField& uf) const;
+  /// Which of the block's 6 faces lie on a domain face whose velocity is
+  /// prescribed (a wall or an inflow).
+  [[nodiscard]] std::array<bool, 6> prescribed_faces(const Block& block) const;
   /// The mean over an inflow face (component d, centre x, beside cell
-  /// `cell` of `block`) of the prescribed profile, as face_mean takes it.
-  [[nodiscard]] double inflow_face_mean(const FlowBoundary& inflow, const Block& block, Vec3 x,
+  /// `cell` of a block with `prescribed` faces) of the profile, as
+  /// face_mean takes it.
+  [[nodiscard]] double inflow_face_mean(const FlowBoundary& inflow,
+                                        const std::array<bool, 6>& prescribed, Vec3 x,
                                         const std::array<int, 3>& cell, int d, double h) const;
   void fill_face_ghosts(FaceField& uf);
   void fill_scalar_neumann(BlockField& f, int width);
