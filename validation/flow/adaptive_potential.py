@@ -23,7 +23,9 @@ Fields (blocks of 8^3 cells, as in the flow cases):
     w = 0 on the periodic (2 pi)^3 box at 64^3 (exact field);
   * the steady Re = 1000 cubic lid-driven cavity at 64^3: the last frame of
     the uniform run of validation/flow/cavity_re1000.py (run it first:
-    `validation/flow/cavity_re1000.py --sizes 64`, about 30 min on one core).
+    `validation/flow/cavity_re1000.py --sizes 64`, about 30 min on one core);
+  * the steady Re = 100 2D cavity at 128^2 (a periodic slab 32 cells thick):
+    the uniform run of validation/flow/cavity_adaptive.py (run it first).
 
 Writes validation/flow/results/adaptive_potential.json and
 docs/validation/figures/flow_adaptive_potential.png.
@@ -147,6 +149,23 @@ def cavity_field():
     return fields, (False, False, False), 1.0 / n, 1.0
 
 
+def cavity_2d_field():
+    """The steady 2D Re = 100 cavity, 128^2 x 32 cells (periodic slab): the last
+    frame of the uniform run of validation/flow/cavity_adaptive.py."""
+    runs = RESULTS / "runs" / "cavity_adaptive"
+    if not (runs / "uniform" / "flow").exists():
+        return None
+    centres, arrays = read_vtu(last_frame(runs, "uniform"))
+    n, nz = 128, 32
+    index = np.floor(centres * n).astype(int)
+    fields = []
+    for d in range(3):
+        f = np.zeros((n, n, nz))
+        f[index[:, 0], index[:, 1], index[:, 2]] = arrays["velocity"][:, d]
+        fields.append(f)
+    return fields, (False, False, True), 1.0 / n, 1.0
+
+
 def main():
     cases = {"vortex (128^2 x 32)": vortex_field(), "Taylor-Green (64^3)": taylor_green_field()}
     cavity = cavity_field()
@@ -154,6 +173,11 @@ def main():
         print("cavity: no uniform 64^3 run on disk (validation/flow/cavity_re1000.py --sizes 64); skipped")
     else:
         cases["cavity Re 1000 (64^3)"] = cavity
+    cavity_2d = cavity_2d_field()
+    if cavity_2d is None:
+        print("2D cavity: no uniform 128^2 run on disk (validation/flow/cavity_adaptive.py); skipped")
+    else:
+        cases["2D cavity Re 100 (128^2 x 32)"] = cavity_2d
     results = {}
     for name, (components, periodic, h, speed) in cases.items():
         levels = level_estimates(components, periodic)
@@ -181,6 +205,17 @@ def main():
                 print(f"vortex, measured at zeta = {run['zeta']:g} m/s: {run['cells_end']:.0f} cells at the end "
                       f"against the estimate {estimate} ({run['cells_end'] / estimate - 1:+.0%})")
         vortex["measured"] = measured
+    # The measured adaptive 2D cavity runs (cells at t = 15) against the estimate.
+    cavity_json = RESULTS / "cavity_adaptive.json"
+    if cavity_2d is not None and cavity_json.exists():
+        adaptive = json.loads(cavity_json.read_text())
+        levels = level_estimates(*cavity_2d[:2])
+        estimate, _ = fewest_cells(levels, adaptive["zeta_over_U"])
+        run = adaptive["runs"]["adaptive"]
+        results["2D cavity Re 100 (128^2 x 32)"]["measured"] = {
+            "zeta": adaptive["zeta_over_U"], "cells_end": run["cells_end"], "estimate": estimate}
+        print(f"2D cavity, measured at zeta = {adaptive['zeta_over_U']:g} U: {run['cells_end']} cells at "
+              f"t = 15 against the estimate {estimate} ({run['cells_end'] / estimate - 1:+.0%})")
     RESULTS.mkdir(parents=True, exist_ok=True)
     (RESULTS / "adaptive_potential.json").write_text(json.dumps(results, indent=1))
 
