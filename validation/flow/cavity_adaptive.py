@@ -26,9 +26,18 @@ gave 5.2x fewer cells at zeta = 5e-3 U and 6.0x at 1e-2 U as lower bounds):
   is within 1e-2 U of the uniform run's mean over that cell;
 * against Ghia, Ghia & Shin (1982): within 0.02 U on both lines, as
   validation/flow/cavity.py asks of the uniform 64^2 run;
-* regridding keeps the face velocity divergence-free: the adaptive run's max
-  |div uf| is no larger than the uniform run's (both solve the projection to the
-  case's relative tolerance 1e-4, which leaves 1e-3 - 2e-2 1/s in this cavity).
+Reported, not graded: max |div uf| of each run (the projection is solved to the
+case's relative tolerance 1e-4, which leaves 1e-3 - 2e-2 1/s here whatever the
+grid; that regridding keeps the divergence of every parent cell exactly is
+tested by FlowAdapt.FaceFieldsKeepTheDivergenceOfEveryParentCell).
+
+Every run takes the same fixed time step, 0.005 L/U (the CFL step of the 128^2
+grid is 0.0064): the velocity of the cells at the two lid corners, where the
+boundary velocity jumps, depends on the time step by several per cent (the
+approximate projection's face velocity carries dt times the difference between
+averaged cell and face pressure gradients, large beside the corner's pressure
+singularity). With the CFL step, runs whose last step before a frame was
+shortened differently differed there by up to 7.5 % (docs/validation/flow.md).
 Reported: cells at the end and on average, wall times (time to solution).
 
 Writes validation/flow/results/cavity_adaptive.json (runs under
@@ -66,6 +75,7 @@ END = 15.0
 N = 128  # finest cells per side
 THICK = 32  # cells across the slab (4 blocks: two levels of coarsening)
 ZETA = 1e-2  # of the lid speed U = 1 m/s
+TIME_STEP = 0.005  # fixed: below the CFL step of every grid here (see the docstring)
 CELL_RATIO = 5.0
 LINE_TOLERANCE = 5e-3
 FIELD_TOLERANCE = 1e-2
@@ -81,6 +91,7 @@ def slab_case(n, adaptive, lid_region=False):
     text = CASE.read_text()
     cells_z = THICK * n // N
     for old, new in (("size_m = [1.0, 1.0, 1.0]", f"size_m = [1.0, 1.0, {THICK / N!r}]"),
+                     ("max_time_step_s = 0.02", f"max_time_step_s = {TIME_STEP!r}"),
                      ("cells = [32, 32, 32]", f"cells = [{n}, {n}, {cells_z}]"),
                      ('z_min = { type = "wall" }', 'z_min = { type = "periodic" }'),
                      ('z_max = { type = "wall" }', 'z_max = { type = "periodic" }')):
@@ -168,23 +179,20 @@ def cell_means(fine_arrays, coarse_arrays):
 ADAPTIVE = {"adaptive": "velocity criterion", "adaptive_lid": "velocity criterion + lid band finest"}
 
 
-def checks_of(name, cells_uniform, cells_end, line_diff, field_diff, ghia_diff, div):
+def checks_of(name, cells_uniform, cells_end, line_diff, field_diff, ghia_diff):
     return [
         {"quantity": "uniform finest cells / adaptive cells at t = 15",
          "measured": round(cells_uniform / cells_end, 2), "reference": f"{int(cells_uniform)} / {int(cells_end)}",
-         "tolerance": f">= {CELL_RATIO:g}", "pass": cells_uniform / cells_end >= CELL_RATIO},
+         "tolerance": f">= {CELL_RATIO:g}", "pass": bool(cells_uniform / cells_end >= CELL_RATIO)},
         {"quantity": "centre lines: max |u_adaptive - u_uniform| (u on x = 0.5, v on y = 0.5) / U",
          "measured": round(line_diff[name], 5), "reference": f"uniform {N}^2",
-         "tolerance": f"<= {LINE_TOLERANCE:g}", "pass": line_diff[name] <= LINE_TOLERANCE},
+         "tolerance": f"<= {LINE_TOLERANCE:g}", "pass": bool(line_diff[name] <= LINE_TOLERANCE)},
         {"quantity": "whole grid: max over adaptive cells |u - mean of the uniform run over the cell| / U",
          "measured": round(field_diff[name], 5), "reference": f"uniform {N}^2",
-         "tolerance": f"<= {FIELD_TOLERANCE:g}", "pass": field_diff[name] <= FIELD_TOLERANCE},
+         "tolerance": f"<= {FIELD_TOLERANCE:g}", "pass": bool(field_diff[name] <= FIELD_TOLERANCE)},
         {"quantity": "centre lines against Ghia et al. (1982), max difference / U",
          "measured": round(ghia_diff[name], 5), "reference": "Ghia, Ghia & Shin (1982), Re = 100",
-         "tolerance": f"<= {GHIA_TOLERANCE:g}", "pass": ghia_diff[name] <= GHIA_TOLERANCE},
-        {"quantity": "max |div uf| over the run [1/s]",
-         "measured": f"{div[name]:.2e}", "reference": f"uniform {N}^2: {div['uniform']:.2e}",
-         "tolerance": "<= the uniform run's", "pass": div[name] <= div["uniform"]},
+         "tolerance": f"<= {GHIA_TOLERANCE:g}", "pass": bool(ghia_diff[name] <= GHIA_TOLERANCE)},
     ]
 
 
@@ -265,6 +273,7 @@ def main():
                "end_time_s": END, "cells_uniform": int(cells_uniform), "threads": args.threads,
                "wall_seconds": {k: round(v, 1) for k, v in seconds.items()},
                "uniform_ghia_difference": round(ghia_diff["uniform"], 5),
+               "uniform_max_divergence_1_s": div["uniform"],
                "uniform64": {"cells": int(rows["uniform64"][-1]["cells"]),
                              "centre_line_difference": round(line_diff["uniform64"], 5),
                              "field_difference": round(field_diff["uniform64"], 5),
@@ -274,7 +283,7 @@ def main():
     for name, label in ADAPTIVE.items():
         cells_end = rows[name][-1]["cells"]
         cells_mean = float(np.mean([r["cells"] for r in rows[name][1:]]))
-        checks = checks_of(name, cells_uniform, cells_end, line_diff, field_diff, ghia_diff, div)
+        checks = checks_of(name, cells_uniform, cells_end, line_diff, field_diff, ghia_diff)
         passed = all(c["pass"] for c in checks)
         ok_any = ok_any or passed
         level = frames[name]["level"]
@@ -283,6 +292,7 @@ def main():
             "cells_mean": round(cells_mean), "cell_ratio_end": round(cells_uniform / cells_end, 2),
             "cell_ratio_mean": round(cells_uniform / cells_mean, 2),
             "cells_per_level": {int(k): int((level == k).sum()) for k in np.unique(level)},
+            "max_divergence_1_s": div[name],
             "cells_beyond_field_tolerance_first_layer": differing[name]}
         print(f"{name} ({label}): {int(cells_end)} cells at the end ({cells_uniform / cells_end:.2f}x fewer), "
               f"{cells_mean:.0f} on average; wall time {seconds[name]:.0f} s against {seconds['uniform']:.0f} s")
