@@ -138,15 +138,20 @@ def cavity_field():
     name = "cavity-re1000-64"
     if not (runs / name / "flow").exists():
         return None
+    return uniform_velocity(runs, name, 64, (64, 64, 64)), (False, False, False), 1.0 / 64, 1.0
+
+
+def uniform_velocity(runs, name, n, shape):
+    """The three velocity components of the last frame of a uniform run with n
+    cells per unit length, as arrays of `shape` cells."""
     centres, arrays = read_vtu(last_frame(runs, name))
-    n = 64
     index = np.floor(centres * n).astype(int)
     fields = []
     for d in range(3):
-        f = np.zeros((n, n, n))
+        f = np.zeros(shape)
         f[index[:, 0], index[:, 1], index[:, 2]] = arrays["velocity"][:, d]
         fields.append(f)
-    return fields, (False, False, False), 1.0 / n, 1.0
+    return fields
 
 
 def cavity_2d_field():
@@ -155,15 +160,7 @@ def cavity_2d_field():
     runs = RESULTS / "runs" / "cavity_adaptive"
     if not (runs / "uniform" / "flow").exists():
         return None
-    centres, arrays = read_vtu(last_frame(runs, "uniform"))
-    n, nz = 128, 32
-    index = np.floor(centres * n).astype(int)
-    fields = []
-    for d in range(3):
-        f = np.zeros((n, n, nz))
-        f[index[:, 0], index[:, 1], index[:, 2]] = arrays["velocity"][:, d]
-        fields.append(f)
-    return fields, (False, False, True), 1.0 / n, 1.0
+    return uniform_velocity(runs, "uniform", 128, (128, 128, 32)), (False, False, True), 1.0 / 128, 1.0
 
 
 def main():

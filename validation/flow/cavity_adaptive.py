@@ -42,7 +42,7 @@ Reported: cells at the end and on average, wall times (time to solution).
 
 Writes validation/flow/results/cavity_adaptive.json (runs under
 validation/flow/results/runs/cavity_adaptive/) and
-docs/validation/figures/flow_cavity_adaptive.png. About 25 min on 2 cores.
+docs/validation/figures/flow_cavity_adaptive.png. About 50 min on 2 cores.
 Exits 1 if a check fails.
 
 Usage: /usr/bin/python3 validation/flow/cavity_adaptive.py [--build build] [--threads T] [--replot]
@@ -230,6 +230,14 @@ def draw_grid(fig, ax, arrays, title):
     ax.set_title(title, fontsize=9)
 
 
+def tolerance_axes(ax, tolerance, xlabel, ylabel, title):
+    ax.axhline(tolerance, color="r", ls="--", lw=0.8, label="tolerance")
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.legend(fontsize=6)
+    ax.set_title(title, fontsize=9)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--build", default="build")
@@ -321,13 +329,11 @@ def main():
     ax2.set_title("centre lines, Re = 100", fontsize=9)
     ax3 = fig.add_subplot(2, 3, 4)
     for name in ("adaptive", "adaptive_lid", "uniform64"):
-        ax3.semilogy(centres, np.abs(profiles[name]["u"] - profiles["uniform"]["u"]) + 1e-7, label=f"{name}: |Δu| on x = 0.5")
-        ax3.semilogy(centres, np.abs(profiles[name]["v"] - profiles["uniform"]["v"]) + 1e-7, label=f"{name}: |Δv| on y = 0.5")
-    ax3.axhline(LINE_TOLERANCE, color="r", ls="--", lw=0.8, label="tolerance")
-    ax3.set_xlabel("position along the line / L")
-    ax3.set_ylabel(f"difference from uniform {N}$^2$ / U")
-    ax3.legend(fontsize=6)
-    ax3.set_title("centre lines against the uniform finest run", fontsize=9)
+        for c, line in (("u", "x"), ("v", "y")):
+            ax3.semilogy(centres, np.abs(profiles[name][c] - profiles["uniform"][c]) + 1e-7,
+                         label=f"{name}: |Δ{c}| on {line} = 0.5")
+    tolerance_axes(ax3, LINE_TOLERANCE, "position along the line / L",
+                   f"difference from uniform {N}$^2$ / U", "centre lines against the uniform finest run")
     ax5 = fig.add_subplot(2, 3, 5)
     for name in ("adaptive", "adaptive_lid"):
         means = cell_means(ref, frames[name])
@@ -337,11 +343,8 @@ def main():
         r = np.minimum(np.hypot(0.5 * (lo + hi)[sel, 0], 1 - 0.5 * (lo + hi)[sel, 1]),
                        np.hypot(1 - 0.5 * (lo + hi)[sel, 0], 1 - 0.5 * (lo + hi)[sel, 1]))
         ax5.loglog(r, d + 1e-7, ".", ms=2, label=name)
-    ax5.axhline(FIELD_TOLERANCE, color="r", ls="--", lw=0.8, label="tolerance")
-    ax5.set_xlabel("distance of the cell from the nearer lid corner / L")
-    ax5.set_ylabel(f"|u - mean of uniform {N}$^2$ over the cell| / U")
-    ax5.legend(fontsize=7)
-    ax5.set_title("whole grid against the uniform finest run", fontsize=9)
+    tolerance_axes(ax5, FIELD_TOLERANCE, "distance of the cell from the nearer lid corner / L",
+                   f"|u - mean of uniform {N}$^2$ over the cell| / U", "whole grid against the uniform finest run")
     ax4 = fig.add_subplot(2, 3, 6)
     for name in ADAPTIVE:
         ax4.plot([r["time_s"] for r in rows[name]], [r["cells"] for r in rows[name]], label=name)
