@@ -363,7 +363,8 @@ def main():
     ax4.set_ylabel("cells")
     ax4.set_ylim(0, 1.1 * cells_uniform)
     ax4.legend(fontsize=7)
-    ax4.set_title("wall time " + ", ".join(f"{k} {v:.0f} s" for k, v in seconds.items()), fontsize=8)
+    times = [f"{k} {v:.0f} s" for k, v in seconds.items()]
+    ax4.set_title("wall time: " + ", ".join(times[:2]) + ",\n" + ", ".join(times[2:]), fontsize=8)
     fig.tight_layout()
     FIGURE.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(FIGURE, dpi=100)
