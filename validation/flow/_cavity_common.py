@@ -1,6 +1,7 @@
 """Shared by the flow validation scripts: reading our .vtu frames, cell boxes,
 centre-line profiles, running variants of a case file."""
 import base64
+import csv
 import re
 import subprocess
 import time
@@ -67,3 +68,26 @@ def run(sanguis, runs, name, text):
 def last_frame(runs, name):
     frames = sorted((runs / name / "flow").glob("flow_*.vtu"))
     return frames[-1]
+
+
+def read_rows(path):
+    """The rows of a diagnostics.csv, every value as a float."""
+    with open(path, newline="") as f:
+        return [{k: float(v) for k, v in r.items()} for r in csv.DictReader(f)]
+
+
+def draw_speed_and_blocks(fig, ax, lo, hi, speed, block, label, fraction, linewidth):
+    """Cells cut by a plane (lower and upper corners, in x and y) coloured by
+    speed, with a white outline around each block."""
+    from matplotlib.collections import PolyCollection
+
+    quads = [[(a[0], a[1]), (b[0], a[1]), (b[0], b[1]), (a[0], b[1])] for a, b in zip(lo, hi)]
+    speeds = PolyCollection(quads, array=speed, cmap="viridis", edgecolors="none")
+    ax.add_collection(speeds)
+    fig.colorbar(speeds, ax=ax, label=label, fraction=fraction)
+    outlines = []
+    for b in np.unique(block):
+        sel = block == b
+        a, c = lo[sel].min(axis=0), hi[sel].max(axis=0)
+        outlines.append([(a[0], a[1]), (c[0], a[1]), (c[0], c[1]), (a[0], c[1])])
+    ax.add_collection(PolyCollection(outlines, facecolors="none", edgecolors="w", linewidths=linewidth))

@@ -48,7 +48,6 @@ Exits 1 if a check fails.
 Usage: /usr/bin/python3 validation/flow/cavity_adaptive.py [--build build] [--threads T] [--replot]
 """
 import argparse
-import csv
 import json
 import subprocess
 import sys
@@ -59,12 +58,11 @@ import matplotlib
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _cavity_common import cell_boxes, read_vtu  # noqa: E402
+from _cavity_common import cell_boxes, draw_speed_and_blocks, read_rows, read_vtu  # noqa: E402
 from cavity import GHIA_U, GHIA_V  # noqa: E402
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-from matplotlib.collections import PolyCollection  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 CASE = ROOT / "cases" / "flow" / "cavity-re100.toml"
@@ -124,11 +122,6 @@ def sanguis_run(exe, name, text, threads):
         subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
         seconds += time.time() - start
     return seconds
-
-
-def read_rows(path):
-    with open(path, newline="") as f:
-        return [{k: float(v) for k, v in r.items()} for r in csv.DictReader(f)]
 
 
 def last_frame(name):
@@ -210,18 +203,8 @@ def draw_grid(fig, ax, arrays, title):
     h = 1.0 / N
     lo, hi = cell_boxes(arrays)
     cut = (lo[:, 2] <= 0.5 * h) & (hi[:, 2] > 0.5 * h)
-    quads = [[(a[0], a[1]), (b[0], a[1]), (b[0], b[1]), (a[0], b[1])] for a, b in zip(lo[cut], hi[cut])]
     speed = np.linalg.norm(arrays["velocity"][cut], axis=1)
-    speeds = PolyCollection(quads, array=speed, cmap="viridis", edgecolors="none")
-    ax.add_collection(speeds)
-    fig.colorbar(speeds, ax=ax, label="|u| / U", fraction=0.045)
-    block = arrays["block"][cut]
-    outlines = []
-    for b in np.unique(block):
-        sel = block == b
-        a, c = lo[cut][sel].min(axis=0), hi[cut][sel].max(axis=0)
-        outlines.append([(a[0], a[1]), (c[0], a[1]), (c[0], c[1]), (a[0], c[1])])
-    ax.add_collection(PolyCollection(outlines, facecolors="none", edgecolors="w", linewidths=0.5))
+    draw_speed_and_blocks(fig, ax, lo[cut], hi[cut], speed, arrays["block"][cut], "|u| / U", 0.045, 0.5)
     ax.set_xlim(0, 1)
     ax.set_ylim(0, 1)
     ax.set_aspect("equal")
@@ -269,9 +252,9 @@ def main():
     ghia_diff = {name: max(np.abs(p["u_ghia"] - GHIA_U[:, 1]).max(),
                            np.abs(p["v_ghia"] - GHIA_V[:, 1]).max())
                  for name, p in profiles.items()}
-    field_diff, differing, seen_through = {}, {}, {}
+    field_diff, differing, seen_through, means_of = {}, {}, {}, {}
     for name in (*ADAPTIVE, "uniform64"):
-        means = cell_means(ref, frames[name])
+        means = means_of[name] = cell_means(ref, frames[name])
         field_diff[name] = float(np.abs(frames[name]["velocity"] - means).max())
         differing[name] = where_cells_differ(frames[name], means, FIELD_TOLERANCE)
         # The uniform run's own field averaged onto this grid's cells, through the
@@ -345,10 +328,9 @@ def main():
                    f"difference from uniform {N}$^2$ / U", "centre lines against the uniform finest run")
     ax5 = fig.add_subplot(2, 3, 5)
     for name in ("adaptive", "adaptive_lid"):
-        means = cell_means(ref, frames[name])
         lo, hi = cell_boxes(frames[name])
         sel = lo[:, 2] < 1e-9
-        d = np.abs(frames[name]["velocity"] - means).max(axis=1)[sel]
+        d = np.abs(frames[name]["velocity"] - means_of[name]).max(axis=1)[sel]
         r = np.minimum(np.hypot(0.5 * (lo + hi)[sel, 0], 1 - 0.5 * (lo + hi)[sel, 1]),
                        np.hypot(1 - 0.5 * (lo + hi)[sel, 0], 1 - 0.5 * (lo + hi)[sel, 1]))
         ax5.loglog(r, d + 1e-7, ".", ms=2, label=name)

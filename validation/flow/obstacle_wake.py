@@ -27,7 +27,6 @@ Exits 1 if a check fails.
 Usage: /usr/bin/python3 validation/flow/obstacle_wake.py [--build build] [--threads T] [--replot]
 """
 import argparse
-import csv
 import json
 import re
 import subprocess
@@ -39,11 +38,10 @@ import matplotlib
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _cavity_common import cell_boxes, read_vtu  # noqa: E402
+from _cavity_common import cell_boxes, draw_speed_and_blocks, read_rows, read_vtu  # noqa: E402
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-from matplotlib.collections import PolyCollection  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 CASE = ROOT / "cases" / "flow" / "obstacle-wake.toml"
@@ -59,11 +57,6 @@ DIVERGENCE_LIMIT = 1e-3
 def set_end(end):
     global END
     END = end
-
-
-def read_rows(path):
-    with open(path, newline="") as f:
-        return [{k: float(v) for k, v in r.items()} for r in csv.DictReader(f)]
 
 
 def sanguis_run(exe, case, out, threads, extra=()):
@@ -201,18 +194,8 @@ def main():
 
     fig = plt.figure(figsize=(13, 7.5))
     lo, hi, level, speed, block = slice_cells(arrays, 4.0 + 1.0 / 32)
-    quads = [[(a[0], a[1]), (b[0], a[1]), (b[0], b[1]), (a[0], b[1])] for a, b in zip(lo, hi)]
     ax1 = fig.add_subplot(2, 2, (1, 2))
-    speeds = PolyCollection(quads, array=speed, cmap="viridis", edgecolors="none")
-    ax1.add_collection(speeds)
-    fig.colorbar(speeds, ax=ax1, label="|u| [m/s]", fraction=0.025)
-    # Block outlines: one rectangle per block cut by the plane.
-    outlines = []
-    for b in np.unique(block):
-        sel = block == b
-        a, c = lo[sel].min(axis=0), hi[sel].max(axis=0)
-        outlines.append([(a[0], a[1]), (c[0], a[1]), (c[0], c[1]), (a[0], c[1])])
-    ax1.add_collection(PolyCollection(outlines, facecolors="none", edgecolors="w", linewidths=0.4))
+    draw_speed_and_blocks(fig, ax1, lo, hi, speed, block, "|u| [m/s]", 0.025, 0.4)
     ax1.add_patch(plt.Rectangle((3.5, 3.5), 1.0, 1.0, color="k"))
     ax1.set_xlim(0, 16)
     ax1.set_ylim(0, 8)
