@@ -26,7 +26,19 @@ Writes validation/flow/results/vortex_adaptive.json (and the driver's CSVs
 under results/runs/vortex/), docs/validation/figures/flow_vortex_adaptive.png.
 Exits 1 if a check fails.
 
-Usage: /usr/bin/python3 validation/flow/vortex_adaptive.py [--build build] [--threads T] [--replot]
+--tilted: the 3D version (the driver's --geometry tilted): the unit cube, 32^3 to
+128^3 cells, the vortex a column whose axis runs along (1, 0, 1)/sqrt(2), so
+the tube the grid refines is tilted against all three axes, carried by the
+same stream along x; one adaptive run, zeta = 5e-3 m/s. The same checks with
+the same tolerances (fixed before its first run, 2026-11-24), except the
+cell count, which is reported and not graded: the issue asks 5x fewer cells
+of Taylor-Green and the cavity, and of the vortex no spurious reflection and
+the tracer's mass. Writes vortex_adaptive_3d.json and
+flow_vortex_adaptive_3d.png (runs under results/runs/vortex_tilted/). About
+20 min on 2 cores.
+
+Usage: /usr/bin/python3 validation/flow/vortex_adaptive.py [--build build] [--threads T]
+           [--tilted] [--replot]
 """
 import argparse
 import csv
@@ -46,9 +58,11 @@ SIGMA, SWIRL = 0.05, 0.5
 CHECKED = "adaptive zeta 0.005"
 
 
-def exact_v(x):
-    """v along y = 0.5 through the vortex centre (x = 0.5 at t = 1)."""
-    r = x - 0.5
+def exact_v(x, tilted=False):
+    """v along y = 0.5 through the vortex centre (x = 0.5 at t = 1); tilted,
+    the line crosses the axis at 45 degrees: the distance from it is
+    |x - 0.5| / sqrt(2), and v is the swirl there."""
+    r = (x - 0.5) / np.sqrt(2.0) if tilted else x - 0.5
     amplitude = SWIRL * SIGMA * np.exp(0.5)
     return r * amplitude / SIGMA**2 * np.exp(-r * r / (2 * SIGMA**2))
 
@@ -62,32 +76,38 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--build", default=str(ROOT / "build"))
     ap.add_argument("--threads", type=int, default=1)
+    ap.add_argument("--tilted", action="store_true", help="the 3D version (see the docstring)")
     ap.add_argument("--replot", action="store_true", help="check and plot existing results")
     args = ap.parse_args()
     started = time.time()
+    power = "^3" if args.tilted else "^2"
+    runs_dir = RUNS.with_name("vortex_tilted") if args.tilted else RUNS
+    figure = FIGURE.with_name("flow_vortex_adaptive_3d.png") if args.tilted else FIGURE
+    summary_path = RESULTS / ("vortex_adaptive_3d.json" if args.tilted else "vortex_adaptive.json")
     if not args.replot:
         exe = Path(args.build) / "validation" / "validate_vortex_adaptive"
-        subprocess.run([str(exe), str(RUNS), "--threads", str(args.threads)], check=True)
+        extra = ["--geometry", "tilted", "--zeta", "0.005"] if args.tilted else []
+        subprocess.run([str(exe), str(runs_dir), "--threads", str(args.threads), *extra], check=True)
     runs = {r["run"]: {k: (v if k == "run" else float(v)) for k, v in r.items()}
-            for r in read_rows(RUNS / "vortex_adaptive.csv")}
+            for r in read_rows(runs_dir / "vortex_adaptive.csv")}
     profiles = {}
-    for r in read_rows(RUNS / "vortex_profiles.csv"):
+    for r in read_rows(runs_dir / "vortex_profiles.csv"):
         profiles.setdefault(r["run"], []).append((float(r["x"]), float(r["v"])))
 
-    fine, mid, ada = runs["uniform 128^2"], runs["uniform 64^2"], runs[CHECKED]
+    fine, mid, ada = runs[f"uniform 128{power}"], runs[f"uniform 64{power}"], runs[CHECKED]
     adaptive = sorted((r for n, r in runs.items() if n.startswith("adaptive")),
                       key=lambda r: r["zeta"])
     cell_ratio = fine["cells_mean"] / ada["cells_mean"]
     checks = [
-        ("cells: uniform 128^2 / adaptive (mean over the steps)", cell_ratio, ">= 5",
-         cell_ratio >= 5.0),
-        ("max velocity error, adaptive / uniform 128^2", ada["max_error"] / fine["max_error"],
+        (f"cells: uniform 128{power} / adaptive (mean over the steps)", cell_ratio,
+         "reported" if args.tilted else ">= 5", args.tilted or cell_ratio >= 5.0),
+        (f"max velocity error, adaptive / uniform 128{power}", ada["max_error"] / fine["max_error"],
          "<= 1.5", ada["max_error"] <= 1.5 * fine["max_error"]),
-        ("RMS velocity error, adaptive / uniform 128^2", ada["rms_error"] / fine["rms_error"],
+        (f"RMS velocity error, adaptive / uniform 128{power}", ada["rms_error"] / fine["rms_error"],
          "<= 1.5", ada["rms_error"] <= 1.5 * fine["rms_error"]),
-        ("max velocity error, adaptive / uniform 64^2", ada["max_error"] / mid["max_error"],
+        (f"max velocity error, adaptive / uniform 64{power}", ada["max_error"] / mid["max_error"],
          "< 1", ada["max_error"] < mid["max_error"]),
-        ("far-field disturbance (r > 4 sigma), adaptive / uniform 128^2",
+        (f"far-field disturbance (r > 4 sigma), adaptive / uniform 128{power}",
          ada["far_field"] / fine["far_field"], "<= 2", ada["far_field"] <= 2 * fine["far_field"]),
         ("tracer mass drift, adaptive", ada["tracer_drift"], "< 1e-12",
          ada["tracer_drift"] < 1e-12),
@@ -96,13 +116,14 @@ def main():
     ]
     ok = all(c[3] for c in checks)
     for name, value, tol, passed in checks:
-        print(f"{'PASS' if passed else 'FAIL'}: {name} = {value:.4g} ({tol})")
+        verdict = "REPORTED" if tol == "reported" else ("PASS" if passed else "FAIL")
+        print(f"{verdict}: {name} = {value:.4g} ({tol})")
 
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4.2))
-    uniform = [runs[n] for n in ("uniform 32^2", "uniform 64^2", "uniform 128^2")]
+    uniform = [runs[f"uniform {n}{power}"] for n in (32, 64, 128)]
     ax1.loglog([r["cells_mean"] for r in uniform], [r["max_error"] for r in uniform], "o-",
                label="uniform, max error")
     ax1.loglog([r["cells_mean"] for r in uniform], [r["rms_error"] for r in uniform], "s-",
@@ -116,12 +137,12 @@ def main():
                      textcoords="offset points", xytext=(4, 4))
     ax1.set_xlabel("cells (mean over the steps)")
     ax1.set_ylabel("velocity error at t = 1 s (m/s)")
-    ax1.set_title("vortex after one crossing")
+    ax1.set_title("vortex after one crossing" + (" (3D, tilted axis)" if args.tilted else ""))
     ax1.legend(fontsize=8)
     xs = np.linspace(0.3, 0.7, 400)
-    ax2.plot(xs, exact_v(xs), "k-", lw=1.2, label="exact")
-    for name, style in (("uniform 32^2", ":"), ("uniform 64^2", "--"), ("uniform 128^2", "-"),
-                        (CHECKED, "o")):
+    ax2.plot(xs, exact_v(xs, args.tilted), "k-", lw=1.2, label="exact")
+    for name, style in ((f"uniform 32{power}", ":"), (f"uniform 64{power}", "--"),
+                        (f"uniform 128{power}", "-"), (CHECKED, "o")):
         pts = sorted(p for p in profiles.get(name, []) if 0.3 <= p[0] <= 0.7)
         if pts:
             x, v = zip(*pts)
@@ -131,8 +152,8 @@ def main():
     ax2.set_title("swirl through the vortex centre")
     ax2.legend(fontsize=8)
     fig.tight_layout()
-    FIGURE.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(FIGURE, dpi=110)
+    figure.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(figure, dpi=110)
 
     summary = {
         "runs": runs,
@@ -141,8 +162,8 @@ def main():
         "script_seconds": round(time.time() - started, 1),
         "date": time.strftime("%Y-%m-%d %H:%M"),
     }
-    (RESULTS / "vortex_adaptive.json").write_text(json.dumps(summary, indent=1))
-    print(f"{'PASS' if ok else 'FAIL'}; figure {FIGURE.relative_to(ROOT)}")
+    summary_path.write_text(json.dumps(summary, indent=1))
+    print(f"{'PASS' if ok else 'FAIL'}; figure {figure.relative_to(ROOT)}")
     return 0 if ok else 1
 
 

@@ -4,6 +4,7 @@
 // the velocity), with a passive tracer in its core.
 //
 //   validate_vortex_adaptive OUTDIR [--threads T] [--zeta Z1,Z2,..] [--uniform yes|no]
+//                            [--geometry plane|tilted]
 //
 // The box is the unit square, periodic in x and y, one tree (1/4) thick and
 // periodic in z; blocks of 8^3 cells; levels 0, 1, 2 give 32^2, 64^2 and
@@ -13,6 +14,15 @@
 // of the Euler equations; with U = (1, 0, 0) and no viscosity the exact
 // field at t = 1 is the initial one. Every run takes the same time step
 // (CFL 0.8 of the finest grid), so that only the grids differ.
+//
+// --geometry tilted: the 3D version. The box is the unit cube (4^3 trees,
+// 32^3 to 128^3 cells) and the vortex is a column whose axis runs along
+// (1, 0, 1)/sqrt(2) through the box (it closes on itself through the periodic
+// faces after a length sqrt(2); its images are 0.71 = 14 sigma apart, where
+// the Gaussian is 1e-21), with the same profile across the axis: still an
+// exact steady Euler solution, carried by the same stream along x. Its
+// refined region is a tilted tube, so the coarse-fine faces it crosses face
+// all three directions.
 //
 // Writes OUTDIR/vortex_adaptive.csv (one row per run: errors against the
 // exact field, the far-field disturbance, cells, tracer drift, wall time)
@@ -47,28 +57,43 @@ const Vec3 kStream{1.0, 0.0, 0.0};
 const Vec3 kStart{0.5, 0.5, 0.0};
 constexpr double kEnd = 1.0;     // one crossing of the box
 constexpr int kFinestLevel = 2;  // every run steps at the CFL step of 128^2
+bool g_tilted = false;           // --geometry tilted: the 3D column along kAxis
+const Vec3 kAxis{1.0 / std::sqrt(2.0), 0.0, 1.0 / std::sqrt(2.0)};
 
-/// Nearest periodic image of x - centre in the plane.
+/// x - centre across the vortex axis, to the nearest periodic image: in the
+/// plane, the nearest image of x - centre; tilted, the component normal to
+/// kAxis, the shortest over the images of the nearest 27 boxes.
 Vec3 offset(const Vec3& x, const Vec3& centre) {
-  Vec3 r{x.x - centre.x, x.y - centre.y, 0.0};
+  Vec3 r{x.x - centre.x, x.y - centre.y, g_tilted ? x.z - centre.z : 0.0};
   r.x -= std::round(r.x);
   r.y -= std::round(r.y);
-  return r;
+  r.z -= std::round(r.z);
+  if (!g_tilted) return r;
+  Vec3 best{1e9, 1e9, 1e9};
+  for (int i = -1; i <= 1; ++i)
+    for (int j = -1; j <= 1; ++j)
+      for (int k = -1; k <= 1; ++k) {
+        const Vec3 image = r + Vec3{double(i), double(j), double(k)};
+        const Vec3 across = image - dot(image, kAxis) * kAxis;
+        if (dot(across, across) < dot(best, best)) best = across;
+      }
+  return best;
 }
 
 /// Exact velocity at time t: the vortex at kStart + U t in the stream.
 Vec3 exact(const Vec3& x, double t) {
   const Vec3 r = offset(x, kStart + t * kStream);
   const double amplitude = kSwirl * kSigma * std::exp(0.5);  // A: peak swirl at r = sigma
-  const double g =
-      amplitude / (kSigma * kSigma) * std::exp(-(r.x * r.x + r.y * r.y) / (2 * kSigma * kSigma));
-  // u = d psi/dy, v = -d psi/dx with psi = A exp(-r^2 / 2 sigma^2).
+  const double g = amplitude / (kSigma * kSigma) * std::exp(-dot(r, r) / (2 * kSigma * kSigma));
+  // u = d psi/dy, v = -d psi/dx with psi = A exp(-r^2 / 2 sigma^2): in the
+  // plane g (z x r), about the tilted axis g (axis x r).
+  if (g_tilted) return kStream + g * cross(kAxis, r);
   return kStream + Vec3{-r.y * g, r.x * g, 0.0};
 }
 
 double tracer0(const Vec3& x) {
   const Vec3 r = offset(x, kStart);
-  return std::exp(-(r.x * r.x + r.y * r.y) / (2 * kSigma * kSigma));
+  return std::exp(-dot(r, r) / (2 * kSigma * kSigma));
 }
 
 struct RunResult {
@@ -104,7 +129,7 @@ Vec3 centre_of(const Block& block, int b, int i, int j, int k) {
 /// One run: uniform at `min_level` when min_level == max_level, else adaptive.
 RunResult run(const std::string& name, int min_level, int max_level, double zeta, int threads) {
   ForestSpec spec;
-  spec.trees = {4, 4, 1};
+  spec.trees = {4, 4, g_tilted ? 4 : 1};
   spec.tree_length = 0.25;
   spec.periodic = {true, true, true};
   spec.level = min_level;
@@ -166,7 +191,7 @@ RunResult run(const std::string& name, int min_level, int max_level, double zeta
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   r.cells_mean = cell_sum / steps;
   r.cells_end = static_cast<double>(forest.global_blocks()) * b3;
-  r.cells_uniform_finest = 16.0 * std::pow(8.0, max_level) * b3;
+  r.cells_uniform_finest = (g_tilted ? 64.0 : 16.0) * std::pow(8.0, max_level) * b3;
   r.tracer_drift = std::abs(total(forest, tracer) / mass0 - 1.0);
   const int b = forest.block_cells();
   const Vec3 centre = kStart + ns.time() * kStream;
@@ -185,7 +210,7 @@ RunResult run(const std::string& name, int min_level, int max_level, double zeta
           sum2 += dot(e, e) * h * h * h;
           volume += h * h * h;
           const Vec3 d = offset(x, centre);
-          if (std::sqrt(d.x * d.x + d.y * d.y) > 4 * kSigma) {
+          if (std::sqrt(dot(d, d)) > 4 * kSigma) {
             r.far_field = std::max(r.far_field, norm(u - kStream));
           }
           // v on the cells next to the plane y = 0.5 (and the lowest z layer).
@@ -226,6 +251,13 @@ int main(int argc, char** argv) {
         zetas.push_back(std::atof(list.substr(at, comma - at).c_str()));
         at = comma + 1;
       }
+    } else if (key == "--geometry") {  // plane (default) or tilted (3D)
+      const std::string geometry = argv[a + 1];
+      if (geometry != "plane" && geometry != "tilted") {
+        std::cerr << "--geometry: plane or tilted, not " << geometry << "\n";
+        return 2;
+      }
+      g_tilted = geometry == "tilted";
     } else if (key == "--uniform") {  // yes (default) or no: skip the uniform runs
       uniform = std::string(argv[a + 1]) != "no";
     } else {
@@ -241,7 +273,13 @@ int main(int argc, char** argv) {
   };
   std::vector<Spec> runs;
   if (uniform) {
-    runs = {{"uniform 32^2", 0, 0, 0.0}, {"uniform 64^2", 1, 1, 0.0}, {"uniform 128^2", 2, 2, 0.0}};
+    if (g_tilted) {
+      runs = {
+          {"uniform 32^3", 0, 0, 0.0}, {"uniform 64^3", 1, 1, 0.0}, {"uniform 128^3", 2, 2, 0.0}};
+    } else {
+      runs = {
+          {"uniform 32^2", 0, 0, 0.0}, {"uniform 64^2", 1, 1, 0.0}, {"uniform 128^2", 2, 2, 0.0}};
+    }
   }
   for (const double zeta : zetas) {
     char name[64];
