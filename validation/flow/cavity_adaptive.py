@@ -198,9 +198,10 @@ ADAPTIVE = {"adaptive": "velocity criterion", "adaptive_lid": "velocity criterio
 
 def configure(finest):
     """Sets the module constants for --finest; returns the runs."""
-    global N, REFERENCE_THICK, TIME_STEP, RUNS, FIGURE, SUMMARY, ADAPTIVE
+    global N, THICK, REFERENCE_THICK, TIME_STEP, RUNS, FIGURE, SUMMARY, ADAPTIVE
     setup = SETUPS[finest]
     N, REFERENCE_THICK, TIME_STEP = finest, setup["reference_thick"], setup["time_step"]
+    THICK = setup["runs"]["adaptive"][3]  # the adaptive runs' slab, in finest cells
     RUNS = RESULTS / "runs" / f"cavity_adaptive{setup['suffix']}"
     FIGURE = FIGURE.with_name(f"flow_cavity_adaptive{setup['suffix']}.png")
     SUMMARY = RESULTS / f"cavity_adaptive{setup['suffix']}.json"

@@ -31,11 +31,13 @@ Exits 1 if a check fails.
 the tube the grid refines is tilted against all three axes, carried by the
 same stream along x; one adaptive run, zeta = 5e-3 m/s. The same checks with
 the same tolerances (fixed before its first run, 2026-11-24), except the
-cell count, which is reported and not graded: the issue asks 5x fewer cells
-of Taylor-Green and the cavity, and of the vortex no spurious reflection and
-the tracer's mass. Writes vortex_adaptive_3d.json and
-flow_vortex_adaptive_3d.png (runs under results/runs/vortex_tilted/). About
-20 min on 2 cores.
+cell count, which is reported and not graded (pass: null in the JSON): the
+issue asks 5x fewer cells of Taylor-Green and the cavity, and of the vortex
+no spurious reflection and the tracer's mass. (It measured 4.92, which the
+plane version's >= 5 would fail: the tilted column is sqrt(2) long in the
+box, so its tube fills sqrt(2) times the volume.) Writes
+vortex_adaptive_3d.json and flow_vortex_adaptive_3d.png (runs under
+results/runs/vortex_tilted/). About 17 min on 2 cores.
 
 Usage: /usr/bin/python3 validation/flow/vortex_adaptive.py [--build build] [--threads T]
            [--tilted] [--replot]
@@ -59,12 +61,21 @@ CHECKED = "adaptive zeta 0.005"
 
 
 def exact_v(x, tilted=False):
-    """v along y = 0.5 through the vortex centre (x = 0.5 at t = 1); tilted,
-    the line crosses the axis at 45 degrees: the distance from it is
-    |x - 0.5| / sqrt(2), and v is the swirl there."""
-    r = (x - 0.5) / np.sqrt(2.0) if tilted else x - 0.5
+    """v along y = 0.5 through the vortex centre (x = 0.5 at t = 1). Tilted:
+    v on the line the 128^3 run samples, y = 0.5 + h/2, z = h/2 (h = 1/128;
+    the driver samples the cells above y = 0.5 in the lowest layer), which
+    crosses the axis (1, 0, 1)/sqrt(2) through (0.5, 0.5, 0) at x = 0.5 + h/2;
+    coarser uniform runs sample their own h/2 farther along."""
     amplitude = SWIRL * SIGMA * np.exp(0.5)
-    return r * amplitude / SIGMA**2 * np.exp(-r * r / (2 * SIGMA**2))
+    if not tilted:
+        r = x - 0.5
+        return r * amplitude / SIGMA**2 * np.exp(-r * r / (2 * SIGMA**2))
+    h = 1.0 / 128
+    axis = np.array([1.0, 0.0, 1.0]) / np.sqrt(2.0)
+    r = np.stack([x - 0.5, np.full_like(x, 0.5 * h), np.full_like(x, 0.5 * h)], axis=1)
+    across = r - np.outer(r @ axis, axis)
+    g = amplitude / SIGMA**2 * np.exp(-(across * across).sum(axis=1) / (2 * SIGMA**2))
+    return g * np.cross(axis, across)[:, 1]
 
 
 def read_rows(path):
@@ -100,7 +111,7 @@ def main():
     cell_ratio = fine["cells_mean"] / ada["cells_mean"]
     checks = [
         (f"cells: uniform 128{power} / adaptive (mean over the steps)", cell_ratio,
-         "reported" if args.tilted else ">= 5", args.tilted or cell_ratio >= 5.0),
+         "reported" if args.tilted else ">= 5", None if args.tilted else cell_ratio >= 5.0),
         (f"max velocity error, adaptive / uniform 128{power}", ada["max_error"] / fine["max_error"],
          "<= 1.5", ada["max_error"] <= 1.5 * fine["max_error"]),
         (f"RMS velocity error, adaptive / uniform 128{power}", ada["rms_error"] / fine["rms_error"],
@@ -114,7 +125,7 @@ def main():
         ("max |div uf| over the steps, adaptive (1/s)", ada["max_divergence"], "< 1e-6",
          ada["max_divergence"] < 1e-6),
     ]
-    ok = all(c[3] for c in checks)
+    ok = all(c[3] for c in checks if c[3] is not None)  # None: reported, not graded
     for name, value, tol, passed in checks:
         verdict = "REPORTED" if tol == "reported" else ("PASS" if passed else "FAIL")
         print(f"{verdict}: {name} = {value:.4g} ({tol})")
@@ -140,7 +151,8 @@ def main():
     ax1.set_title("vortex after one crossing" + (" (3D, tilted axis)" if args.tilted else ""))
     ax1.legend(fontsize=8)
     xs = np.linspace(0.3, 0.7, 400)
-    ax2.plot(xs, exact_v(xs, args.tilted), "k-", lw=1.2, label="exact")
+    ax2.plot(xs, exact_v(xs, args.tilted), "k-", lw=1.2,
+             label="exact (on the 128$^3$ sampling line)" if args.tilted else "exact")
     for name, style in ((f"uniform 32{power}", ":"), (f"uniform 64{power}", "--"),
                         (f"uniform 128{power}", "-"), (CHECKED, "o")):
         pts = sorted(p for p in profiles.get(name, []) if 0.3 <= p[0] <= 0.7)

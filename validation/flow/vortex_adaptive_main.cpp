@@ -18,9 +18,11 @@
 // --geometry tilted: the 3D version. The box is the unit cube (4^3 trees,
 // 32^3 to 128^3 cells) and the vortex is a column whose axis runs along
 // (1, 0, 1)/sqrt(2) through the box (it closes on itself through the periodic
-// faces after a length sqrt(2); its images are 0.71 = 14 sigma apart, where
-// the Gaussian is 1e-21), with the same profile across the axis: still an
-// exact steady Euler solution, carried by the same stream along x. Its
+// faces after a length sqrt(2); its images are 0.71 = 14 sigma apart, so the
+// nearest image changes 7.1 sigma from the axis, where the Gaussian is
+// 1.4e-11: the field is periodic and steady to about 1e-10 m/s), with the
+// same profile across the axis: an exact steady Euler solution to that
+// level, carried by the same stream along x. Its
 // refined region is a tilted tube, so the coarse-fine faces it crosses face
 // all three directions.
 //
@@ -231,7 +233,7 @@ RunResult run(const std::string& name, int min_level, int max_level, double zeta
 int main(int argc, char** argv) {
   if (argc < 2) {
     std::cerr << "usage: validate_vortex_adaptive OUTDIR [--threads T] [--zeta Z1,Z2,..] "
-                 "[--uniform yes|no]\n";
+                 "[--uniform yes|no] [--geometry plane|tilted]\n";
     return 2;
   }
   MpiSession::ensure();
