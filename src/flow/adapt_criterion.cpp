@@ -147,6 +147,9 @@ std::vector<AdaptFlag> wavelet_flags(const Forest& forest, std::span<BlockField*
   if (!criterion.block_min_level.empty() && criterion.block_min_level.size() != blocks) {
     throw std::invalid_argument("wavelet flags: block_min_level needs one level per local block");
   }
+  if (!criterion.block_max_level.empty() && criterion.block_max_level.size() != blocks) {
+    throw std::invalid_argument("wavelet flags: block_max_level needs one level per local block");
+  }
   for (const BlockField* f : fields) {
     if (f->cells() < 4 || f->layout().ghost < 2) {
       throw std::invalid_argument("wavelet flags: needs blocks of >= 4 cells and 2 ghost layers");
@@ -161,11 +164,19 @@ std::vector<AdaptFlag> wavelet_flags(const Forest& forest, std::span<BlockField*
                : std::clamp(criterion.block_min_level[blk], criterion.min_level,
                             std::max(criterion.min_level, criterion.max_level));
   };
-  // A block at max_level that may not coarsen either has nothing to decide.
+  // The finest level the criterion may take a block to: max_level, or the
+  // block's cap, but never below its floor.
+  auto ceiling_of = [&](std::size_t blk) {
+    const int cap = criterion.block_max_level.empty()
+                        ? criterion.max_level
+                        : std::min(criterion.block_max_level[blk], criterion.max_level);
+    return std::max(cap, floor_of(blk));
+  };
+  // A block at its ceiling that may not coarsen either has nothing to decide.
   std::vector<bool> pinned(blocks);
   for (std::size_t blk = 0; blk < blocks; ++blk) {
     const int level = forest.block(static_cast<int>(blk)).level;
-    pinned[blk] = level >= criterion.max_level && level <= floor_of(blk);
+    pinned[blk] = level >= ceiling_of(blk) && level <= floor_of(blk);
   }
   std::vector<bool> refine(blocks, false), coarsen(blocks, true);
   forest.exchange(fields, 2, true);  // face ghosts: the slopes are taken along one direction
@@ -241,9 +252,11 @@ std::vector<AdaptFlag> wavelet_flags(const Forest& forest, std::span<BlockField*
           for (int i = 0; i < b && !tagged; ++i)
             tagged = (*finest_tag)(static_cast<int>(blk), i, j, k) > 0.0;
     }
-    if (level > criterion.max_level) {
+    // Forced-finest cells (immersed-boundary stencils) override a region's cap.
+    const int top = tagged ? std::max(criterion.max_level, floor_of(blk)) : ceiling_of(blk);
+    if (level > top) {
       flags[blk] = AdaptFlag::Coarsen;
-    } else if (level < floor_of(blk) || ((tagged || refine[blk]) && level < criterion.max_level)) {
+    } else if (level < floor_of(blk) || ((tagged || refine[blk]) && level < top)) {
       flags[blk] = AdaptFlag::Refine;
     } else if (!tagged && !refine[blk] && coarsen[blk]) {
       flags[blk] = AdaptFlag::Coarsen;

@@ -40,6 +40,12 @@ struct WaveletCriterion {
   /// level (at most max_level) and never coarsened below it (refinement
   /// regions). A block at max_level that may not coarsen is not estimated.
   std::vector<int> block_min_level{};
+  /// Optional, one per local block: the block is never refined beyond this
+  /// level (regions kept coarse, e.g. a far field), and a block above it is
+  /// coarsened. Where it is below the block's floor (block_min_level), the
+  /// floor wins; cells tagged forced-finest still take their block to
+  /// max_level.
+  std::vector<int> block_max_level{};
 };
 
 /// The estimate (4.11) of every local block: the largest e over its cells.

@@ -138,12 +138,27 @@ void read_adaptivity(const ConfigTable& flow, const ConfigTable& t, FlowCase& c)
     for (int d = 0; d < 3; ++d) {
       if (!(region.max[d] > region.min[d])) r.fail("max_m", "must be above min_m in x, y and z");
     }
-    const std::int64_t levels = r.get_int("refine_levels");
+    const std::string range = "must be in -coarsen_levels..refine_levels of [flow.adapt] (" +
+                              std::to_string(-coarsen) + ".." + std::to_string(refine) + ")";
+    const bool capped = r.has("max_refine_levels");
+    if (!capped && !r.has("refine_levels")) {
+      r.fail("refine_levels", "a region needs refine_levels, max_refine_levels or both");
+    }
+    // A region gives a floor, a cap or both; with a cap alone it has no floor.
+    const std::int64_t levels =
+        capped ? r.get_int("refine_levels", -static_cast<std::int64_t>(coarsen))
+               : r.get_int("refine_levels");
     if (levels < -static_cast<std::int64_t>(coarsen) || levels > refine) {
-      r.fail("refine_levels", "must be in -coarsen_levels..refine_levels of [flow.adapt] (" +
-                                  std::to_string(-coarsen) + ".." + std::to_string(refine) + ")");
+      r.fail("refine_levels", range);
     }
     region.refine_levels = static_cast<int>(levels);
+    if (capped) {
+      const std::int64_t cap = r.get_int("max_refine_levels");
+      if (cap < -static_cast<std::int64_t>(coarsen) || cap > refine)
+        r.fail("max_refine_levels", range);
+      if (cap < levels) r.fail("max_refine_levels", "must be >= the region's refine_levels");
+      region.max_refine_levels = static_cast<int>(cap);
+    }
     a.regions.push_back(region);
   }
 }
@@ -356,8 +371,9 @@ std::string describe(const FlowCase& c) {
       << c.adapt.min_level << ".." << c.adapt.max_level << ")\n";
     for (const auto& r : c.adapt.regions) {
       s << "refinement region (" << r.min.x << ", " << r.min.y << ", " << r.min.z << ") - ("
-        << r.max.x << ", " << r.max.y << ", " << r.max.z << ") m: at least " << r.refine_levels
-        << " level(s) above the grid\n";
+        << r.max.x << ", " << r.max.y << ", " << r.max.z << ") m: at least " << r.refine_levels;
+      if (r.max_refine_levels) s << ", at most " << *r.max_refine_levels;
+      s << " level(s) above the grid\n";
     }
   }
   return s.str();

@@ -6,6 +6,7 @@
 
 #include <array>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -14,10 +15,12 @@
 
 namespace sanguis::flow {
 
-/// A box where the grid stays at least `refine_levels` finer than [flow.grid].
+/// A box where the grid stays at least `refine_levels` finer than [flow.grid]
+/// and, with `max_refine_levels`, at most that many finer.
 struct RefinementRegion {
-  Vec3 min{}, max{};      ///< (m)
-  int refine_levels = 0;  ///< levels above the grid's
+  Vec3 min{}, max{};                     ///< (m)
+  int refine_levels = 0;                 ///< levels above the grid's (a floor)
+  std::optional<int> max_refine_levels;  ///< levels above the grid's (a cap)
 };
 
 /// [flow.adapt]: the grid follows the flow (wavelet criterion, eq. 4.11).

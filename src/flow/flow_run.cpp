@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -85,23 +86,34 @@ double leaf_cells(const Forest& forest) {
 }
 
 /// [flow.adapt]: the wavelet criterion (eq. 4.11) on the three velocity
-/// components within the case's levels, and at least the regions' levels.
+/// components within the case's levels, at least the regions' floors and at
+/// most their caps (a block overlapping a region takes both).
 std::vector<AdaptFlag> adapt_flags(const FlowAdaptivity& a, const Forest& forest,
                                    NavierStokes& ns) {
   const double zeta = a.velocity_threshold;
   WaveletCriterion criterion{{zeta, zeta, zeta}, a.min_level, a.max_level};
   const int base = forest.spec().level;
-  criterion.block_min_level.assign(static_cast<std::size_t>(forest.local_blocks()), a.min_level);
+  const auto blocks = static_cast<std::size_t>(forest.local_blocks());
+  criterion.block_min_level.assign(blocks, a.min_level);
+  const bool capped = std::any_of(a.regions.begin(), a.regions.end(),
+                                  [](const RefinementRegion& r) { return r.max_refine_levels; });
+  if (capped) criterion.block_max_level.assign(blocks, a.max_level);
   for (int blk = 0; blk < forest.local_blocks(); ++blk) {
     const Block& block = forest.block(blk);
-    int& floor = criterion.block_min_level[static_cast<std::size_t>(blk)];
+    const auto at = static_cast<std::size_t>(blk);
     for (const RefinementRegion& r : a.regions) {
       bool overlaps = true;
       for (int d = 0; d < 3; ++d) {
         overlaps =
             overlaps && block.lower[d] < r.max[d] && block.lower[d] + block.length > r.min[d];
       }
-      if (overlaps) floor = std::max(floor, base + r.refine_levels);
+      if (!overlaps) continue;
+      criterion.block_min_level[at] =
+          std::max(criterion.block_min_level[at], base + r.refine_levels);
+      if (r.max_refine_levels) {
+        criterion.block_max_level[at] =
+            std::min(criterion.block_max_level[at], base + *r.max_refine_levels);
+      }
     }
   }
   BlockField* velocity[] = {&ns.velocity()[0], &ns.velocity()[1], &ns.velocity()[2]};

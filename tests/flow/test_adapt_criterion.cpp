@@ -79,6 +79,46 @@ TEST(FlowAdaptCriterion, PerBlockFloorsRefineBelowThemAndNeverCoarsenAtThem) {
   EXPECT_THROW(wavelet_flags(forest, fields, criterion), std::invalid_argument);
 }
 
+TEST(FlowAdaptCriterion, PerBlockCapsStopRefinementTheFloorAndTheTagOverrideThem) {
+  // The front along x = 0.5 on level-2 blocks (centres x = 0.125 .. 0.875):
+  // the blocks beside it (0.375, 0.625) would refine. Caps: 2 at 0.375 (it
+  // stays), 1 at 0.625 (it is above its cap: it coarsens, although the
+  // front wants it finer), 2 with a floor of 3 at 0.125 (the floor wins).
+  const Forest forest(spec_at(2));
+  BlockField u(forest.local_blocks(), 8);
+  fill_cells(forest, u, [](const Vec3& x) { return std::tanh((x.x - 0.5) / 0.01); });
+  WaveletCriterion criterion{{1e-3}, 1, 3};
+  const auto blocks = static_cast<std::size_t>(forest.local_blocks());
+  criterion.block_min_level.assign(blocks, 1);
+  criterion.block_max_level.assign(blocks, 3);
+  auto column = [&](int blk) { return static_cast<int>(block_centre(forest.block(blk)).x * 4); };
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    const auto at = static_cast<std::size_t>(blk);
+    if (column(blk) == 0) criterion.block_min_level[at] = 3;
+    if (column(blk) == 0 || column(blk) == 1) criterion.block_max_level[at] = 2;
+    if (column(blk) == 2) criterion.block_max_level[at] = 1;
+  }
+  BlockField* fields[] = {&u};
+  const auto flags = wavelet_flags(forest, fields, criterion);
+  const AdaptFlag expected[] = {AdaptFlag::Refine, AdaptFlag::Keep, AdaptFlag::Coarsen,
+                                AdaptFlag::Coarsen};  // the last column: flat, no cap
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    EXPECT_EQ(flags[static_cast<std::size_t>(blk)], expected[column(blk)])
+        << "column " << column(blk);
+  }
+  // Forced-finest cells take their block to max_level through its cap.
+  BlockField tag(forest.local_blocks(), 8);
+  fill_cells(forest, tag, [](const Vec3& x) { return x.x > 0.25 && x.x < 0.75 ? 1.0 : 0.0; });
+  const auto tagged = wavelet_flags(forest, fields, criterion, &tag);
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    if (column(blk) == 1 || column(blk) == 2) {
+      EXPECT_EQ(tagged[static_cast<std::size_t>(blk)], AdaptFlag::Refine);
+    }
+  }
+  criterion.block_max_level.resize(3);
+  EXPECT_THROW(wavelet_flags(forest, fields, criterion), std::invalid_argument);
+}
+
 TEST(FlowAdaptCriterion, CubicGivesTheThirdOrderWaveletExactly) {
   // u = x^3: R(u) = X^3 + 3 X h^2 / 4 per coarse cell (h the fine cell), the
   // central slope over one coarse cell 6 X^2 h + 9.5 h^3, so P(R(u)) differs

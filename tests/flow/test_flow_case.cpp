@@ -269,12 +269,57 @@ TEST(FlowCaseErrors, AdaptivityKeysAreChecked) {
                      "coarsen_levels");
   expect_input_error(replaced(kAdaptiveChannel, "refine_levels = 1 }]", "refine_levels = 2 }]"),
                      "region[0].refine_levels");
+  // A cap (max_refine_levels): alone (no floor), with a floor, never below it.
+  const FlowCase capped =
+      parse(replaced(kAdaptiveChannel, "refine_levels = 1 }]", "max_refine_levels = 0 }]"));
+  ASSERT_EQ(capped.adapt.regions.size(), 1u);
+  EXPECT_EQ(capped.adapt.regions[0].refine_levels, 0);  // -coarsen_levels: no floor
+  EXPECT_EQ(capped.adapt.regions[0].max_refine_levels, 0);
+  expect_input_error(replaced(kAdaptiveChannel, "refine_levels = 1 }]",
+                              "refine_levels = 1, max_refine_levels = 0 }]"),
+                     "region[0].max_refine_levels': must be >= the region's refine_levels");
+  expect_input_error(replaced(kAdaptiveChannel, "refine_levels = 1 }]", "max_refine_levels = 2 }]"),
+                     "region[0].max_refine_levels");
+  expect_input_error(replaced(kAdaptiveChannel, "refine_levels = 1 }]", "max_refine_level = 0 }]"),
+                     "region[0].refine_levels': a region needs refine_levels, "
+                     "max_refine_levels or both");
   expect_input_error(
       replaced(kAdaptiveChannel, "cells = [8, 16, 8]", "cells = [8, 16, 8]\nblock_cells = 2"),
       "grid.block_cells");
   expect_input_error(
       replaced(kAdaptiveChannel, "velocity_threshold_m_s = 7e-4", "velocity_threshold_m_s = -1.0"),
       "velocity_threshold_m_s");
+}
+
+TEST(FlowRun, ARegionsCapKeepsItsBlocksAtMostThatFine) {
+  // kAdaptiveChannel refines its upper half too while the lid's shear layer
+  // grows (8192 cells at t = 0.02, 0.03); capped at the grid's level there,
+  // the run keeps 8 fine level-1 regions below and the coarse upper half:
+  // 8 x 512 + 512 = 4608 cells in every row.
+  const auto base = std::filesystem::temp_directory_path() / "sanguis_flow_capped_test";
+  std::filesystem::remove_all(base);
+  const FlowCase c = parse(replaced(
+      kAdaptiveChannel, "refine_levels = 1 }]",
+      "refine_levels = 1 },\n          { min_m = [0.0, 0.5, 0.0], max_m = [0.5, 1.0, 0.5], "
+      "max_refine_levels = 0 }]"));
+  ASSERT_EQ(c.adapt.regions.size(), 2u);
+  std::ostringstream console;
+  FlowRunOptions options;
+  options.output_dir = base;
+  options.quiet = true;
+  run_flow_case(c, options, console);
+  const std::string csv = read_bytes(base / "diagnostics.csv");
+  const std::string header = csv.substr(0, csv.find('\n'));
+  const auto column = std::count(header.begin(), header.begin() + header.find(",cells,") + 1, ',');
+  int rows = 0;
+  for (std::size_t at = csv.find('\n'); at + 1 < csv.size(); at = csv.find('\n', at + 1)) {
+    std::string row = csv.substr(at + 1, csv.find('\n', at + 1) - at - 1);
+    for (auto skip = column; skip > 0; --skip) row.erase(0, row.find(',') + 1);
+    EXPECT_EQ(std::stod(row.substr(0, row.find(','))), 4608.0) << "row " << rows;
+    ++rows;
+  }
+  EXPECT_EQ(rows, 5);
+  std::filesystem::remove_all(base);
 }
 
 TEST(FlowRun, AdaptiveRunRefinesAndRestartsOnItsGridBitForBit) {
