@@ -138,8 +138,13 @@ void read_adaptivity(const ConfigTable& flow, const ConfigTable& t, FlowCase& c)
     for (int d = 0; d < 3; ++d) {
       if (!(region.max[d] > region.min[d])) r.fail("max_m", "must be above min_m in x, y and z");
     }
-    const std::string range = "must be in -coarsen_levels..refine_levels of [flow.adapt] (" +
-                              std::to_string(-coarsen) + ".." + std::to_string(refine) + ")";
+    // Both keys count levels above the grid's, within [flow.adapt]'s range.
+    const auto check_range = [&](const char* key, std::int64_t value) {
+      if (value < -static_cast<std::int64_t>(coarsen) || value > refine) {
+        r.fail(key, "must be in -coarsen_levels..refine_levels of [flow.adapt] (" +
+                        std::to_string(-coarsen) + ".." + std::to_string(refine) + ")");
+      }
+    };
     const bool capped = r.has("max_refine_levels");
     if (!capped && !r.has("refine_levels")) {
       r.fail("refine_levels", "a region needs refine_levels, max_refine_levels or both");
@@ -148,14 +153,11 @@ void read_adaptivity(const ConfigTable& flow, const ConfigTable& t, FlowCase& c)
     const std::int64_t levels =
         capped ? r.get_int("refine_levels", -static_cast<std::int64_t>(coarsen))
                : r.get_int("refine_levels");
-    if (levels < -static_cast<std::int64_t>(coarsen) || levels > refine) {
-      r.fail("refine_levels", range);
-    }
+    check_range("refine_levels", levels);
     region.refine_levels = static_cast<int>(levels);
     if (capped) {
       const std::int64_t cap = r.get_int("max_refine_levels");
-      if (cap < -static_cast<std::int64_t>(coarsen) || cap > refine)
-        r.fail("max_refine_levels", range);
+      check_range("max_refine_levels", cap);
       if (cap < levels) r.fail("max_refine_levels", "must be >= the region's refine_levels");
       region.max_refine_levels = static_cast<int>(cap);
     }

@@ -87,14 +87,13 @@ THICK = 32  # cells across the slab at the finest (4 blocks: two levels of coars
 REFERENCE_THICK = 32  # cells across the uniform reference's slab
 ZETA = 1e-2  # of the lid speed U = 1 m/s
 TIME_STEP = 0.005  # fixed: below the CFL step of every grid here (see the docstring)
-# What --finest changes: cells per side, reference slab thickness [cells], fixed step,
-# the runs {name: (cells per side, adaptive, lid band finest, slab cells across)},
-# and the suffix of the output names.
+# What --finest changes: the fixed step, the runs {name: (cells per side, adaptive,
+# lid band finest, slab cells across)} and the suffix of the output names.
 SETUPS = {
-    128: {"reference_thick": 32, "time_step": 0.005, "suffix": "",
+    128: {"time_step": 0.005, "suffix": "",
           "runs": {"adaptive": (128, True, False, 32), "adaptive_lid": (128, True, True, 32),
                    "uniform": (128, False, False, 32), "uniform64": (64, False, False, 16)}},
-    256: {"reference_thick": 8, "time_step": 0.0025, "suffix": "_256",
+    256: {"time_step": 0.0025, "suffix": "_256",
           "runs": {"adaptive": (256, True, False, 32), "uniform": (256, False, False, 8)}},
 }
 CELL_RATIO = 5.0
@@ -200,8 +199,9 @@ def configure(finest):
     """Sets the module constants for --finest; returns the runs."""
     global N, THICK, REFERENCE_THICK, TIME_STEP, RUNS, FIGURE, SUMMARY, ADAPTIVE
     setup = SETUPS[finest]
-    N, REFERENCE_THICK, TIME_STEP = finest, setup["reference_thick"], setup["time_step"]
+    N, TIME_STEP = finest, setup["time_step"]
     THICK = setup["runs"]["adaptive"][3]  # the adaptive runs' slab, in finest cells
+    REFERENCE_THICK = setup["runs"]["uniform"][3]
     RUNS = RESULTS / "runs" / f"cavity_adaptive{setup['suffix']}"
     FIGURE = FIGURE.with_name(f"flow_cavity_adaptive{setup['suffix']}.png")
     SUMMARY = RESULTS / f"cavity_adaptive{setup['suffix']}.json"

@@ -193,7 +193,8 @@ RunResult run(const std::string& name, int min_level, int max_level, double zeta
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   r.cells_mean = cell_sum / steps;
   r.cells_end = static_cast<double>(forest.global_blocks()) * b3;
-  r.cells_uniform_finest = (g_tilted ? 64.0 : 16.0) * std::pow(8.0, max_level) * b3;
+  const auto& trees = forest.spec().trees;
+  r.cells_uniform_finest = double(trees[0]) * trees[1] * trees[2] * std::pow(8.0, max_level) * b3;
   r.tracer_drift = std::abs(total(forest, tracer) / mass0 - 1.0);
   const int b = forest.block_cells();
   const Vec3 centre = kStart + ns.time() * kStream;
@@ -275,12 +276,9 @@ int main(int argc, char** argv) {
   };
   std::vector<Spec> runs;
   if (uniform) {
-    if (g_tilted) {
-      runs = {
-          {"uniform 32^3", 0, 0, 0.0}, {"uniform 64^3", 1, 1, 0.0}, {"uniform 128^3", 2, 2, 0.0}};
-    } else {
-      runs = {
-          {"uniform 32^2", 0, 0, 0.0}, {"uniform 64^2", 1, 1, 0.0}, {"uniform 128^2", 2, 2, 0.0}};
+    const std::string power = g_tilted ? "^3" : "^2";
+    for (int level = 0; level <= kFinestLevel; ++level) {
+      runs.push_back({"uniform " + std::to_string(32 << level) + power, level, level, 0.0});
     }
   }
   for (const double zeta : zetas) {
