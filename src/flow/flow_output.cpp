@@ -65,7 +65,7 @@ namespace {
 
 // Version 2: the header is followed by the level and coordinates of every
 // local block (4 int64 each), so that an adaptive run restarts on its grid.
-constexpr char kMagic[16] = "sanguis-flow-2";
+constexpr char kMagic[16] = "sanguis-flow-3";
 
 /// The fields a checkpoint holds, in file order.
 template <typename Solver>
@@ -77,6 +77,7 @@ auto state_fields(Solver& ns) {
   for (auto& f : ns.face_velocity()) fields.push_back(&f);
   fields.push_back(&ns.pressure());
   fields.push_back(&ns.viscosity());
+  fields.push_back(&ns.predictor_pressure());
   return fields;
 }
 

@@ -262,6 +262,7 @@ NavierStokes::NavierStokes(const Forest& forest, const std::array<FlowBoundary, 
   uf_ = make_vector_field(n, b);
   accel_ = make_vector_field(n, b);
   p_ = BlockField(n, b);
+  predictor_p_ = BlockField(n, b);
   mu_ = BlockField(n, b);
   mu_.fill(fluid.viscosity);
   allocate_work_fields();
@@ -286,7 +287,6 @@ void NavierStokes::allocate_work_fields() {
   const int n = forest_.local_blocks();
   const int b = forest_.block_cells();
   scratch_ = make_vector_field(n, b);
-  phi_ = BlockField(n, b);
   solid_ = BlockField(n, b);
   open_ = make_vector_field(n, b);
   for (auto& f : open_) f.fill(1.0);
@@ -311,30 +311,31 @@ void NavierStokes::set_velocity(const std::function<Vec3(const Vec3&)>& u0, doub
   });
   // Project the initial field: uf exactly divergence-free, u corrected.
   face_average_plus_acceleration(0.0);
-  phi_.fill(0.0);
-  pressure_report_ = project(phi_);
+  BlockField& phi = scratch_[1];
+  phi.fill(0.0);
+  pressure_report_ = project(phi);
   forest_.for_each_block([&](int blk) {
     const double h = forest_.block(blk).length / b;
     for (int d = 0; d < 3; ++d) {
-      const std::ptrdiff_t s = phi_.layout().stride(d);
+      const std::ptrdiff_t s = phi.layout().stride(d);
       double* ub = u_[D(d)].block(blk);
-      const double* pb = phi_.block(blk);
+      const double* pb = phi.block(blk);
       for_each_cell(b, [&](int i, int j, int k) {
-        const std::ptrdiff_t c = phi_.layout().index(i, j, k);
+        const std::ptrdiff_t c = phi.layout().index(i, j, k);
         ub[c] -= 0.5 * ((pb[c + s] - pb[c]) + (pb[c] - pb[c - s])) / h;
       });
     }
   });
   p_.fill(0.0);
-  phi_.fill(0.0);
+  predictor_p_.fill(0.0);
   // g = a until the first projection gives a pressure.
   forest_.for_each_block([&](int blk) {
     for (int d = 0; d < 3; ++d) {
-      const std::ptrdiff_t s = phi_.layout().stride(d);
+      const std::ptrdiff_t s = p_.layout().stride(d);
       const double* ab = accel_[D(d)].block(blk);
       double* gb = g_[D(d)].block(blk);
       for_each_cell(b, [&](int i, int j, int k) {
-        const std::ptrdiff_t c = phi_.layout().index(i, j, k);
+        const std::ptrdiff_t c = p_.layout().index(i, j, k);
         gb[c] = 0.5 * (ab[c] + ab[c + s]);
       });
     }
@@ -1122,11 +1123,22 @@ StepReport NavierStokes::step(double dt) {
   fill_scalar_neumann(g_[1], 1);
   fill_scalar_neumann(g_[2], 1);
   predict_face_velocity(dt);
+  // The predicted uf already holds -grad p through g (eq. 4.2 at t + dt/2),
+  // so this projection finds only a correction: the previous step's
+  // correction is its warm start (p itself, used before, is far from it:
+  // 3.9 V-cycles per step against 1.3 on the 64^3 cavity).
+  BlockField& predictor_phi = scratch_[1];
   forest_.for_each_block([&](int blk) {
-    for_each_cell(
-        b, [&](int i, int j, int k) { phi_(blk, i, j, k) = p_(blk, i, j, k) * 0.5 * dt / rho; });
+    for_each_cell(b, [&](int i, int j, int k) {
+      predictor_phi(blk, i, j, k) = predictor_p_(blk, i, j, k) * 0.5 * dt / rho;
+    });
   });
-  report.predictor_cycles = project(phi_).cycles;
+  report.predictor_cycles = project(predictor_phi).cycles;
+  forest_.for_each_block([&](int blk) {
+    for_each_cell(b, [&](int i, int j, int k) {
+      predictor_p_(blk, i, j, k) = predictor_phi(blk, i, j, k) * 2.0 * rho / dt;
+    });
+  });
   fill_face_ghosts(uf_);
   set_boundary_faces(uf_);
 
@@ -1221,8 +1233,9 @@ RegridReport NavierStokes::regrid(Forest& forest, std::span<const AdaptFlag> fla
   }
   RegridReport report;
   report.blocks_before = forest.global_blocks();
-  // phi_ and the scratch fields are rebuilt from p and u at every step.
-  std::vector<BlockField*> cells{&u_[0], &u_[1], &u_[2], &g_[0], &g_[1], &g_[2], &p_, &mu_};
+  // The scratch fields are rebuilt from p and u at every step.
+  std::vector<BlockField*> cells{&u_[0], &u_[1], &u_[2], &g_[0],       &g_[1],
+                                 &g_[2], &p_,    &mu_,   &predictor_p_};
   cells.insert(cells.end(), scalars.begin(), scalars.end());
   FaceField* faces[] = {&uf_, &accel_};
   std::vector<AdaptFlag> wanted(flags.begin(), flags.end());

@@ -174,6 +174,10 @@ class NavierStokes {
   [[nodiscard]] FaceField& face_velocity() { return uf_; }
   [[nodiscard]] BlockField& pressure() { return p_; }
   [[nodiscard]] const BlockField& pressure() const { return p_; }
+  /// The pressure correction the predictor projection found at the last
+  /// step (Pa): the warm start of the next one, so part of the state.
+  [[nodiscard]] BlockField& predictor_pressure() { return predictor_p_; }
+  [[nodiscard]] const BlockField& predictor_pressure() const { return predictor_p_; }
   [[nodiscard]] const BlockField& viscosity() const { return mu_; }
   /// Writable viscosity field (e.g. set from a phase indicator): taking it
   /// marks the viscous coefficients for rebuilding at the next step, so take
@@ -279,14 +283,14 @@ class NavierStokes {
   double time_ = 0.0;
   double bc_time_ = 0.0;  ///< time at which inflow profiles are evaluated
 
-  VectorField u_;        ///< cell-centred velocity (m/s)
-  VectorField g_;        ///< cell-centred a - grad p / rho (m/s^2)
-  BlockField p_;         ///< cell-centred pressure (Pa)
-  BlockField phi_;       ///< projection potential (dt/rho) p of the predictor, warm start
-  FaceField uf_;         ///< face velocity, exactly divergence-free after a step (m/s)
-  FaceField accel_;      ///< body force / rho on faces (m/s^2)
-  BlockField mu_;        ///< dynamic viscosity per cell (Pa s)
-  VectorField scratch_;  ///< u* and other temporaries
+  VectorField u_;           ///< cell-centred velocity (m/s)
+  VectorField g_;           ///< cell-centred a - grad p / rho (m/s^2)
+  BlockField p_;            ///< cell-centred pressure (Pa)
+  BlockField predictor_p_;  ///< pressure correction of the predictor projection (Pa), warm start
+  FaceField uf_;            ///< face velocity, exactly divergence-free after a step (m/s)
+  FaceField accel_;         ///< body force / rho on faces (m/s^2)
+  BlockField mu_;           ///< dynamic viscosity per cell (Pa s)
+  VectorField scratch_;     ///< u* and other temporaries
 
   std::array<ScalarBoundary, 3> velocity_bc_;  ///< per velocity component
   ScalarBoundary pressure_bc_;
