@@ -60,6 +60,12 @@ void fill_face(const Forest& forest, const Block& block, BlockField& field, int 
   const int e1 = (d + 1) % 3, e2 = (d + 2) % 3;
   const std::ptrdiff_t s1 = L.stride(e1), s2 = L.stride(e2);
   const bool given = value != nullptr && static_cast<bool>(*value);
+  // Every ghost is written from interior cells only, so the order is free:
+  // the inner loop runs along the transverse direction with the smaller
+  // stride (rows of x where the face allows it), and each kind of closure
+  // has its own loop (this fill runs before every smoothing of a block).
+  const bool e1_inner = s1 < s2;
+  const std::ptrdiff_t s_in = e1_inner ? s1 : s2, s_out = e1_inner ? s2 : s1;
   for (int m = 0; m < width; ++m) {
     const int ghost = side == 0 ? -1 - m : b + m;
     const int mirror = side == 0 ? m : b - 1 - m;
@@ -69,27 +75,37 @@ void fill_face(const Forest& forest, const Block& block, BlockField& field, int 
     const auto g0 = along(d, ghost, 0, 0), m0 = along(d, mirror, 0, 0), n0 = along(d, next, 0, 0);
     const std::ptrdiff_t og = L.index(g0[0], g0[1], g0[2]), om = L.index(m0[0], m0[1], m0[2]),
                          on = L.index(n0[0], n0[1], n0[2]);
-    for (int t2 = -width; t2 < b + width; ++t2) {
-      for (int t1 = -width; t1 < b + width; ++t1) {
-        const std::ptrdiff_t t = t1 * s1 + t2 * s2;
-        const double inner = data[om + t];
-        double& out = data[og + t];
-        if (kind == BcKind::Neumann) {
-          out = inner;
-        } else if (value == nullptr) {
-          out = -inner;  // homogeneous (multigrid corrections): linear closure
+    for (int t_out = -width; t_out < b + width; ++t_out) {
+      const std::ptrdiff_t row = t_out * s_out;
+      double* out = data + og + row;
+      const double* inner = data + om + row;
+      const double* second = data + on + row;
+      if (kind == BcKind::Neumann) {
+        for (int t = -width; t < b + width; ++t) out[t * s_in] = inner[t * s_in];
+      } else if (value == nullptr) {
+        // Homogeneous (multigrid corrections): linear closure.
+        for (int t = -width; t < b + width; ++t) out[t * s_in] = -inner[t * s_in];
+      } else if (!given) {
+        // A wall at rest: the closures below with g = 0.
+        const double g = 0.0;
+        if (quadratic) {
+          for (int t = -width; t < b + width; ++t)
+            out[t * s_in] = (8.0 * g - 6.0 * inner[t * s_in] + second[t * s_in]) / 3.0;
         } else {
-          double g = 0.0;
-          if (given) {
-            Vec3 x = block.lower;
-            x[e1] += (t1 + 0.5) * h;
-            x[e2] += (t2 + 0.5) * h;
-            x[d] += side == 0 ? 0.0 : block.length;
-            g = (*value)(into_domain(forest, x, e1, e2));
-          }
+          for (int t = -width; t < b + width; ++t) out[t * s_in] = 2.0 * g - inner[t * s_in];
+        }
+      } else {
+        for (int t = -width; t < b + width; ++t) {
+          const int t1 = e1_inner ? t : t_out, t2 = e1_inner ? t_out : t;
+          Vec3 x = block.lower;
+          x[e1] += (t1 + 0.5) * h;
+          x[e2] += (t2 + 0.5) * h;
+          x[d] += side == 0 ? 0.0 : block.length;
+          const double g = (*value)(into_domain(forest, x, e1, e2));
           // Quadratic through the face value and the two first cells: exact
           // for parabolic profiles (third-order boundary closure).
-          out = quadratic ? (8.0 * g - 6.0 * inner + data[on + t]) / 3.0 : 2.0 * g - inner;
+          out[t * s_in] = quadratic ? (8.0 * g - 6.0 * inner[t * s_in] + second[t * s_in]) / 3.0
+                                    : 2.0 * g - inner[t * s_in];
         }
       }
     }

@@ -769,13 +769,27 @@ void NavierStokes::advect_field(const BlockField& field, const BlockField* sourc
   const int b = forest_.block_cells();
   const BlockLayout L = field.layout();
   const Strides s{L.stride(0), L.stride(1), L.stride(2)};
+  // One block's arrays and cell size, read once per block: per face, the
+  // compiler reloads them (the flux stores may alias them), and the cell
+  // size costs a division.
+  struct BlockView {
+    const double* f;
+    const double* src;
+    std::array<const double*, 3> uf;
+    double h;
+  };
+  auto view = [&](int blk) {
+    return BlockView{field.block(blk),
+                     source ? source->block(blk) : nullptr,
+                     {uf_[0].block(blk), uf_[1].block(blk), uf_[2].block(blk)},
+                     forest_.block(blk).length / b};
+  };
   // BCG value times the face velocity on face c (number n along d) of a
   // block; dirichlet_lo/hi: the block's d-faces 0/b carry a boundary value.
-  auto face_flux = [&](int blk, int d, std::ptrdiff_t c, int n, bool dirichlet_lo,
+  auto face_flux = [&](const BlockView& v, int d, std::ptrdiff_t c, int n, bool dirichlet_lo,
                        bool dirichlet_hi) {
-    const double h = forest_.block(blk).length / b;
-    const double* f = field.block(blk);
-    const double un = uf_[D(d)].block(blk)[c];
+    const double* f = v.f;
+    const double un = v.uf[D(d)][c];
     double value;
     if (n == 0 && dirichlet_lo) {
       // The boundary value itself, from the quadratic ghost closure.
@@ -785,28 +799,31 @@ void NavierStokes::advect_field(const BlockField& field, const BlockField* sourc
     } else {
       const std::ptrdiff_t up = un > 0.0 ? c - s[D(d)] : c;
       std::array<double, 3> vt{};
-      for (int e = 0; e < 3; ++e) {
-        const double* ufe = uf_[D(e)].block(blk);
-        vt[D(e)] = 0.5 * (ufe[up] + ufe[up + s[D(e)]]);
-      }
-      const double src =
-          source ? 0.25 * dt * (source->block(blk)[c] + source->block(blk)[c - s[D(d)]]) : 0.0;
-      value = bcg_face_value(f, src, un, dt, h, d, c, s, vt);
+      for (int e = 0; e < 3; ++e) vt[D(e)] = 0.5 * (v.uf[D(e)][up] + v.uf[D(e)][up + s[D(e)]]);
+      const double src = v.src ? 0.25 * dt * (v.src[c] + v.src[c - s[D(d)]]) : 0.0;
+      value = bcg_face_value(f, src, un, dt, v.h, d, c, s, vt);
     }
     return value * un;
   };
-  // Fluxes of all faces 0..b of one block along d into fl.
-  auto block_fluxes = [&](int blk, int d, double* fl) {
+  // Fluxes of all faces 0..b of one block along d into fl; the direction a
+  // compile-time constant, so that the strides along it are known.
+  auto fluxes_along = [&]<int Dir>(std::integral_constant<int, Dir>, int blk, double* fl) {
     const Block& block = forest_.block(blk);
     const bool dirichlet_lo =
-        on_boundary(block, d, 0) && kinds[D(face_index(d, 0))] == BcKind::Dirichlet;
+        on_boundary(block, Dir, 0) && kinds[D(face_index(Dir, 0))] == BcKind::Dirichlet;
     const bool dirichlet_hi =
-        on_boundary(block, d, 1) && kinds[D(face_index(d, 1))] == BcKind::Dirichlet;
-    for_each_face(b, d, [&](int i, int j, int k) {
+        on_boundary(block, Dir, 1) && kinds[D(face_index(Dir, 1))] == BcKind::Dirichlet;
+    const BlockView v = view(blk);
+    for_each_face(b, Dir, [&](int i, int j, int k) {
       const std::ptrdiff_t c = L.index(i, j, k);
-      const int n = d == 0 ? i : (d == 1 ? j : k);
-      fl[c] = face_flux(blk, d, c, n, dirichlet_lo, dirichlet_hi);
+      const int n = Dir == 0 ? i : (Dir == 1 ? j : k);
+      fl[c] = face_flux(v, Dir, c, n, dirichlet_lo, dirichlet_hi);
     });
+  };
+  auto block_fluxes = [&](int blk, int d, double* fl) {
+    if (d == 0) fluxes_along(std::integral_constant<int, 0>{}, blk, fl);
+    if (d == 1) fluxes_along(std::integral_constant<int, 1>{}, blk, fl);
+    if (d == 2) fluxes_along(std::integral_constant<int, 2>{}, blk, fl);
   };
   // out = f - dt div(flux) / h on one block.
   auto update = [&](int blk, const std::array<const double*, 3>& flux) {
@@ -825,7 +842,7 @@ void NavierStokes::advect_field(const BlockField& field, const BlockField* sourc
       [&](int blk, int d, std::ptrdiff_t f) {
         const bool dirichlet_hi = on_boundary(forest_.block(blk), d, 1) &&
                                   kinds[D(face_index(d, 1))] == BcKind::Dirichlet;
-        return face_flux(blk, d, f, b, false, dirichlet_hi);
+        return face_flux(view(blk), d, f, b, false, dirichlet_hi);
       },
       update);
 }
