@@ -65,6 +65,7 @@ namespace {
 
 // Version 2: the header is followed by the level and coordinates of every
 // local block (4 int64 each), so that an adaptive run restarts on its grid.
+// Version 3: the predictor's correction pressure follows the viscosity.
 constexpr char kMagic[16] = "sanguis-flow-3";
 
 /// The fields a checkpoint holds, in file order.
