@@ -66,7 +66,8 @@ namespace {
 // Version 2: the header is followed by the level and coordinates of every
 // local block (4 int64 each), so that an adaptive run restarts on its grid.
 // Version 3: the predictor's correction pressure follows the viscosity.
-constexpr char kMagic[16] = "sanguis-flow-3";
+// Version 4: then the last viscous increment's three components.
+constexpr char kMagic[16] = "sanguis-flow-4";
 
 /// The fields a checkpoint holds, in file order.
 template <typename Solver>
@@ -79,6 +80,7 @@ auto state_fields(Solver& ns) {
   fields.push_back(&ns.pressure());
   fields.push_back(&ns.viscosity());
   fields.push_back(&ns.predictor_pressure());
+  for (auto& f : ns.viscous_increment()) fields.push_back(&f);
   return fields;
 }
 

@@ -178,6 +178,10 @@ class NavierStokes {
   /// step (Pa): the warm start of the next one, so part of the state.
   [[nodiscard]] BlockField& predictor_pressure() { return predictor_p_; }
   [[nodiscard]] const BlockField& predictor_pressure() const { return predictor_p_; }
+  /// The last step's viscous increment per component, u** - (u* + dt g)
+  /// (m/s): the warm start of the next viscous solves, so part of the state.
+  [[nodiscard]] VectorField& viscous_increment() { return viscous_increment_; }
+  [[nodiscard]] const VectorField& viscous_increment() const { return viscous_increment_; }
   [[nodiscard]] const BlockField& viscosity() const { return mu_; }
   /// Writable viscosity field (e.g. set from a phase indicator): taking it
   /// marks the viscous coefficients for rebuilding at the next step, so take
@@ -227,6 +231,8 @@ class NavierStokes {
   /// uf = the face mean of u (face_mean, fourth order; the plain average
   /// near walls, inflows and solids) + dt a, before the projection.
   void face_average_plus_acceleration(double dt);
+  /// max |uf| / h over the faces of all ranks (1/s).
+  [[nodiscard]] double max_face_rate() const;
   MultigridReport project(BlockField& phi);
   void set_boundary_faces(FaceField& uf) const;
   /// Which of the block's 6 faces lie on a domain face whose velocity is
@@ -289,8 +295,9 @@ class NavierStokes {
   BlockField predictor_p_;  ///< pressure correction of the predictor projection (Pa), warm start
   FaceField uf_;            ///< face velocity, exactly divergence-free after a step (m/s)
   FaceField accel_;         ///< body force / rho on faces (m/s^2)
-  BlockField mu_;           ///< dynamic viscosity per cell (Pa s)
-  VectorField scratch_;     ///< u* and other temporaries
+  VectorField viscous_increment_;  ///< last viscous increment per component (m/s), warm start
+  BlockField mu_;                  ///< dynamic viscosity per cell (Pa s)
+  VectorField scratch_;            ///< u* and other temporaries
 
   std::array<ScalarBoundary, 3> velocity_bc_;  ///< per velocity component
   ScalarBoundary pressure_bc_;
