@@ -253,6 +253,16 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   bench_cmd->add_flag("--general-kernels", bo.general_kernels,
                       "flow-cavity: multigrid kernels that read constant coefficients too (A/B)");
+  bench_cmd
+      ->add_option("--relaxation", bo.relaxation,
+                   "flow-cavity: over-relaxation of the multigrid smoother (default: the "
+                   "solver's, 1.15)")
+      ->check(CLI::Range(0.0, 2.0));
+  bench_cmd
+      ->add_option("--sweeps", bo.sweeps,
+                   "flow-cavity: smoothing sweeps before and after the coarse correction "
+                   "(default: the solver's, 2)")
+      ->check(CLI::Range(0, 8));
   bench_cmd->add_flag("--scatter", bo.scatter,
                       "dem-spheres: fill the lattice in random order (ids scattered in space)");
   bench_cmd

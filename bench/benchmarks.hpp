@@ -23,6 +23,11 @@ struct BenchOptions {
   // flow-cavity: multigrid kernels that read the coefficient arrays even where they
   // are constant (MultigridOptions::uniform_coefficient_kernels = false), for A/B runs.
   bool general_kernels = false;
+  // flow-cavity: over-relaxation of the red-black smoother (0: the solver's,
+  // MultigridOptions::relaxation), for A/B runs.
+  double relaxation = 0.0;
+  // flow-cavity: red-black sweeps before and after the coarse correction (0: the solver's).
+  int sweeps = 0;
   // dem-spheres: lattice sites filled in random order, so that ids (and the storage
   // until it is sorted) are scattered in space, as a random fill leaves them.
   bool scatter = false;

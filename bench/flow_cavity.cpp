@@ -51,20 +51,19 @@ double stream_triad_bytes_per_s() {
   return best;
 }
 
-/// Bytes a V(2,2)-cycle moves per finest cell, counted at the interior size of
-/// the arrays, for the kernels in use. General kernels: each red-black sweep
-/// reads x, rhs, alpha and the three face coefficients twice (one colour per
-/// pass) and writes x: 2 x (6 x 8 + 8) = 112 B; residual: 7 arrays read, 1
-/// written = 64 B. Constant coefficients (the cavity's pressure problem): a
-/// sweep reads x and rhs twice and writes x: 2 x (2 x 8 + 8) = 48 B; residual:
+/// Bytes a V(s,s)-cycle moves per finest cell (s = sweeps; the numbers below for 2), counted at the
+/// interior size of the arrays, for the kernels in use. General kernels: each red-black sweep reads
+/// x, rhs, alpha and the three face coefficients twice (one colour per pass) and writes x: 2 x (6 x
+/// 8 + 8) = 112 B; residual: 7 arrays read, 1 written = 64 B. Constant coefficients (the cavity's
+/// pressure problem): a sweep reads x and rhs twice and writes x: 2 x (2 x 8 + 8) = 48 B; residual:
 /// x, rhs read, r written = 24 B. Restriction and prolongation: 8 + 16 B; the
 /// coarser levels add 1/7. A lower bound: the ghost layers make the rows
 /// longer, and the passes around the cycle (the solve's own residual and norm,
 /// the mean removed from this singular problem: about 70 B per cell) are not
 /// counted, a larger share of the constant kernels' smaller total.
-constexpr double vcycle_bytes_per_cell(bool general) {
+constexpr double vcycle_bytes_per_cell(bool general, int sweeps) {
   const double sweep = general ? 112.0 : 48.0, residual = general ? 64.0 : 24.0;
-  return (4.0 * sweep + residual + 24.0) * 8.0 / 7.0;
+  return (2.0 * sweeps * sweep + residual + 24.0) * 8.0 / 7.0;
 }
 
 }  // namespace
@@ -83,6 +82,10 @@ std::string run_flow_cavity(const BenchOptions& o) {
   options.viscous.tolerance = 1e-3;
   options.pressure.constant_coefficient_kernels = !o.general_kernels;
   options.viscous.constant_coefficient_kernels = !o.general_kernels;
+  for (flow::MultigridOptions* mg : {&options.pressure, &options.viscous}) {
+    if (o.relaxation > 0.0) mg->relaxation = o.relaxation;
+    if (o.sweeps > 0) mg->pre_sweeps = mg->post_sweeps = o.sweeps;
+  }
   flow::NavierStokes ns(forest, cavity_boundaries(1.0), flow::Fluid{1.0, 0.01}, options);
   ns.set_velocity([](const Vec3&) { return Vec3{}; });
 
@@ -115,6 +118,8 @@ std::string run_flow_cavity(const BenchOptions& o) {
   mg_options.tolerance = 0.0;
   mg_options.max_cycles = 10;
   mg_options.constant_coefficient_kernels = !o.general_kernels;
+  if (o.relaxation > 0.0) mg_options.relaxation = o.relaxation;
+  if (o.sweeps > 0) mg_options.pre_sweeps = mg_options.post_sweeps = o.sweeps;
   const auto mg_start = std::chrono::steady_clock::now();
   const auto mg_report = mg.solve(x, rhs, bc, mg_options);
   const double mg_seconds =
@@ -139,10 +144,11 @@ std::string run_flow_cavity(const BenchOptions& o) {
        << ",\"multigrid_s_per_vcycle_per_cell\":"
        << mg_seconds / (static_cast<double>(mg_report.cycles) * cells)
        << ",\"multigrid_reduction_per_cycle\":" << mg_report.mean_reduction()
-       << ",\"multigrid_kernels\":\"" << (constant ? "constant" : "general") << "\"";
+       << ",\"multigrid_kernels\":\"" << (constant ? "constant" : "general") << "\""
+       << ",\"relaxation\":" << mg_options.relaxation << ",\"sweeps\":" << mg_options.pre_sweeps;
   const double triad = stream_triad_bytes_per_s();
-  const double effective =
-      vcycle_bytes_per_cell(!constant) * static_cast<double>(mg_report.cycles) * cells / mg_seconds;
+  const double effective = vcycle_bytes_per_cell(!constant, mg_options.pre_sweeps) *
+                           static_cast<double>(mg_report.cycles) * cells / mg_seconds;
   json << ",\"stream_triad_GB_s\":" << triad * 1e-9
        << ",\"multigrid_effective_GB_s\":" << effective * 1e-9
        << ",\"multigrid_bandwidth_fraction\":" << effective / triad << "}";

@@ -160,10 +160,12 @@ inline void relax_constant(double* x, const double* rhs, const BlockLayout& L, i
 
 /// r = rhs - A x on a block with constant alpha and beta (every cell active):
 /// applied() without the coefficient loads, same operations, same order.
-inline void residual_constant(const double* x, const double* rhs, double* r, const BlockLayout& L,
-                              double alpha, double beta, double inv_h2) {
+/// Returns the sum of the squared residuals, in the order of block_squares().
+inline double residual_constant(const double* x, const double* rhs, double* r, const BlockLayout& L,
+                                double alpha, double beta, double inv_h2) {
   const int b = L.cells;
   const std::ptrdiff_t sy = L.stride(1), sz = L.stride(2);
+  double squares = 0.0;
   for (int k = 0; k < b; ++k)
     for (int j = 0; j < b; ++j) {
       const std::ptrdiff_t row = L.index(0, j, k);
@@ -173,9 +175,24 @@ inline void residual_constant(const double* x, const double* rhs, double* r, con
         ax -= inv_h2 * (beta * (xr[i + 1] - xr[i]) - beta * (xr[i] - xr[i - 1]));
         ax -= inv_h2 * (beta * (xr[i + sy] - xr[i]) - beta * (xr[i] - xr[i - sy]));
         ax -= inv_h2 * (beta * (xr[i + sz] - xr[i]) - beta * (xr[i] - xr[i - sz]));
-        r[row + i] = rhs[row + i] - ax;  // the general residual's factor active is 1 here
+        const double value = rhs[row + i] - ax;  // the general residual's factor active is 1 here
+        r[row + i] = value;
+        squares += value * value;
       }
     }
+  return squares;
+}
+
+/// The sum of f^2 over one block's cells, in the order (k, j, i): the one
+/// order of the fused sums in compute_residual(), so rms() of a residual
+/// equals the norm that compute_residual() returns, to the last bit.
+double block_squares(const BlockField& f, int blk) {
+  const int b = f.cells();
+  double squares = 0.0;
+  for (int k = 0; k < b; ++k)
+    for (int j = 0; j < b; ++j)
+      for (int i = 0; i < b; ++i) squares += f(blk, i, j, k) * f(blk, i, j, k);
+  return squares;
 }
 
 // Restriction to the next coarser level: each coarse cell (i, j, k) of every block
@@ -299,6 +316,7 @@ void Multigrid::detect_constant_coefficients() {
   for (Level& level : levels_) {
     const int b = level.cells;
     level.block_constant.assign(static_cast<std::size_t>(n), 0);
+    level.block_all_active.assign(static_cast<std::size_t>(n), 0);
     level.block_alpha.assign(static_cast<std::size_t>(n), 0.0);
     level.block_beta.assign(static_cast<std::size_t>(n), 0.0);
     forest_.for_each_block([&](int blk) {
@@ -329,6 +347,7 @@ void Multigrid::detect_constant_coefficients() {
       level.block_constant[at] = !not_a_number && a_lo == a_hi && b_lo == b_hi && a_lo >= 0.0 &&
                                  b_lo > 0.0 && active_lo == 1.0 &&
                                  std::signbit(a_lo) == std::signbit(a_hi);
+      level.block_all_active[at] = active_lo == 1.0;
       level.block_alpha[at] = a_lo;
       level.block_beta[at] = b_lo;
     });
@@ -636,6 +655,7 @@ void Multigrid::compute_residual(int level, BlockField& x, const BlockField& rhs
   const int b = L.cells;
   const std::array<std::ptrdiff_t, 3> s{L.stride(0), L.stride(1), L.stride(2)};
   fill_ghosts_between_blocks_apart(level, x);  // the rest block by block, as in smooth()
+  block_squares_.resize(static_cast<std::size_t>(forest_.local_blocks()));
   forest_.for_each_block([&](int blk) {
     fill_block_ghosts(blk, x, bc, -1);
     const double h = forest_.block(blk).length / b;
@@ -648,15 +668,20 @@ void Multigrid::compute_residual(int level, BlockField& x, const BlockField& rhs
     double* rb = r.block(blk);
     const auto at = static_cast<std::size_t>(blk);
     if (constant_kernels_ && lv.block_constant[at]) {
-      residual_constant(xb, fb, rb, L, lv.block_alpha[at], lv.block_beta[at], inv_h2);
+      block_squares_[at] =
+          residual_constant(xb, fb, rb, L, lv.block_alpha[at], lv.block_beta[at], inv_h2);
       return;
     }
+    double squares = 0.0;
     for (int kk = 0; kk < b; ++kk)
       for (int j = 0; j < b; ++j)
         for (int i = 0; i < b; ++i) {
           const std::ptrdiff_t c = L.index(i, j, kk);
-          rb[c] = (fb[c] - applied(xb, k, c, s, inv_h2)) * ab[c];
+          const double value = (fb[c] - applied(xb, k, c, s, inv_h2)) * ab[c];
+          rb[c] = value;
+          squares += value * value;
         }
+    block_squares_[at] = squares;
   });
 }
 
@@ -746,26 +771,42 @@ void Multigrid::vcycle(int level, BlockField& x, const BlockField& rhs, const Sc
   smooth(level, x, rhs, bc, post_sweeps_);
 }
 
-double Multigrid::rms(const BlockField& f) const {
-  const int b = f.cells();
+double Multigrid::rms(const BlockField& f) {
+  block_squares_.resize(static_cast<std::size_t>(forest_.local_blocks()));
+  forest_.for_each_block(
+      [&](int blk) { block_squares_[static_cast<std::size_t>(blk)] = block_squares(f, blk); });
+  return root_mean_square(f.cells());
+}
+
+double Multigrid::root_mean_square(int b) const {
+  // Per-block sums added in block order: the same bits on any number of
+  // threads, and the blocks' sums computed in parallel.
   double local = 0.0;
-  for (int blk = 0; blk < forest_.local_blocks(); ++blk)
-    for (int k = 0; k < b; ++k)
-      for (int j = 0; j < b; ++j)
-        for (int i = 0; i < b; ++i) local += f(blk, i, j, k) * f(blk, i, j, k);
+  for (const double squares : block_squares_) local += squares;
   const double cells = static_cast<double>(forest_.global_blocks()) * b * b * b;
   return std::sqrt(forest_.sum(local) / cells);
 }
 
 double Multigrid::mean(const BlockField& f) const {
   const int b = f.cells();
-  const BlockField& active = levels_.front().active;
+  const Level& finest = levels_.front();
+  const BlockField& active = finest.active;
   double local = 0.0, count = 0.0;
   for (int blk = 0; blk < forest_.local_blocks(); ++blk) {
     // Composite grids: weighted by the cell volume (in finest-cell units, so
     // that a uniform forest keeps the plain count).
     const double volume =
         composite_ ? std::ldexp(1.0, 3 * (forest_.max_level() - forest_.block(blk).level)) : 1.0;
+    if (finest.block_all_active[static_cast<std::size_t>(blk)]) {
+      // active is 1 in every cell: the same terms without reading it.
+      for (int k = 0; k < b; ++k)
+        for (int j = 0; j < b; ++j)
+          for (int i = 0; i < b; ++i) {
+            local += volume * f(blk, i, j, k);
+            count += volume;
+          }
+      continue;
+    }
     for (int k = 0; k < b; ++k)
       for (int j = 0; j < b; ++j)
         for (int i = 0; i < b; ++i) {
@@ -775,6 +816,22 @@ double Multigrid::mean(const BlockField& f) const {
   }
   const double cells = forest_.sum(count);
   return cells > 0.0 ? forest_.sum(local) / cells : 0.0;
+}
+
+void Multigrid::shift_interior(BlockField& f, double by) const {
+  const int b = f.cells();
+  const Level& finest = levels_.front();
+  forest_.for_each_block([&](int blk) {
+    if (finest.block_all_active[static_cast<std::size_t>(blk)]) {
+      for (int k = 0; k < b; ++k)
+        for (int j = 0; j < b; ++j)
+          for (int i = 0; i < b; ++i) f(blk, i, j, k) -= by;  // by * active, active = 1
+      return;
+    }
+    for (int k = 0; k < b; ++k)
+      for (int j = 0; j < b; ++j)
+        for (int i = 0; i < b; ++i) f(blk, i, j, k) -= by * finest.active(blk, i, j, k);
+  });
 }
 
 void Multigrid::residual(BlockField& x, const BlockField& rhs, const ScalarBoundary& bc,
@@ -790,15 +847,6 @@ MultigridReport Multigrid::solve(BlockField& x, const BlockField& rhs, const Sca
   constant_kernels_ = options.constant_coefficient_kernels;
   const BlockField* source = &rhs;
   BlockField& shifted = shifted_rhs_;
-  const int b = rhs.cells();
-  const BlockField& active = levels_.front().active;
-  auto shift_interior = [&](BlockField& f, double by) {
-    forest_.for_each_block([&](int blk) {
-      for (int k = 0; k < b; ++k)
-        for (int j = 0; j < b; ++j)
-          for (int i = 0; i < b; ++i) f(blk, i, j, k) -= by * active(blk, i, j, k);
-    });
-  };
   if (singular_) {
     // Compatibility: a singular problem only has a solution for a zero-mean rhs.
     shifted.raw().assign(rhs.raw().begin(), rhs.raw().end());  // reuses the buffer
@@ -809,7 +857,7 @@ MultigridReport Multigrid::solve(BlockField& x, const BlockField& rhs, const Sca
   report.rhs_norm = rms(*source);
   Level& fine = levels_.front();
   compute_residual(0, x, *source, &bc, fine.res);
-  report.residuals.push_back(rms(fine.res));
+  report.residuals.push_back(root_mean_square(fine.cells));
   const double scale = report.rhs_norm > 0.0 ? report.rhs_norm : report.residuals.front();
   const double target = std::max(options.tolerance * scale, options.absolute_tolerance);
   report.converged = report.residuals.back() <= target;
@@ -817,11 +865,11 @@ MultigridReport Multigrid::solve(BlockField& x, const BlockField& rhs, const Sca
     vcycle(0, x, *source, &bc);
     if (singular_) shift_interior(x, mean(x));
     compute_residual(0, x, *source, &bc, fine.res);
-    report.residuals.push_back(rms(fine.res));
+    report.residuals.push_back(root_mean_square(fine.cells));
     ++report.cycles;
     report.converged = report.residuals.back() <= target;
   }
-  fill_ghosts(0, x, &bc, false, false);
+  if (options.fill_ghosts_on_return) fill_ghosts(0, x, &bc, false, false);
   return report;
 }
 

@@ -61,6 +61,10 @@ struct MultigridOptions {
   /// and matched coarse-fine faces included; the residual needs no special case. false: always the
   /// general kernels (for tests and comparisons).
   bool constant_coefficient_kernels = true;
+  /// Fill x's ghosts (neighbours and bc) before returning. false where the
+  /// caller refills them anyway (the viscous solves: the velocity's ghosts
+  /// are filled again before anything reads them), saving a full exchange.
+  bool fill_ghosts_on_return = true;
 };
 
 struct MultigridReport {
@@ -114,6 +118,7 @@ class Multigrid {
     /// Per local block: 1 where alpha (>= 0) and beta (> 0) are each one value
     /// on the block's cells and faces 0..b and every cell is active; the values.
     std::vector<unsigned char> block_constant;
+    std::vector<unsigned char> block_all_active;  ///< per local block: active is 1 in every cell
     std::vector<double> block_alpha, block_beta;
     /// Every block of every rank constant (then every cell and ghost is active).
     bool constant_coefficients = false;
@@ -132,6 +137,8 @@ class Multigrid {
   void fill_block_ghosts(int blk, BlockField& x, const ScalarBoundary* bc, int colour) const;
   void smooth(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc,
               int sweeps);
+  /// r = rhs - A x on `level`, and each block's sum of r^2 into
+  /// block_squares_ (one pass: summed as r is written; root_mean_square()).
   void compute_residual(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc,
                         BlockField& r);
   void vcycle(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc);
@@ -142,8 +149,12 @@ class Multigrid {
   /// Coarse ghosts at coarse-fine faces such that the coarse flux equals the
   /// mean of the fine fluxes across that face.
   void match_fluxes(int level, BlockField& x);
-  double rms(const BlockField& f) const;
+  double rms(const BlockField& f);
+  /// sqrt(sum of block_squares_ / cells), all ranks; b: cells per block edge.
+  double root_mean_square(int b) const;
   double mean(const BlockField& f) const;  ///< over the active cells of the finest level
+  /// f -= by in the active cells of the finest level (the mean removal).
+  void shift_interior(BlockField& f, double by) const;
   void compute_activity();
   void detect_constant_coefficients();
 
@@ -168,7 +179,8 @@ class Multigrid {
   std::vector<double> coarse_active_;
   std::array<std::vector<double>, 3> coarse_beta_;  ///< (n_d + 1) faces along d
   double coarse_h_ = 1.0;
-  BlockField shifted_rhs_;  ///< zero-mean copy of the rhs of singular problems
+  BlockField shifted_rhs_;             ///< zero-mean copy of the rhs of singular problems
+  std::vector<double> block_squares_;  ///< per local block: sum of squares (rms, residuals)
   int pre_sweeps_ = 2;
   int post_sweeps_ = 2;
   double omega_ = 1.0;

@@ -122,6 +122,16 @@ inline void for_each_cell(int b, Body&& body) {
       for (int i = 0; i < b; ++i) body(i, j, k);
 }
 
+/// Calls body(row, j, k) for every row of a block's cells along x, row being
+/// the offset of cell (0, j, k): the pointer-and-offset form of
+/// for_each_cell for the passes that stream several arrays (contiguous in i,
+/// so the compiler vectorises them; the same operations per cell).
+template <typename Body>
+inline void for_each_row(const BlockLayout& L, Body&& body) {
+  for (int k = 0; k < L.cells; ++k)
+    for (int j = 0; j < L.cells; ++j) body(L.index(0, j, k), j, k);
+}
+
 /// Calls body(c, f) for every cell c of the block's layer beside face (d, side)
 /// and the index f of that face in a face field (c on the lower face, c + s_d
 /// on the upper one).
@@ -550,6 +560,13 @@ void NavierStokes::fill_velocity_ghosts(VectorField& u, int width) {
 void NavierStokes::fill_scalar_neumann(BlockField& f, int width) {
   forest_.exchange(f, width);
   fill_boundary_ghosts(forest_, f, uniform_kinds(forest_, BcKind::Neumann), width);
+}
+
+void NavierStokes::fill_neumann_ghosts(VectorField& v, int width) {
+  BlockField* fields[] = {&v[0], &v[1], &v[2]};
+  forest_.exchange(fields, width);  // one exchange for the three
+  const auto kinds = uniform_kinds(forest_, BcKind::Neumann);
+  for (BlockField& f : v) fill_boundary_ghosts(forest_, f, kinds, width);
 }
 
 std::array<bool, 6> NavierStokes::prescribed_faces(const Block& block) const {
@@ -995,6 +1012,9 @@ void NavierStokes::viscous_step(double dt, StepReport& report) {
   if (theta < 1.0 || variable_viscosity_) {
     add_viscous_fluxes(1.0 - theta, variable_viscosity_, dt / fluid_.density, scratch_);
   }
+  // face_average_plus_acceleration() fills u's ghosts before they are read.
+  MultigridOptions solve_options = options_.viscous;
+  solve_options.fill_ghosts_on_return = false;
   for (int comp = 0; comp < 3; ++comp) {
     BlockField& rhs = scratch_[D(comp)];
     BlockField& u = u_[D(comp)];
@@ -1004,13 +1024,20 @@ void NavierStokes::viscous_step(double dt, StepReport& report) {
     // V-cycles per step for the three solves from the right-hand side alone,
     // 2.8 with the increment).
     BlockField& increment = viscous_increment_[D(comp)];
+    const BlockLayout L = u.layout();
     forest_.for_each_block([&](int blk) {
-      for_each_cell(b, [&](int i, int j, int k) {
-        rhs(blk, i, j, k) += dt * g(blk, i, j, k);
-        u(blk, i, j, k) = rhs(blk, i, j, k) + increment(blk, i, j, k);
+      double* rb = rhs.block(blk);
+      double* ub = u.block(blk);
+      const double* gb = g.block(blk);
+      const double* ib = increment.block(blk);
+      for_each_row(L, [&](std::ptrdiff_t row, int, int) {
+        for (std::ptrdiff_t c = row; c < row + b; ++c) {
+          rb[c] += dt * gb[c];
+          ub[c] = rb[c] + ib[c];
+        }
       });
     });
-    const auto r = viscous_mg_->solve(u, rhs, velocity_bc_[D(comp)], options_.viscous);
+    const auto r = viscous_mg_->solve(u, rhs, velocity_bc_[D(comp)], solve_options);
     report.viscous_cycles += r.cycles;
     if (!r.converged) {
       std::ostringstream what;
@@ -1020,9 +1047,15 @@ void NavierStokes::viscous_step(double dt, StepReport& report) {
       throw SimulationError(what.str());
     }
     forest_.for_each_block([&](int blk) {
-      for_each_cell(b, [&](int i, int j, int k) {
-        increment(blk, i, j, k) = u(blk, i, j, k) - rhs(blk, i, j, k);
-        u(blk, i, j, k) -= dt * g(blk, i, j, k);
+      const double* rb = rhs.block(blk);
+      double* ub = u.block(blk);
+      const double* gb = g.block(blk);
+      double* ib = increment.block(blk);
+      for_each_row(L, [&](std::ptrdiff_t row, int, int) {
+        for (std::ptrdiff_t c = row; c < row + b; ++c) {
+          ib[c] = ub[c] - rb[c];
+          ub[c] -= dt * gb[c];
+        }
       });
     });
   }
@@ -1091,19 +1124,40 @@ MultigridReport NavierStokes::project(BlockField& phi) {
   // Composite grids: the divergence of a coarse cell beside finer blocks
   // takes the fine faces' flux (their mean), as the composite operator does.
   synchronise_coarse_faces(uf_);
+  // The same pass takes each block's max |uf| over its faces 0..b, for the
+  // tolerance floor below: max_face_rate() without a second pass (a max, so
+  // the same value in any order).
+  const std::ptrdiff_t sy = L.stride(1), sz = L.stride(2);
+  block_face_rate_.resize(static_cast<std::size_t>(forest_.local_blocks()));
   forest_.for_each_block([&](int blk) {
     const double h = forest_.block(blk).length / b;
-    for_each_cell(b, [&](int i, int j, int k) {
-      const std::ptrdiff_t c = L.index(i, j, k);
-      double div = 0.0;
-      for (int d = 0; d < 3; ++d)
-        div += uf_[D(d)].block(blk)[c + L.stride(d)] - uf_[D(d)].block(blk)[c];
-      rhs.block(blk)[c] = -div / h;
+    const double* ux = uf_[0].block(blk);
+    const double* uy = uf_[1].block(blk);
+    const double* uz = uf_[2].block(blk);
+    double* out = rhs.block(blk);
+    double largest = 0.0;
+    for_each_row(L, [&](std::ptrdiff_t row, int, int) {
+      for (std::ptrdiff_t c = row; c < row + b; ++c) {
+        double div = 0.0;
+        div += ux[c + 1] - ux[c];
+        div += uy[c + sy] - uy[c];
+        div += uz[c + sz] - uz[c];
+        out[c] = -div / h;
+        largest = std::max(largest, std::abs(ux[c]));
+        largest = std::max(largest, std::abs(ux[c + 1]));
+        largest = std::max(largest, std::abs(uy[c]));
+        largest = std::max(largest, std::abs(uy[c + sy]));
+        largest = std::max(largest, std::abs(uz[c]));
+        largest = std::max(largest, std::abs(uz[c + sz]));
+      }
     });
+    block_face_rate_[static_cast<std::size_t>(blk)] = largest / h;
   });
+  double rate = 0.0;
+  for (const double r : block_face_rate_) rate = std::max(rate, r);
   // A floor above round-off: |div uf| ~ 1e-12 max|uf|/h is exact enough.
   MultigridOptions options = options_.pressure;
-  options.absolute_tolerance = std::max(options.absolute_tolerance, 1e-12 * max_face_rate());
+  options.absolute_tolerance = std::max(options.absolute_tolerance, 1e-12 * forest_.max(rate));
   MultigridReport report = pressure_mg_->solve(phi, rhs, pressure_bc_, options);
   if (!report.converged) {
     std::ostringstream what;
@@ -1146,9 +1200,7 @@ StepReport NavierStokes::step(double dt) {
 
   // 1. prediction of the face velocity at t + dt/2, MAC projection with dt/2.
   fill_velocity_ghosts(u_);
-  fill_scalar_neumann(g_[0], 1);
-  fill_scalar_neumann(g_[1], 1);
-  fill_scalar_neumann(g_[2], 1);
+  fill_neumann_ghosts(g_, 1);
   predict_face_velocity(dt);
   // The predicted uf already holds -grad p through g (eq. 4.2 at t + dt/2),
   // so this projection finds only a correction: the previous step's
@@ -1174,8 +1226,12 @@ StepReport NavierStokes::step(double dt) {
 
   // 3. implicit viscosity.
   bool viscous = false;
-  for (int blk = 0; blk < forest_.local_blocks() && !viscous; ++blk)
-    for_each_cell(b, [&](int i, int j, int k) { viscous = viscous || mu_(blk, i, j, k) != 0.0; });
+  for (int blk = 0; blk < forest_.local_blocks() && !viscous; ++blk) {
+    const double* mu = mu_.block(blk);
+    for_each_row(mu_.layout(), [&](std::ptrdiff_t row, int, int) {
+      for (std::ptrdiff_t c = row; c < row + b; ++c) viscous |= mu[c] != 0.0;
+    });
+  }
   viscous = forest_.max(viscous ? 1.0 : 0.0) > 0.0;
   if (viscous) {
     viscous_step(dt, report);
@@ -1196,34 +1252,43 @@ StepReport NavierStokes::step(double dt) {
   forest_.for_each_block([&](int blk) {
     const Block& block = forest_.block(blk);
     const double h = block.length / b;
+    const double h_dt = h * dt;
     const double* pb = phi.block(blk);
+    double* p_out = p_.block(blk);
+    for_each_row(L, [&](std::ptrdiff_t row, int, int) {
+      for (std::ptrdiff_t c = row; c < row + b; ++c) p_out[c] = pb[c] * rho / dt;
+    });
     // Faces where the velocity is prescribed (walls, inflow): the pressure
     // condition there (Neumann) only keeps uf fixed; their gradient is not
     // the fluid's, so g comes from the interior face beside them.
     const std::array<bool, 6> prescribed = prescribed_faces(block);
-    for_each_cell(b, [&](int i, int j, int k) {
-      const std::ptrdiff_t c = L.index(i, j, k);
-      const std::array<int, 3> n{i, j, k};
-      p_.block(blk)[c] = pb[c] * rho / dt;
-      for (int d = 0; d < 3; ++d) {
-        const std::ptrdiff_t s = L.stride(d);
-        const double* a = accel_[D(d)].block(blk);
-        const double* open = open_[D(d)].block(blk);
-        const double grad_lo = (pb[c] - pb[c - s]) / (h * dt);
-        const double grad_hi = (pb[c + s] - pb[c]) / (h * dt);
-        // Average over the faces open to the flow (both, away from solids
-        // and prescribed boundaries).
-        const double open_lo = (n[D(d)] == 0 && prescribed[D(face_index(d, 0))]) ? 0.0 : open[c];
-        const double open_hi =
-            (n[D(d)] == b - 1 && prescribed[D(face_index(d, 1))]) ? 0.0 : open[c + s];
-        const double weight = open_lo + open_hi;
-        const double gd =
-            weight > 0.0 ? (open_lo * (a[c] - grad_lo) + open_hi * (a[c + s] - grad_hi)) / weight
-                         : 0.0;
-        g_[D(d)].block(blk)[c] = gd;
-        u_[D(d)].block(blk)[c] += dt * gd;
-      }
-    });
+    for (int d = 0; d < 3; ++d) {
+      const std::ptrdiff_t s = L.stride(d);
+      const double* a = accel_[D(d)].block(blk);
+      const double* open = open_[D(d)].block(blk);
+      double* gb = g_[D(d)].block(blk);
+      double* ub = u_[D(d)].block(blk);
+      const bool shut_lo = prescribed[D(face_index(d, 0))];
+      const bool shut_hi = prescribed[D(face_index(d, 1))];
+      for_each_row(L, [&](std::ptrdiff_t row, int j, int k) {
+        for (int i = 0; i < b; ++i) {
+          const std::ptrdiff_t c = row + i;
+          const int n = d == 0 ? i : (d == 1 ? j : k);
+          const double grad_lo = (pb[c] - pb[c - s]) / h_dt;
+          const double grad_hi = (pb[c + s] - pb[c]) / h_dt;
+          // Average over the faces open to the flow (both, away from solids
+          // and prescribed boundaries).
+          const double open_lo = (n == 0 && shut_lo) ? 0.0 : open[c];
+          const double open_hi = (n == b - 1 && shut_hi) ? 0.0 : open[c + s];
+          const double weight = open_lo + open_hi;
+          const double gd =
+              weight > 0.0 ? (open_lo * (a[c] - grad_lo) + open_hi * (a[c + s] - grad_hi)) / weight
+                           : 0.0;
+          gb[c] = gd;
+          ub[c] += dt * gd;
+        }
+      });
+    }
   });
   clear_solid_cells(u_);
   time_ += dt;

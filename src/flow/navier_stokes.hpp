@@ -246,6 +246,8 @@ class NavierStokes {
                                         const std::array<int, 3>& cell, int d, double h) const;
   void fill_face_ghosts(FaceField& uf);
   void fill_scalar_neumann(BlockField& f, int width);
+  /// fill_scalar_neumann() for the three components of v, one exchange.
+  void fill_neumann_ghosts(VectorField& v, int width);
   void update_viscous_coefficients(double dt);
   void close_solid_faces(FaceField& uf) const;
   /// out += factor div(mu (laplacian_weight grad u + [transpose] grad u^T))
@@ -295,9 +297,10 @@ class NavierStokes {
   BlockField predictor_p_;  ///< pressure correction of the predictor projection (Pa), warm start
   FaceField uf_;            ///< face velocity, exactly divergence-free after a step (m/s)
   FaceField accel_;         ///< body force / rho on faces (m/s^2)
-  VectorField viscous_increment_;  ///< last viscous increment per component (m/s), warm start
-  BlockField mu_;                  ///< dynamic viscosity per cell (Pa s)
-  VectorField scratch_;            ///< u* and other temporaries
+  VectorField viscous_increment_;        ///< last viscous increment per component (m/s), warm start
+  BlockField mu_;                        ///< dynamic viscosity per cell (Pa s)
+  VectorField scratch_;                  ///< u* and other temporaries
+  std::vector<double> block_face_rate_;  ///< project(): per local block max |uf| / h
 
   std::array<ScalarBoundary, 3> velocity_bc_;  ///< per velocity component
   ScalarBoundary pressure_bc_;
