@@ -1,7 +1,9 @@
 #include "flow/navier_stokes.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <sstream>
 #include <stdexcept>
 #include <vector>
@@ -15,15 +17,21 @@ constexpr std::size_t D(int d) {
 }
 using Strides = std::array<std::ptrdiff_t, 3>;
 
+/// The time step and the cell size of one block, for the BCG kernels.
+struct StepScales {
+  double dt = 0.0;
+  double h = 0.0;
+};
+
 /// Bell-Colella-Glaz upwind value at the lower d-face of cell c (between
 /// c - s_d and c) at t + dt/2 (Bell, Colella & Glaz 1989, as in Basilisk's
 /// bcg.h): the upwind cell value extrapolated by its central slope, a source
 /// term (`source` = dt/4 (src_c + src_{c-s_d}), src the cell source), and transverse upwind
 /// corrections with the transverse velocities `vt` of the upwind cell.
-inline double bcg_face_value(const double* f, double source, double un, double dt, double h, int d,
+inline double bcg_face_value(const double* f, double source, double un, const StepScales& k, int d,
                              std::ptrdiff_t c, const Strides& s, const std::array<double, 3>& vt) {
   const double sign = un > 0.0 ? 1.0 : -1.0;
-  const double courant = dt * un / h;
+  const double courant = k.dt * un / k.h;
   const std::ptrdiff_t up = un > 0.0 ? c - s[D(d)] : c;
   const double slope = 0.5 * (f[up + s[D(d)]] - f[up - s[D(d)]]);  // h df/dx
   double value = f[up] + source + 0.5 * sign * (1.0 - sign * courant) * slope;
@@ -31,9 +39,56 @@ inline double bcg_face_value(const double* f, double source, double un, double d
     if (e == d) continue;
     const double vn = vt[D(e)];
     const double df = vn < 0.0 ? f[up + s[D(e)]] - f[up] : f[up] - f[up - s[D(e)]];
-    value -= dt * vn * df / (2.0 * h);
+    value -= k.dt * vn * df / (2.0 * k.h);
   }
   return value;
+}
+
+/// bcg_face_value() on the lower Dir-faces c = row + i, i in [0, n), of one
+/// row along x, written without branches so that the loop vectorises: both
+/// candidate upwind cells (c - s_Dir and c) are read and the value of the
+/// upwind one selected, so every face takes the same operations, in the same
+/// order, as bcg_face_value (the same bits). `normal(c)` gives the face's
+/// normal velocity, `transverse(e, q)` the transverse velocity along e
+/// carried by cell q, `source(c)` the source term; `store(c, value, un)`.
+template <int Dir, typename Normal, typename Transverse, typename Source, typename Store>
+inline void bcg_face_row(const double* f, std::ptrdiff_t row, int n, const Strides& s,
+                         const StepScales& k, Normal&& normal, Transverse&& transverse,
+                         Source&& source, Store&& store) {
+  // The transverse directions in increasing order, as bcg_face_value's loop.
+  constexpr int Ea = Dir == 0 ? 1 : 0, Eb = Dir == 2 ? 1 : 2;
+  const std::ptrdiff_t sd = s[D(Dir)], sa = s[D(Ea)], sb = s[D(Eb)];
+  // `store` writes an array that no callback reads (face values or fluxes):
+  // without this, the aliasing tests needed exceed what GCC will version.
+#pragma GCC ivdep
+  for (std::ptrdiff_t c = row; c < row + n; ++c) {
+    const double un = normal(c);
+    const bool positive = un > 0.0;
+    const std::ptrdiff_t lo = c - sd;  // the upwind cell when un > 0; else c
+    const double sign = positive ? 1.0 : -1.0;
+    const double courant = k.dt * un / k.h;
+    // Every candidate is loaded, whichever is used: a load under a condition
+    // would be a masked load, which keeps the loop scalar.
+    const double f_lo2 = f[lo - sd], f_lo = f[lo], f_c = f[c], f_hi = f[c + sd];
+    const double f_up = positive ? f_lo : f_c;
+    const double f_next = positive ? f_c : f_hi;
+    const double f_prev = positive ? f_lo2 : f_lo;
+    const double slope = 0.5 * (f_next - f_prev);
+    double value = f_up + source(c) + 0.5 * sign * (1.0 - sign * courant) * slope;
+    const auto correct = [&](int e, std::ptrdiff_t se) {
+      const double v_lo = transverse(e, lo), v_c = transverse(e, c);
+      const double above_lo = f[lo + se], above_c = f[c + se];
+      const double below_lo = f[lo - se], below_c = f[c - se];
+      const double vn = positive ? v_lo : v_c;
+      const double above = positive ? above_lo : above_c;
+      const double below = positive ? below_lo : below_c;
+      const double df = vn < 0.0 ? above - f_up : f_up - below;
+      value -= k.dt * vn * df / (2.0 * k.h);
+    };
+    correct(Ea, sa);
+    correct(Eb, sb);
+    store(c, value, un);
+  }
 }
 
 /// h^2 times the transverse Laplacian, at the d-face below cell c, of the
@@ -681,19 +736,29 @@ void NavierStokes::predict_face_velocity(double dt) {
   const BlockLayout L = u_[0].layout();
   const Strides s{L.stride(0), L.stride(1), L.stride(2)};
   forest_.for_each_block([&](int blk) {
-    const double h = forest_.block(blk).length / b;
+    const StepScales scales{dt, forest_.block(blk).length / b};
     const std::array<const double*, 3> u{u_[0].block(blk), u_[1].block(blk), u_[2].block(blk)};
     for (int d = 0; d < 3; ++d) {
       const double* f = u[D(d)];
       const double* src = g_[D(d)].block(blk);
       double* out = uf_[D(d)].block(blk);
-      for_each_face(b, d, [&](int i, int j, int k) {
-        const std::ptrdiff_t c = L.index(i, j, k);
-        const double un = 0.5 * (f[c] + f[c - s[D(d)]]);
-        const std::ptrdiff_t up = un > 0.0 ? c - s[D(d)] : c;
-        const std::array<double, 3> vt{u[0][up], u[1][up], u[2][up]};
-        out[c] = bcg_face_value(f, 0.25 * dt * (src[c] + src[c - s[D(d)]]), un, dt, h, d, c, s, vt);
-      });
+      const std::ptrdiff_t sd = s[D(d)];
+      // bcg_face_value with the cell velocities: un the mean of the two
+      // cells, the transverse velocities the upwind cell's.
+      auto along = [&]<int Dir>(std::integral_constant<int, Dir>) {
+        const int ni = Dir == 0 ? b + 1 : b, nj = Dir == 1 ? b + 1 : b, nk = Dir == 2 ? b + 1 : b;
+        for (int k = 0; k < nk; ++k)
+          for (int j = 0; j < nj; ++j)
+            bcg_face_row<Dir>(
+                f, L.index(0, j, k), ni, s, scales,
+                [&](std::ptrdiff_t c) { return 0.5 * (f[c] + f[c - sd]); },
+                [&](int e, std::ptrdiff_t q) { return u[D(e)][q]; },
+                [&](std::ptrdiff_t c) { return 0.25 * dt * (src[c] + src[c - sd]); },
+                [&](std::ptrdiff_t c, double value, double) { out[c] = value; });
+      };
+      if (d == 0) along(std::integral_constant<int, 0>{});
+      if (d == 1) along(std::integral_constant<int, 1>{});
+      if (d == 2) along(std::integral_constant<int, 2>{});
     }
   });
   set_boundary_faces(uf_);
@@ -785,13 +850,13 @@ void NavierStokes::advect_field(const BlockField& field, const BlockField* sourc
     const double* f;
     const double* src;
     std::array<const double*, 3> uf;
-    double h;
+    StepScales scales;
   };
   auto view = [&](int blk) {
     return BlockView{field.block(blk),
                      source ? source->block(blk) : nullptr,
                      {uf_[0].block(blk), uf_[1].block(blk), uf_[2].block(blk)},
-                     forest_.block(blk).length / b};
+                     StepScales{dt, forest_.block(blk).length / b}};
   };
   // BCG value times the face velocity on face c (number n along d) of a
   // block; dirichlet_lo/hi: the block's d-faces 0/b carry a boundary value.
@@ -810,7 +875,7 @@ void NavierStokes::advect_field(const BlockField& field, const BlockField* sourc
       std::array<double, 3> vt{};
       for (int e = 0; e < 3; ++e) vt[D(e)] = 0.5 * (v.uf[D(e)][up] + v.uf[D(e)][up + s[D(e)]]);
       const double src = v.src ? 0.25 * dt * (v.src[c] + v.src[c - s[D(d)]]) : 0.0;
-      value = bcg_face_value(f, src, un, dt, v.h, d, c, s, vt);
+      value = bcg_face_value(f, src, un, v.scales, d, c, s, vt);
     }
     return value * un;
   };
@@ -823,11 +888,38 @@ void NavierStokes::advect_field(const BlockField& field, const BlockField* sourc
     const bool dirichlet_hi =
         on_boundary(block, Dir, 1) && kinds[D(face_index(Dir, 1))] == BcKind::Dirichlet;
     const BlockView v = view(blk);
-    for_each_face(b, Dir, [&](int i, int j, int k) {
-      const std::ptrdiff_t c = L.index(i, j, k);
-      const int n = Dir == 0 ? i : (Dir == 1 ? j : k);
-      fl[c] = face_flux(v, Dir, c, n, dirichlet_lo, dirichlet_hi);
-    });
+    const std::ptrdiff_t sd = s[D(Dir)];
+    const double* un = v.uf[D(Dir)];
+    const bool has_source = v.src != nullptr;
+    const double* src = has_source ? v.src : v.f;  // v.f: read, then not used
+    const int ni = Dir == 0 ? b + 1 : b, nj = Dir == 1 ? b + 1 : b, nk = Dir == 2 ? b + 1 : b;
+    for (int k = 0; k < nk; ++k)
+      for (int j = 0; j < nj; ++j) {
+        const std::ptrdiff_t row = L.index(0, j, k);
+        // The interior faces in one branch-free pass (face_flux's last case)...
+        bcg_face_row<Dir>(
+            v.f, row, ni, s, v.scales, [&](std::ptrdiff_t c) { return un[c]; },
+            [&](int e, std::ptrdiff_t q) {
+              return 0.5 * (v.uf[D(e)][q] + v.uf[D(e)][q + s[D(e)]]);
+            },
+            [&](std::ptrdiff_t c) {
+              const double term = 0.25 * dt * (src[c] + src[c - sd]);  // loaded either way
+              return has_source ? term : 0.0;
+            },
+            [&](std::ptrdiff_t c, double value, double u) { fl[c] = value * u; });
+        // ... then the faces on a Dirichlet boundary again, by face_flux.
+        const int n_row = Dir == 1 ? j : k;  // the face number along Dir, rows of y or z faces
+        for (int side = 0; side < 2; ++side) {
+          const int face = side == 0 ? 0 : b;
+          if (!(side == 0 ? dirichlet_lo : dirichlet_hi)) continue;
+          if (Dir == 0) {
+            fl[row + face] = face_flux(v, Dir, row + face, face, dirichlet_lo, dirichlet_hi);
+          } else if (n_row == face) {
+            for (int i = 0; i < b; ++i)
+              fl[row + i] = face_flux(v, Dir, row + i, face, dirichlet_lo, dirichlet_hi);
+          }
+        }
+      }
   };
   auto block_fluxes = [&](int blk, int d, double* fl) {
     if (d == 0) fluxes_along(std::integral_constant<int, 0>{}, blk, fl);
@@ -1135,7 +1227,15 @@ MultigridReport NavierStokes::project(BlockField& phi) {
     const double* uy = uf_[1].block(blk);
     const double* uz = uf_[2].block(blk);
     double* out = rhs.block(blk);
-    double largest = 0.0;
+    // |x| as its bits: for doubles >= 0 the unsigned order of the bits is
+    // the order of the values, and an integer max vectorises where a
+    // floating-point one (NaN rules) does not. A NaN would win here (and
+    // leave the floor below at options.absolute_tolerance); the solve then
+    // fails on its NaN residual.
+    const auto magnitude = [](double x) {
+      return std::bit_cast<std::uint64_t>(x) & ~(std::uint64_t{1} << 63);
+    };
+    std::uint64_t largest = 0;
     for_each_row(L, [&](std::ptrdiff_t row, int, int) {
       for (std::ptrdiff_t c = row; c < row + b; ++c) {
         double div = 0.0;
@@ -1143,15 +1243,13 @@ MultigridReport NavierStokes::project(BlockField& phi) {
         div += uy[c + sy] - uy[c];
         div += uz[c + sz] - uz[c];
         out[c] = -div / h;
-        largest = std::max(largest, std::abs(ux[c]));
-        largest = std::max(largest, std::abs(ux[c + 1]));
-        largest = std::max(largest, std::abs(uy[c]));
-        largest = std::max(largest, std::abs(uy[c + sy]));
-        largest = std::max(largest, std::abs(uz[c]));
-        largest = std::max(largest, std::abs(uz[c + sz]));
+        const std::uint64_t m =
+            std::max({magnitude(ux[c]), magnitude(ux[c + 1]), magnitude(uy[c]),
+                      magnitude(uy[c + sy]), magnitude(uz[c]), magnitude(uz[c + sz])});
+        largest = std::max(largest, m);
       }
     });
-    block_face_rate_[static_cast<std::size_t>(blk)] = largest / h;
+    block_face_rate_[static_cast<std::size_t>(blk)] = std::bit_cast<double>(largest) / h;
   });
   double rate = 0.0;
   for (const double r : block_face_rate_) rate = std::max(rate, r);
@@ -1262,24 +1360,29 @@ StepReport NavierStokes::step(double dt) {
     // condition there (Neumann) only keeps uf fixed; their gradient is not
     // the fluid's, so g comes from the interior face beside them.
     const std::array<bool, 6> prescribed = prescribed_faces(block);
-    for (int d = 0; d < 3; ++d) {
-      const std::ptrdiff_t s = L.stride(d);
-      const double* a = accel_[D(d)].block(blk);
-      const double* open = open_[D(d)].block(blk);
-      double* gb = g_[D(d)].block(blk);
-      double* ub = u_[D(d)].block(blk);
-      const bool shut_lo = prescribed[D(face_index(d, 0))];
-      const bool shut_hi = prescribed[D(face_index(d, 1))];
+    // The direction a compile-time constant: the face number n along it is
+    // then i or a row constant, and the loop vectorises.
+    auto along = [&]<int Dir>(std::integral_constant<int, Dir>) {
+      const std::ptrdiff_t s = L.stride(Dir);
+      const double* a = accel_[D(Dir)].block(blk);
+      const double* open = open_[D(Dir)].block(blk);
+      double* gb = g_[D(Dir)].block(blk);
+      double* ub = u_[D(Dir)].block(blk);
+      const bool shut_lo = prescribed[D(face_index(Dir, 0))];
+      const bool shut_hi = prescribed[D(face_index(Dir, 1))];
       for_each_row(L, [&](std::ptrdiff_t row, int j, int k) {
+      // g and u are written, neither read at another cell.
+#pragma GCC ivdep
         for (int i = 0; i < b; ++i) {
           const std::ptrdiff_t c = row + i;
-          const int n = d == 0 ? i : (d == 1 ? j : k);
+          const int n = Dir == 0 ? i : (Dir == 1 ? j : k);
           const double grad_lo = (pb[c] - pb[c - s]) / h_dt;
           const double grad_hi = (pb[c + s] - pb[c]) / h_dt;
           // Average over the faces open to the flow (both, away from solids
           // and prescribed boundaries).
-          const double open_lo = (n == 0 && shut_lo) ? 0.0 : open[c];
-          const double open_hi = (n == b - 1 && shut_hi) ? 0.0 : open[c + s];
+          const double open_c = open[c], open_next = open[c + s];  // loaded either way
+          const double open_lo = (n == 0 && shut_lo) ? 0.0 : open_c;
+          const double open_hi = (n == b - 1 && shut_hi) ? 0.0 : open_next;
           const double weight = open_lo + open_hi;
           const double gd =
               weight > 0.0 ? (open_lo * (a[c] - grad_lo) + open_hi * (a[c + s] - grad_hi)) / weight
@@ -1288,7 +1391,10 @@ StepReport NavierStokes::step(double dt) {
           ub[c] += dt * gd;
         }
       });
-    }
+    };
+    along(std::integral_constant<int, 0>{});
+    along(std::integral_constant<int, 1>{});
+    along(std::integral_constant<int, 2>{});
   });
   clear_solid_cells(u_);
   time_ += dt;
