@@ -61,8 +61,10 @@ double stream_triad_bytes_per_s() {
 /// longer, and the passes around the cycle (the solve's own residual and norm,
 /// the mean removed from this singular problem: about 70 B per cell) are not
 /// counted, a larger share of the constant kernels' smaller total.
+constexpr double sweep_bytes_per_cell(bool general) { return general ? 112.0 : 48.0; }
+
 constexpr double vcycle_bytes_per_cell(bool general, int sweeps) {
-  const double sweep = general ? 112.0 : 48.0, residual = general ? 64.0 : 24.0;
+  const double sweep = sweep_bytes_per_cell(general), residual = general ? 64.0 : 24.0;
   return (2.0 * sweeps * sweep + residual + 24.0) * 8.0 / 7.0;
 }
 
@@ -125,6 +127,14 @@ std::string run_flow_cavity(const BenchOptions& o) {
   const double mg_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - mg_start).count();
 
+  // The smoother alone (what issue #6's bandwidth target names): sweeps of
+  // the finest level on the same problem, ghosts filled as in a V-cycle.
+  constexpr int kSmootherSweeps = 20;
+  const auto smooth_start = std::chrono::steady_clock::now();
+  mg.relax(x, rhs, bc, kSmootherSweeps, mg_options);
+  const double smooth_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - smooth_start).count();
+
   const double cells = static_cast<double>(o.cells_per_side * o.cells_per_side * o.cells_per_side);
   // The kernels that ran: constant ones where the option is on and detection
   // found alpha and beta constant on the finest level.
@@ -151,7 +161,12 @@ std::string run_flow_cavity(const BenchOptions& o) {
                            static_cast<double>(mg_report.cycles) * cells / mg_seconds;
   json << ",\"stream_triad_GB_s\":" << triad * 1e-9
        << ",\"multigrid_effective_GB_s\":" << effective * 1e-9
-       << ",\"multigrid_bandwidth_fraction\":" << effective / triad << "}";
+       << ",\"multigrid_bandwidth_fraction\":" << effective / triad;
+  const double sweep_seconds = smooth_seconds / (kSmootherSweeps * cells);
+  const double smoother = sweep_bytes_per_cell(!constant) / sweep_seconds;
+  json << ",\"smoother_s_per_sweep_per_cell\":" << sweep_seconds
+       << ",\"smoother_effective_GB_s\":" << smoother * 1e-9
+       << ",\"smoother_bandwidth_fraction\":" << smoother / triad << "}";
   return json.str();
 }
 

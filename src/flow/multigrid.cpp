@@ -839,6 +839,13 @@ void Multigrid::residual(BlockField& x, const BlockField& rhs, const ScalarBound
   compute_residual(0, x, rhs, &bc, r);
 }
 
+void Multigrid::relax(BlockField& x, const BlockField& rhs, const ScalarBoundary& bc, int sweeps,
+                      const MultigridOptions& options) {
+  omega_ = options.relaxation;
+  constant_kernels_ = options.constant_coefficient_kernels;
+  smooth(0, x, rhs, &bc, sweeps);
+}
+
 MultigridReport Multigrid::solve(BlockField& x, const BlockField& rhs, const ScalarBoundary& bc,
                                  const MultigridOptions& options) {
   pre_sweeps_ = options.pre_sweeps;

@@ -92,6 +92,12 @@ class Multigrid {
   MultigridReport solve(BlockField& x, const BlockField& rhs, const ScalarBoundary& bc,
                         const MultigridOptions& options = {});
 
+  /// `sweeps` sweeps of the V-cycles' smoother (red-black Gauss-Seidel with
+  /// the options' relaxation and kernels) on the finest level, ghosts filled
+  /// as in a V-cycle: the smoother alone, for benchmarks and tests.
+  void relax(BlockField& x, const BlockField& rhs, const ScalarBoundary& bc, int sweeps,
+             const MultigridOptions& options = {});
+
   /// r = rhs - A x on the finest level (fills x's ghosts with bc).
   void residual(BlockField& x, const BlockField& rhs, const ScalarBoundary& bc, BlockField& r);
 
