@@ -88,6 +88,9 @@ run membrane-2threads "$sanguis" bench membrane "${membrane[@]}" --threads 2
 if have "${GERRIS:-gerris3D}"; then
   run flow-cavity-vs-gerris "$root/bench/flow_cavity_vs_gerris.sh" --cells-per-side "$flow_n" \
     --steps "$((flow_steps / 2 > 0 ? flow_steps / 2 : 1))"
+  # 16^3 blocks: the fastest on a uniform grid (docs/performance.md, "Block size").
+  run flow-cavity-vs-gerris-b16 "$root/bench/flow_cavity_vs_gerris.sh" --cells-per-side "$flow_n" \
+    --steps "$((flow_steps / 2 > 0 ? flow_steps / 2 : 1))" --block-cells 16
 else
   echo "== flow-cavity-vs-gerris: skipped (Gerris not installed: scripts/install-deps.sh --bench)"
 fi
