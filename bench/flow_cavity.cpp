@@ -61,7 +61,9 @@ double stream_triad_bytes_per_s() {
 /// longer, and the passes around the cycle (the solve's own residual and norm,
 /// the mean removed from this singular problem: about 70 B per cell) are not
 /// counted, a larger share of the constant kernels' smaller total.
-constexpr double sweep_bytes_per_cell(bool general) { return general ? 112.0 : 48.0; }
+constexpr double sweep_bytes_per_cell(bool general) {
+  return general ? 112.0 : 48.0;
+}
 
 constexpr double vcycle_bytes_per_cell(bool general, int sweeps) {
   const double sweep = sweep_bytes_per_cell(general), residual = general ? 64.0 : 24.0;

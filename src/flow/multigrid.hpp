@@ -144,9 +144,11 @@ class Multigrid {
   void smooth(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc,
               int sweeps);
   /// r = rhs - A x on `level`, and each block's sum of r^2 into
-  /// block_squares_ (one pass: summed as r is written; root_mean_square()).
+  /// block_squares_ (one pass: summed as r is written; root_mean_square()),
+  /// unless !squares_wanted (the V-cycle's residual, only restricted): then
+  /// the constant-coefficient blocks' sums are not formed.
   void compute_residual(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc,
-                        BlockField& r);
+                        BlockField& r, bool squares_wanted = true);
   void vcycle(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc);
   void coarse_solve();
   void build_coarse_operator();

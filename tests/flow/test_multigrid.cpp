@@ -2,8 +2,8 @@
 // residual reduction per V-cycle.
 #include <gtest/gtest.h>
 
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <random>
 
