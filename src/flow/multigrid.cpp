@@ -720,22 +720,17 @@ void prolong_all_active(const BlockField& coarse, int blk, int b, BlockField& x)
       // unit-stride and the loop vectorises.
       for (int c = 0; c < b / 2; ++c) {
         double low = 0.0, high = 0.0;
-        low += kNear * w00 * r00[c];
-        high += kNear * w00 * r00[c];
-        low += kFar * w00 * r00[c - 1];
-        high += kFar * w00 * r00[c + 1];
-        low += kNear * w10 * r10[c];
-        high += kNear * w10 * r10[c];
-        low += kFar * w10 * r10[c - 1];
-        high += kFar * w10 * r10[c + 1];
-        low += kNear * w01 * r01[c];
-        high += kNear * w01 * r01[c];
-        low += kFar * w01 * r01[c - 1];
-        high += kFar * w01 * r01[c + 1];
-        low += kNear * w11 * r11[c];
-        high += kNear * w11 * r11[c];
-        low += kFar * w11 * r11[c - 1];
-        high += kFar * w11 * r11[c + 1];
+        // One coarse row's two terms (near, far) for each fine cell.
+        const auto add = [&](double w, const double* r) {
+          low += kNear * w * r[c];
+          low += kFar * w * r[c - 1];
+          high += kNear * w * r[c];
+          high += kFar * w * r[c + 1];
+        };
+        add(w00, r00);
+        add(w10, r10);
+        add(w01, r01);
+        add(w11, r11);
         row[2 * c] += low;  // / weight, which is exactly 1
         row[2 * c + 1] += high;
       }
