@@ -52,7 +52,7 @@ Vec3 into_domain(const Forest& forest, Vec3 x, int e1, int e2) {
 }
 
 void fill_face(const Forest& forest, const Block& block, BlockField& field, int blk, int d,
-               int side, BcKind kind, const FaceValue* value, int width) {
+               int side, BcKind kind, const FaceValue* value, int width, int colour) {
   const BlockLayout& L = field.layout();
   const int b = L.cells;
   double* data = field.block(blk);
@@ -66,6 +66,13 @@ void fill_face(const Forest& forest, const Block& block, BlockField& field, int 
   // has its own loop (this fill runs before every smoothing of a block).
   const bool e1_inner = s1 < s2;
   const std::ptrdiff_t s_in = e1_inner ? s1 : s2, s_out = e1_inner ? s2 : s1;
+  // colour >= 0: the face ghosts of that colour only, (ghost + t1 + t2 +
+  // parity) & 1 == colour as in Forest::copy_face_ghosts, without the edge
+  // and corner ghosts (the smoother's 7-point stencil reads neither).
+  const bool one_colour = colour >= 0;
+  const int parity = static_cast<int>((block.coord[0] + block.coord[1] + block.coord[2]) * b) & 1;
+  const int t_lo = one_colour ? 0 : -width, t_hi = one_colour ? b : b + width;
+  const int t_step = one_colour ? 2 : 1;
   for (int m = 0; m < width; ++m) {
     const int ghost = side == 0 ? -1 - m : b + m;
     const int mirror = side == 0 ? m : b - 1 - m;
@@ -75,27 +82,28 @@ void fill_face(const Forest& forest, const Block& block, BlockField& field, int 
     const auto g0 = along(d, ghost, 0, 0), m0 = along(d, mirror, 0, 0), n0 = along(d, next, 0, 0);
     const std::ptrdiff_t og = L.index(g0[0], g0[1], g0[2]), om = L.index(m0[0], m0[1], m0[2]),
                          on = L.index(n0[0], n0[1], n0[2]);
-    for (int t_out = -width; t_out < b + width; ++t_out) {
+    for (int t_out = t_lo; t_out < t_hi; ++t_out) {
       const std::ptrdiff_t row = t_out * s_out;
       double* out = data + og + row;
       const double* inner = data + om + row;
       const double* second = data + on + row;
+      const int t0 = one_colour ? (colour + ghost + t_out + parity) & 1 : t_lo;
       if (kind == BcKind::Neumann) {
-        for (int t = -width; t < b + width; ++t) out[t * s_in] = inner[t * s_in];
+        for (int t = t0; t < t_hi; t += t_step) out[t * s_in] = inner[t * s_in];
       } else if (value == nullptr) {
         // Homogeneous (multigrid corrections): linear closure.
-        for (int t = -width; t < b + width; ++t) out[t * s_in] = -inner[t * s_in];
+        for (int t = t0; t < t_hi; t += t_step) out[t * s_in] = -inner[t * s_in];
       } else if (!given) {
         // A wall at rest: the closures below with g = 0.
         const double g = 0.0;
         if (quadratic) {
-          for (int t = -width; t < b + width; ++t)
+          for (int t = t0; t < t_hi; t += t_step)
             out[t * s_in] = (8.0 * g - 6.0 * inner[t * s_in] + second[t * s_in]) / 3.0;
         } else {
-          for (int t = -width; t < b + width; ++t) out[t * s_in] = 2.0 * g - inner[t * s_in];
+          for (int t = t0; t < t_hi; t += t_step) out[t * s_in] = 2.0 * g - inner[t * s_in];
         }
       } else {
-        for (int t = -width; t < b + width; ++t) {
+        for (int t = t0; t < t_hi; t += t_step) {
           const int t1 = e1_inner ? t : t_out, t2 = e1_inner ? t_out : t;
           Vec3 x = block.lower;
           x[e1] += (t1 + 0.5) * h;
@@ -122,7 +130,7 @@ void fill_all(const Forest& forest, BlockField& field, const std::array<BcKind, 
 
 void fill_block_boundary_ghosts(const Forest& forest, BlockField& field, int blk,
                                 const std::array<BcKind, 6>& kinds,
-                                const std::array<FaceValue, 6>* values, int width) {
+                                const std::array<FaceValue, 6>* values, int width, int colour) {
   width = std::min({width, field.cells(), field.layout().ghost});
   const Block& block = forest.block(blk);
   for (int d = 0; d < 3; ++d) {
@@ -130,7 +138,7 @@ void fill_block_boundary_ghosts(const Forest& forest, BlockField& field, int blk
       if (block.neighbours[face_neighbour_slot(d, side)].link != Link::Boundary) continue;
       const auto f = static_cast<std::size_t>(face_index(d, side));
       fill_face(forest, block, field, blk, d, side, kinds[f], values ? &(*values)[f] : nullptr,
-                width);
+                width, colour);
     }
   }
 }

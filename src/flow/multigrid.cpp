@@ -560,9 +560,9 @@ void Multigrid::fill_block_ghosts(int blk, BlockField& x, const ScalarBoundary* 
                                   int colour) const {
   forest_.copy_face_ghosts(x, blk, colour);
   if (bc) {
-    fill_block_boundary_ghosts(forest_, x, blk, bc->kind, &bc->value, 1);
+    fill_block_boundary_ghosts(forest_, x, blk, bc->kind, &bc->value, 1, colour);
   } else {
-    fill_block_boundary_ghosts(forest_, x, blk, kinds_, nullptr, 1);
+    fill_block_boundary_ghosts(forest_, x, blk, kinds_, nullptr, 1, colour);
   }
 }
 

@@ -160,5 +160,68 @@ TEST(FlowForest, DirichletAndNeumannGhostsReproduceTheFaceValue) {
   }
 }
 
+TEST(FlowForest, BoundaryGhostsOfOneColourAreTheFullFillsFaceGhostsOfThatColour) {
+  // The smoother's per-block fill (fill_block_boundary_ghosts with a colour):
+  // every face ghost of that colour gets the value of the full fill, bit for
+  // bit, for each kind of closure (Dirichlet with a given value, at rest,
+  // homogeneous; Neumann), and no other ghost is written.
+  ForestSpec spec;
+  spec.trees = {2, 1, 1};
+  spec.level = 1;
+  spec.block_cells = 4;
+  const Forest forest(spec);
+  const int b = spec.block_cells;
+  std::array<BcKind, 6> kinds = uniform_kinds(forest, BcKind::Dirichlet);
+  kinds[face_index(2, 1)] = BcKind::Neumann;
+  std::array<FaceValue, 6> values{};
+  values[face_index(0, 0)] = [](const Vec3& x) { return 3.0 + x.y * x.z; };
+  values[face_index(1, 1)] = [](const Vec3& x) { return -x.x; };
+  for (const bool homogeneous : {false, true}) {
+    const std::array<FaceValue, 6>* given = homogeneous ? nullptr : &values;
+    BlockField full = tagged_cells(forest);
+    for (int blk = 0; blk < forest.local_blocks(); ++blk)
+      fill_block_boundary_ghosts(forest, full, blk, kinds, given, 1);
+    int checked = 0;
+    for (int colour = 0; colour < 2; ++colour) {
+      BlockField one = tagged_cells(forest);
+      for (int blk = 0; blk < forest.local_blocks(); ++blk)
+        fill_block_boundary_ghosts(forest, one, blk, kinds, given, 1, colour);
+      for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+        const auto& c = forest.block(blk).coord;
+        for (int k = -1; k <= b; ++k)
+          for (int j = -1; j <= b; ++j)
+            for (int i = -1; i <= b; ++i) {
+              const int outside = (i < 0 || i >= b) + (j < 0 || j >= b) + (k < 0 || k >= b);
+              if (outside == 0) continue;
+              const bool of_colour = (((c[0] + c[1] + c[2]) * b + i + j + k) & 1) == colour;
+              if (outside == 1 && of_colour) {
+                ASSERT_EQ(one(blk, i, j, k), full(blk, i, j, k)) << blk << ' ' << i << j << k;
+                const int n[3] = {i, j, k};
+                for (int d = 0; d < 3; ++d) {
+                  if (n[d] >= 0 && n[d] < b) continue;
+                  const int side = n[d] < 0 ? 0 : 1;
+                  checked += forest.block(blk).neighbours[face_neighbour_slot(d, side)].link ==
+                             Link::Boundary;
+                }
+              } else {
+                ASSERT_EQ(one(blk, i, j, k), -1.0) << blk << ' ' << i << j << k;
+              }
+            }
+      }
+    }
+    // The two colours together: every face ghost on the boundary.
+    int boundary_face_ghosts = 0;
+    for (int blk = 0; blk < forest.local_blocks(); ++blk)
+      for (int d = 0; d < 3; ++d)
+        for (int side = 0; side < 2; ++side)
+          boundary_face_ghosts +=
+              forest.block(blk).neighbours[face_neighbour_slot(d, side)].link == Link::Boundary
+                  ? b * b
+                  : 0;
+    EXPECT_GT(boundary_face_ghosts, 0);
+    EXPECT_EQ(checked, boundary_face_ghosts);
+  }
+}
+
 }  // namespace
 }  // namespace sanguis::flow
