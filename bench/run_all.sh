@@ -66,8 +66,9 @@ if have "${LMP:-lmp}"; then
 else
   echo "== dem-spheres-vs-lammps: skipped (LAMMPS not installed: scripts/install-deps.sh --bench)"
 fi
-run dem-spheres-1thread "$sanguis" bench dem-spheres "${spheres[@]}" --threads 1
-run dem-spheres-2threads "$sanguis" bench dem-spheres "${spheres[@]}" --threads 2
+# One and two threads alternated, the median of the pairs' speed-ups (issue #5: 1.8x).
+run dem-spheres-thread-speedup "$root/bench/dem_thread_speedup.sh" --repeat "$repeat" -- \
+  "${spheres[@]}"
 run dem-spheres-2proc "${mpirun_cmd[@]}" -np 2 "$sanguis" bench dem-spheres "${spheres[@]}"
 # The storage sort (docs/performance.md): ids scattered in space, sorted and never sorted.
 for sort in 2000 0; do
