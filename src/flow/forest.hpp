@@ -20,6 +20,9 @@
 // make up each ghost cell (coarse_fine.hpp). `adapt()` refines and coarsens
 // blocks and carries field data along; `partition()` moves field data.
 
+#include <omp.h>
+
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -194,6 +197,11 @@ class Forest {
   /// Runs body(b) for every local block, on the forest's OpenMP threads.
   template <typename Body>
   void for_each_block(Body&& body) const;
+  /// for_each_block() with each thread's share of the blocks (the same
+  /// shares) taken in reverse order: for passes whose block order is free,
+  /// so that a pass starts where the pass before it ended, in cache.
+  template <typename Body>
+  void for_each_block_backward(Body&& body) const;
 
   /// Sum and maximum over all ranks.
   [[nodiscard]] double sum(double local) const;
@@ -291,6 +299,25 @@ void Forest::for_each_block(Body&& body) const {
     for (int b = 0; b < n; ++b) body(b);
   } else {
     for (int b = 0; b < n; ++b) body(b);
+  }
+}
+
+template <typename Body>
+void Forest::for_each_block_backward(Body&& body) const {
+  const int n = local_blocks();
+  if (spec_.threads > 1) {
+#pragma omp parallel num_threads(spec_.threads)
+    {
+      // The contiguous shares of schedule(static) without a chunk size: the
+      // first n % T threads take one block more.
+      const int threads = omp_get_num_threads(), t = omp_get_thread_num();
+      const int share = n / threads, extra = n % threads;
+      const int first = t * share + std::min(t, extra);
+      const int count = share + (t < extra ? 1 : 0);
+      for (int b = first + count - 1; b >= first; --b) body(b);
+    }
+  } else {
+    for (int b = n - 1; b >= 0; --b) body(b);
   }
 }
 

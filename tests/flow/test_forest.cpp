@@ -2,7 +2,11 @@
 // included) and boundary ghost filling.
 #include <gtest/gtest.h>
 
+#include <omp.h>
+
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "flow/boundary.hpp"
 #include "flow/forest.hpp"
@@ -220,6 +224,45 @@ TEST(FlowForest, BoundaryGhostsOfOneColourAreTheFullFillsFaceGhostsOfThatColour)
                   : 0;
     EXPECT_GT(boundary_face_ghosts, 0);
     EXPECT_EQ(checked, boundary_face_ghosts);
+  }
+}
+
+/// The blocks each thread visits, in its order of visit.
+template <typename Loop>
+std::vector<std::vector<int>> visits_per_thread(int threads, int blocks, Loop&& loop) {
+  std::vector<std::vector<int>> visits(static_cast<std::size_t>(threads));
+  std::vector<int> seen(static_cast<std::size_t>(blocks), 0);
+  loop([&](int b) {
+    visits[static_cast<std::size_t>(omp_get_thread_num())].push_back(b);
+    ++seen[static_cast<std::size_t>(b)];
+  });
+  for (int b = 0; b < blocks; ++b) EXPECT_EQ(seen[static_cast<std::size_t>(b)], 1) << "block " << b;
+  return visits;
+}
+
+// The smoother's second half-sweep goes backwards so that it starts on the
+// blocks still in cache; the cache it reuses is the one of the thread that
+// last touched them, so each thread must keep its share of the blocks.
+TEST(FlowForest, BackwardLoopGivesEachThreadItsForwardShareReversed) {
+  for (const int threads : {1, 2, 3}) {
+    ForestSpec spec;
+    spec.trees = {1, 1, 5};
+    spec.level = 1;
+    spec.block_cells = 4;
+    spec.threads = threads;
+    const Forest forest(spec);
+    const int n = forest.local_blocks();
+    ASSERT_EQ(n % 3, 1);  // uneven shares for three threads
+    const auto forward =
+        visits_per_thread(threads, n, [&](auto&& body) { forest.for_each_block(body); });
+    const auto backward =
+        visits_per_thread(threads, n, [&](auto&& body) { forest.for_each_block_backward(body); });
+    for (int t = 0; t < threads; ++t) {
+      auto reversed = forward[static_cast<std::size_t>(t)];
+      std::reverse(reversed.begin(), reversed.end());
+      EXPECT_EQ(backward[static_cast<std::size_t>(t)], reversed)
+          << threads << " threads, thread " << t;
+    }
   }
 }
 
