@@ -275,7 +275,7 @@ def main():
             "quasi-2D as well. Both branches of the reference are used as published, "
             "joined at a = 2.3.",
             "Mean speed (Fig. 3.9a): the peak comes near tau_c as in the thesis, 15-20 % "
-            "lower, and the column comes to rest about one tau_c sooner (5 % at 2.8-2.9 "
+            "lower, and the column comes to rest about one tau_c sooner (5 % at about 2.8 "
             "tau_c against 4). The contact parameters barely move either (Fig. 3.9 column, "
             "one seed each, 2026-11-24; frames every 0.17 tau_c): without rolling friction "
             "the peak is 0.316 and the 5 % crossing 2.96-3.17 tau_c; with it and with normal "
