@@ -291,12 +291,27 @@ class Forest {
   std::vector<std::int32_t> beside_finer_blocks_, beside_coarser_blocks_;
 };
 
+/// The blocks [first, first + count) that thread t of `threads` takes: equal
+/// contiguous shares, the first n % threads threads one block more (what
+/// GCC's schedule(static) does; spelled out so that both loops below agree
+/// on any OpenMP runtime).
+struct BlockShare {
+  int first = 0, count = 0;
+};
+inline BlockShare block_share(int n, int threads, int t) {
+  const int share = n / threads, extra = n % threads;
+  return {t * share + std::min(t, extra), share + (t < extra ? 1 : 0)};
+}
+
 template <typename Body>
 void Forest::for_each_block(Body&& body) const {
   const int n = local_blocks();
   if (spec_.threads > 1) {
-#pragma omp parallel for schedule(static) num_threads(spec_.threads)
-    for (int b = 0; b < n; ++b) body(b);
+#pragma omp parallel num_threads(spec_.threads)
+    {
+      const BlockShare mine = block_share(n, omp_get_num_threads(), omp_get_thread_num());
+      for (int b = mine.first; b < mine.first + mine.count; ++b) body(b);
+    }
   } else {
     for (int b = 0; b < n; ++b) body(b);
   }
@@ -308,13 +323,8 @@ void Forest::for_each_block_backward(Body&& body) const {
   if (spec_.threads > 1) {
 #pragma omp parallel num_threads(spec_.threads)
     {
-      // The contiguous shares of schedule(static) without a chunk size: the
-      // first n % T threads take one block more.
-      const int threads = omp_get_num_threads(), t = omp_get_thread_num();
-      const int share = n / threads, extra = n % threads;
-      const int first = t * share + std::min(t, extra);
-      const int count = share + (t < extra ? 1 : 0);
-      for (int b = first + count - 1; b >= first; --b) body(b);
+      const BlockShare mine = block_share(n, omp_get_num_threads(), omp_get_thread_num());
+      for (int b = mine.first + mine.count - 1; b >= mine.first; --b) body(b);
     }
   } else {
     for (int b = n - 1; b >= 0; --b) body(b);

@@ -647,10 +647,12 @@ void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const Sc
               xb[c] += omega_ * (relaxed_value(xb, rb[c], k, c, s, inv_h2, implicit) - xb[c]);
             }
       };
-      // A half-sweep reads only the other colour, which it does not change,
-      // so its block order is free: the second colour runs backwards and
-      // starts on the blocks the first one left in cache (what a grid larger
-      // than the cache saves), with the same bits.
+      // In a half-sweep each block writes only its own cells and ghosts, and
+      // reads other blocks only through ghosts copied from cells of the
+      // colour no block writes in it; so its block order is free. The second
+      // colour runs backwards over each thread's blocks and starts on those
+      // the first one left in cache (what a grid larger than the cache
+      // saves), with the same bits.
       if (colour == 0) {
         forest_.for_each_block(relax_block);
       } else {

@@ -5,6 +5,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <vector>
 
@@ -227,16 +228,12 @@ TEST(FlowForest, BoundaryGhostsOfOneColourAreTheFullFillsFaceGhostsOfThatColour)
   }
 }
 
-/// The blocks each thread visits, in its order of visit.
+/// The blocks each thread visits, in its order of visit (each thread appends
+/// to its own list only).
 template <typename Loop>
-std::vector<std::vector<int>> visits_per_thread(int threads, int blocks, Loop&& loop) {
+std::vector<std::vector<int>> visits_per_thread(int threads, Loop&& loop) {
   std::vector<std::vector<int>> visits(static_cast<std::size_t>(threads));
-  std::vector<int> seen(static_cast<std::size_t>(blocks), 0);
-  loop([&](int b) {
-    visits[static_cast<std::size_t>(omp_get_thread_num())].push_back(b);
-    ++seen[static_cast<std::size_t>(b)];
-  });
-  for (int b = 0; b < blocks; ++b) EXPECT_EQ(seen[static_cast<std::size_t>(b)], 1) << "block " << b;
+  loop([&](int b) { visits[static_cast<std::size_t>(omp_get_thread_num())].push_back(b); });
   return visits;
 }
 
@@ -244,25 +241,40 @@ std::vector<std::vector<int>> visits_per_thread(int threads, int blocks, Loop&& 
 // blocks still in cache; the cache it reuses is the one of the thread that
 // last touched them, so each thread must keep its share of the blocks.
 TEST(FlowForest, BackwardLoopGivesEachThreadItsForwardShareReversed) {
-  for (const int threads : {1, 2, 3}) {
+  struct Case {
+    std::array<int, 3> trees;
+    int level, threads;
+  };
+  // 40 blocks on 1, 2 and 3 threads (40 % 3 = 1: uneven shares), and 2 blocks
+  // on 3 threads (a thread with none).
+  for (const Case& c : {Case{{1, 1, 5}, 1, 1}, Case{{1, 1, 5}, 1, 2}, Case{{1, 1, 5}, 1, 3},
+                        Case{{1, 1, 2}, 0, 3}}) {
     ForestSpec spec;
-    spec.trees = {1, 1, 5};
-    spec.level = 1;
+    spec.trees = c.trees;
+    spec.level = c.level;
     spec.block_cells = 4;
-    spec.threads = threads;
+    spec.threads = c.threads;
     const Forest forest(spec);
     const int n = forest.local_blocks();
-    ASSERT_EQ(n % 3, 1);  // uneven shares for three threads
     const auto forward =
-        visits_per_thread(threads, n, [&](auto&& body) { forest.for_each_block(body); });
+        visits_per_thread(c.threads, [&](auto&& body) { forest.for_each_block(body); });
     const auto backward =
-        visits_per_thread(threads, n, [&](auto&& body) { forest.for_each_block_backward(body); });
-    for (int t = 0; t < threads; ++t) {
-      auto reversed = forward[static_cast<std::size_t>(t)];
+        visits_per_thread(c.threads, [&](auto&& body) { forest.for_each_block_backward(body); });
+    // Forward: thread t takes the t-th contiguous share, in increasing order,
+    // one block more for the first n % T; so every block exactly once, and
+    // every thread with a share of its own (the team really has T threads).
+    int next = 0;
+    for (int t = 0; t < c.threads; ++t) {
+      const auto& mine = forward[static_cast<std::size_t>(t)];
+      const int expected = n / c.threads + (t < n % c.threads ? 1 : 0);
+      ASSERT_EQ(static_cast<int>(mine.size()), expected) << c.threads << " threads, thread " << t;
+      for (const int b : mine) EXPECT_EQ(b, next++);
+      auto reversed = mine;
       std::reverse(reversed.begin(), reversed.end());
       EXPECT_EQ(backward[static_cast<std::size_t>(t)], reversed)
-          << threads << " threads, thread " << t;
+          << c.threads << " threads, thread " << t;
     }
+    EXPECT_EQ(next, n);
   }
 }
 

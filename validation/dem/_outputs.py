@@ -55,6 +55,15 @@ def read_summary(run_dir):
         return {k: float(v) for k, v in next(csv.DictReader(f)).items()}
 
 
+def calibration_value_folder(calibration_dir, value):
+    """The run folder of a value in a `sanguis calibrate` output (named value_V, V the
+    value's shortest exact form, which Python's formats do not always reproduce)."""
+    for name in os.listdir(calibration_dir):
+        if name.startswith("value_") and float(name[len("value_"):]) == value:
+            return os.path.join(calibration_dir, name)
+    raise FileNotFoundError(f"no run folder for the value {value:g} in {calibration_dir}")
+
+
 def wall_time(run, after=-1.0):
     """Wall-clock seconds of the run: the sum of its `done:` lines (a restarted run has
     one per segment), or of the segments that ended after time `after` [s]."""

@@ -32,7 +32,7 @@ import time
 import matplotlib
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import read_summary  # noqa: E402
+from _outputs import calibration_value_folder, read_summary  # noqa: E402
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -83,9 +83,9 @@ def main():
             sweep.append((float(r["value"]), float(r["repose_angle_deg_mean"]),
                           float(r["repose_angle_deg_std"])))
     seeds = {}
-    for i, v in enumerate(values):
+    for v in values:
         for seed in (1, 2):
-            d = os.path.join(calib, f"value_{i}", f"seed_{seed}")
+            d = os.path.join(calibration_value_folder(calib, v), f"seed_{seed}")
             seeds.setdefault(v, []).append(read_summary(d)["repose_angle_deg"])
     elapsed = time.time() - t0
 

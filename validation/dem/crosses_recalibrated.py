@@ -36,7 +36,8 @@ import time
 import matplotlib
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import read_summary, regime_name, wall_time, write_summary  # noqa: E402
+from _outputs import (calibration_value_folder, read_summary, regime_name, wall_time,  # noqa: E402
+                      write_summary)
 from crosses_dam_break import (CASE, RESULTS, ROOT, diagnostics,  # noqa: E402
                                draw_velocity_bands, lajeunesse, opening_time, velocity_curve)
 from crosses_tangential_map import tangential_settings  # noqa: E402
@@ -82,12 +83,7 @@ def calibrate(exe, target):
 
 
 def value_folder(value):
-    """The calibration's folder of a value (named by `sanguis calibrate` in the value's
-    shortest exact form, which Python's formats do not always reproduce)."""
-    for name in os.listdir(CALIBRATION):
-        if name.startswith("value_") and float(name[len("value_"):]) == value:
-            return os.path.join(CALIBRATION, name)
-    sys.exit(f"no run folder for the value {value:g} in {CALIBRATION}")
+    return calibration_value_folder(CALIBRATION, value)
 
 
 def read_csv(path):
