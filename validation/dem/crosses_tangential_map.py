@@ -205,16 +205,20 @@ def main():
                   "alone; look at the frames. A run of 0.5 s (about 3.7 τc) also cuts short a "
                   "slow top-driven collapse (the thesis' large cross systems move until about "
                   "10 τc).",
-                  "The Table 3.1 point sits on this model's boundary between slow top-driven "
-                  "collapse and a column that stays (height loss within 0.5 s near the 5 % "
-                  "threshold: 0.045 here, 0.080 in the run of 2026-11-22 from a pour of an "
-                  "earlier build, which classified it region 2). Around it the column loses "
-                  "4-7 % of its height for kt 1e2-1e3 and γt 3e2-3e3; a collapse of a third of "
-                  "the height needs kt and γt both about 3x lower (kt 1e2, γt 3e2: 0.36), and "
-                  "every point away from the band (kt 10 or γt 1 or 1e5) collapses fast. The "
-                  "thesis found its physical band at kt 3e2, γt 1e3: this model is stickier by "
-                  "a factor of about 3 in kt and γt, which is also why the 4 cm dam break "
-                  "(crosses_dam_break) runs out about half as far as the thesis."],
+                  "The map is a property of the packing as much as of kt and γt. On this "
+                  "packing (the loose pour of crosses_memory's run of 2026-11-24: H0 20.9 cm, "
+                  "4.94 touching neighbours per cross, where other pours of the case give "
+                  "17.6-18.2 cm and 5.4-6.7) every point collapses top-driven within 0.5 s, the "
+                  "Table 3.1 point included (height loss 0.555), so the grid shows region 2 "
+                  "only. On the packing of the run of 2026-11-23 (H0 17.9 cm, 6.18 "
+                  "neighbours) the Table 3.1 point lost 4.5 % of its height (region 3), the "
+                  "points at kt 1e2-1e3, γt 3e2-3e3 4-7 %, and a collapse of a third of the "
+                  "height needed kt and γt both about 3x lower (kt 1e2, γt 3e2: 0.36); the run "
+                  "of 2026-11-22, from a pour of an earlier build, lost 8.0 % there (region 2). "
+                  "The reading of those runs, that this model is about 3x stickier in kt and "
+                  "γt than the thesis' (crosses_recalibrated, crosses_dam_break), rests on "
+                  "one dense packing; a map to compare with Fig. 3.17 needs several packings "
+                  "per point (not run here)."],
     }
     write_summary(summary, RESULTS, elapsed, args.quick, ok)
     print(f"{'PASS' if ok else 'FAIL'}: {len(results)} runs, {elapsed:.0f} s")

@@ -85,10 +85,13 @@ def report(summaries, meta):
     older = [name for name, s in summaries if s and s.get("date", "") < STORAGE_SORT_SINCE]
     if older:
         out[-2:-2] = [f"{len(older)} of these {len(summaries)} cases were run before the particle "
-                      f"storage sort ({STORAGE_SORT_SINCE}): the code reproduces them bit for bit "
-                      "with `[simulation] storage_sort_steps = 0` (`--set "
-                      "simulation.storage_sort_steps=0`), and by default with another round-off "
-                      "(docs/performance.md, \"Storage along a space-filling curve\").", ""]
+                      f"storage sort ({STORAGE_SORT_SINCE}) by earlier builds. The current build "
+                      "runs them with another round-off (the sort, docs/performance.md, \"Storage "
+                      "along a space-filling curve\", and changes to the contact code since), and "
+                      "`--set simulation.storage_sort_steps=0` does not bring back their bits: "
+                      "crosses_memory, rerun so on 2026-11-24, poured to H0 18.0 cm against 17.9 "
+                      "in its run of 2026-11-22. Pours of crosses are chaotic, so such a rerun is "
+                      "another packing (see crosses_memory's notes).", ""]
     for name, s in summaries:
         if s is None:
             out.append(f"| {name} | — | — | **FAIL** (no summary) | — |")
