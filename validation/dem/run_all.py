@@ -6,11 +6,12 @@ another, then reads the JSON summary each writes to validation/dem/results/NAME.
 and writes docs/validation/dem.md: per case its figures, the measured numbers next to
 the thesis' numbers with the tolerance and PASS/FAIL, the run time, and the hardware and
 date of the run. Exits 1 if any script fails. `make validate-dem` calls it; on the
-2-core development machine it takes about 6 hours: the 8 cm gate with the calibrated
-crosses (two pours ~45 min each, their collapses ~33 and ~53 min, the first one's collapse
-with Table 3.1 ~32 min, 2 threads), the cross columns (pour ~15 min,
-memory pair ~12 min, tangential map ~40 min), the hopper sweep (~75 min), the friction
-calibration (~11 min), the run-out scaling (~10 min) and the settling runs (~6.5 min); `--quick` runs reduced
+2-core development machine it takes about 17 hours (run times of the last runs, in the
+report): the dam breaks of crosses (crosses_dam_break ~7 h, crosses_calibrated_gates
+~5 h, crosses_recalibrated ~3 h), the hopper sweep (~75 min), the cross columns (memory
+pair with its pour ~7 min, tangential map ~14 min, three more pours ~15 min), the
+friction calibration (~4 min), the run-out scaling (~3 min) and the settling runs
+(~4.5 min); `--quick` runs reduced
 variants where a script has one. `--only NAME` reruns one case.
 
 Usage: /usr/bin/python3 validation/dem/run_all.py [--build build] [--quick]
