@@ -39,7 +39,8 @@ done
 [[ -x "$sanguis" ]] || die "$sanguis not found (build first: make build)"
 
 rate() { sed 's/.*"particle_steps_per_s":\([0-9.e+-]*\).*/\1/'; }
-median() { sort -g | awk '{ v[NR] = $1 } END { printf "%.6g", NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'; }
+# shellcheck source=bench/common.sh
+source "$root/bench/common.sh"
 
 one=() many=() ratios=()
 for ((r = 1; r <= repeat; r++)); do

@@ -19,6 +19,8 @@
 set -euo pipefail
 
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+# shellcheck source=bench/common.sh
+source "$root/bench/common.sh"
 sanguis="${SANGUIS:-$root/build/app/sanguis}"
 gerris="${GERRIS:-gerris3D}"
 cells=64
@@ -56,6 +58,6 @@ for ((r = 1; r <= repeat; r++)); do
   echo "$line"
   rates+=("$(echo "$line" | sed 's/.*"cell_updates_per_s":\([0-9.e+-]*\).*/\1/')")
 done
-sanguis_rate=$(printf '%s\n' "${rates[@]}" | sort -g | awk '{ v[NR] = $1 } END { printf "%.6g", NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }')
+sanguis_rate=$(printf '%s\n' "${rates[@]}" | median)
 awk -v a="$sanguis_rate" -v b="$gerris_rate" -v n="$cells" -v s="$steps" -v blk="$block" -v r="$repeat" \
   'BEGIN { printf "{\"benchmark\":\"flow-cavity\",\"summary\":true,\"block_cells\":%d,\"cells_per_side\":%d,\"steps\":%d,\"sanguis_runs\":%d,\"gerris_cell_updates_per_s\":%s,\"sanguis_median_cell_updates_per_s\":%s,\"ratio_sanguis_over_gerris\":%.3g}\n", blk, n, s, r, b, a, a / b }'

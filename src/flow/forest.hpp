@@ -289,6 +289,10 @@ class Forest {
   std::vector<std::int32_t> faces_apart_blocks_;
   std::array<std::vector<std::int32_t>, 6> finer_face_blocks_;
   std::vector<std::int32_t> beside_finer_blocks_, beside_coarser_blocks_;
+
+  /// body(b) over each thread's block_share(), forwards or backwards.
+  template <bool kBackward, typename Body>
+  void for_each_block_share(Body&& body) const;
 };
 
 /// The blocks [first, first + count) that thread t of `threads` takes: equal
@@ -303,32 +307,32 @@ inline BlockShare block_share(int n, int threads, int t) {
   return {t * share + std::min(t, extra), share + (t < extra ? 1 : 0)};
 }
 
-template <typename Body>
-void Forest::for_each_block(Body&& body) const {
+template <bool kBackward, typename Body>
+void Forest::for_each_block_share(Body&& body) const {
+  const auto run = [&](BlockShare mine) {
+    if constexpr (kBackward) {
+      for (int b = mine.first + mine.count - 1; b >= mine.first; --b) body(b);
+    } else {
+      for (int b = mine.first; b < mine.first + mine.count; ++b) body(b);
+    }
+  };
   const int n = local_blocks();
   if (spec_.threads > 1) {
 #pragma omp parallel num_threads(spec_.threads)
-    {
-      const BlockShare mine = block_share(n, omp_get_num_threads(), omp_get_thread_num());
-      for (int b = mine.first; b < mine.first + mine.count; ++b) body(b);
-    }
+    run(block_share(n, omp_get_num_threads(), omp_get_thread_num()));
   } else {
-    for (int b = 0; b < n; ++b) body(b);
+    run({0, n});
   }
 }
 
 template <typename Body>
+void Forest::for_each_block(Body&& body) const {
+  for_each_block_share<false>(body);
+}
+
+template <typename Body>
 void Forest::for_each_block_backward(Body&& body) const {
-  const int n = local_blocks();
-  if (spec_.threads > 1) {
-#pragma omp parallel num_threads(spec_.threads)
-    {
-      const BlockShare mine = block_share(n, omp_get_num_threads(), omp_get_thread_num());
-      for (int b = mine.first + mine.count - 1; b >= mine.first; --b) body(b);
-    }
-  } else {
-    for (int b = n - 1; b >= 0; --b) body(b);
-  }
+  for_each_block_share<true>(body);
 }
 
 template <typename Body>

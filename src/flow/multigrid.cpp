@@ -862,19 +862,22 @@ void Multigrid::residual(BlockField& x, const BlockField& rhs, const ScalarBound
   compute_residual(0, x, rhs, &bc, r);
 }
 
-void Multigrid::relax(BlockField& x, const BlockField& rhs, const ScalarBoundary& bc, int sweeps,
-                      const MultigridOptions& options) {
+void Multigrid::take_options(const MultigridOptions& options) {
+  pre_sweeps_ = options.pre_sweeps;
+  post_sweeps_ = options.post_sweeps;
   omega_ = options.relaxation;
   constant_kernels_ = options.constant_coefficient_kernels;
+}
+
+void Multigrid::relax(BlockField& x, const BlockField& rhs, const ScalarBoundary& bc, int sweeps,
+                      const MultigridOptions& options) {
+  take_options(options);
   smooth(0, x, rhs, &bc, sweeps);
 }
 
 MultigridReport Multigrid::solve(BlockField& x, const BlockField& rhs, const ScalarBoundary& bc,
                                  const MultigridOptions& options) {
-  pre_sweeps_ = options.pre_sweeps;
-  post_sweeps_ = options.post_sweeps;
-  omega_ = options.relaxation;
-  constant_kernels_ = options.constant_coefficient_kernels;
+  take_options(options);
   const BlockField* source = &rhs;
   BlockField& shifted = shifted_rhs_;
   if (singular_) {

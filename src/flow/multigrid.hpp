@@ -115,6 +115,8 @@ class Multigrid {
   [[nodiscard]] bool singular() const { return singular_; }
 
  private:
+  /// The sweeps, relaxation and kernels of `options`, for what follows.
+  void take_options(const MultigridOptions& options);
   struct Level {
     int cells = 0;  ///< cells per block edge at this level
     BlockField x, rhs, res, alpha;

@@ -86,8 +86,10 @@ def main():
     jobs = []
     points = [TABLE_31, LOWER]
     for seed, pour in pours.items():
-        for kt, g in points if not args.reuse else []:
+        for kt, g in points:
             d = os.path.join(RUNS, f"seed_{seed}_kt_{kt:g}_gamma_{g:g}")
+            if args.reuse:
+                continue
             shutil.rmtree(d, ignore_errors=True)
             shutil.copytree(pour, d)
             jobs.append(([exe, "run", CASE, "--output", d, "--restart", "--quiet", "--threads",
