@@ -60,4 +60,65 @@ std::vector<std::size_t> equal_weight_cuts(const std::vector<Count>& histogram, 
   return cut;
 }
 
+// What a unit of work (a contact) costs along the cut axis, learnt from the threads'
+// clocks. The slabs are cut by contact counts, but a contact's cost depends on where it
+// is (an element pair whose bounding balls are apart skips GJK; the contacts of shared
+// particles pass through the gather) and on how fast each thread's core runs. The box
+// along the axis is split into kCells cells, each with a cost factor (1 at first); after
+// each cut the time each slab took, against the time its weighted work predicted,
+// scales the factors of the cells it covered. The updates compound, so the factors
+// resolve the cost within a slab as the cuts move; each is damped (a square root,
+// within [1/2, 2]) so that a core's passing stall moves the next cut only so far.
+class SlabCostProfile {
+ public:
+  static constexpr std::size_t kCells = 256;
+
+  SlabCostProfile() = default;
+  // Along `axis` of the box [low, high].
+  SlabCostProfile(int axis, double low, double high)
+      : axis_(axis),
+        low_(low),
+        width_(std::max((high - low) / static_cast<double>(kCells), 1e-300)),
+        factor_(kCells, 1.0) {}
+
+  int axis() const { return axis_; }
+  bool empty() const { return factor_.empty(); }
+  double factor_at(double coordinate) const {
+    const double u = (coordinate - low_) / width_;
+    if (!(u > 0.0)) return factor_.front();  // also NaN
+    return u >= static_cast<double>(kCells - 1) ? factor_.back()
+                                                : factor_[static_cast<std::size_t>(u)];
+  }
+  // One cut measured: slab b held the coordinates [bound[b], bound[b + 1]), its work
+  // weighted by these factors was predicted[b], and it took seconds[b].
+  void update(const std::vector<double>& bound, const std::vector<double>& predicted,
+              const std::vector<double>& seconds) {
+    double total_predicted = 0.0, total_seconds = 0.0;
+    for (std::size_t b = 0; b < seconds.size(); ++b) {
+      total_predicted += predicted[b];
+      total_seconds += seconds[b];
+    }
+    if (!(total_predicted > 0.0 && total_seconds > 0.0)) return;
+    for (std::size_t b = 0; b < seconds.size(); ++b) {
+      if (!(predicted[b] > 0.0)) continue;  // no work there: nothing learnt
+      const double ratio = (seconds[b] / total_seconds) / (predicted[b] / total_predicted);
+      const double scale = std::clamp(std::sqrt(ratio), 0.5, 2.0);
+      for (std::size_t c = 0; c < kCells; ++c) {
+        const double centre = low_ + (static_cast<double>(c) + 0.5) * width_;
+        if (centre >= bound[b] && centre < bound[b + 1]) factor_[c] *= scale;
+      }
+    }
+    // Only ratios matter; keep the factors near 1.
+    double mean = 0.0;
+    for (const double f : factor_) mean += f;
+    mean /= static_cast<double>(kCells);
+    for (double& f : factor_) f = std::clamp(f / mean, 1e-3, 1e3);
+  }
+
+ private:
+  int axis_ = -1;
+  double low_ = 0.0, width_ = 1.0;
+  std::vector<double> factor_;
+};
+
 }  // namespace sanguis::dem
