@@ -3,7 +3,6 @@
 #include "dem/sphere_pair_kernel.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -19,17 +18,6 @@
 #include "geometry/separating_axes.hpp"
 
 namespace sanguis::dem {
-
-namespace {
-
-// The time each thread spends in its slab (SlabClock) teaches the next cut what the work
-// costs where, once this many steps were timed since the last cut; the cut is redrawn
-// at the next list rebuild, or at once if the slowest slab took more than
-// kSlabImbalance above the mean (a recut costs about one step of dem-spheres).
-constexpr std::int64_t kSlabClockSteps = 200;
-constexpr double kSlabImbalance = 0.015;
-
-}  // namespace
 
 std::pair<double, double> DemSimulation::radius_bounds(const DemSetup& s) {
   // Smallest volume-equivalent radius (a cross's bounding sphere is 3x larger, and a skin
@@ -108,7 +96,6 @@ void DemSimulation::step() {
       rebuild_lists();
     }
     compute_forces();
-    if (slabs_unbalanced()) build_blocks();
     integrator_.finish(p, setup_.gravity, dt);
     if (step_ % 64 == 0) check_state();
     return;
@@ -126,7 +113,6 @@ void DemSimulation::step() {
   std::string error;
   try {
     compute_forces();
-    if (slabs_unbalanced()) build_blocks();
     integrator_.finish(p, setup_.gravity, dt);
     if (step_ % 64 == 0) check_state();
   } catch (const SimulationError& e) {
@@ -476,7 +462,6 @@ void DemSimulation::compute_forces() {
     reduction(+ : touching_pairs, touching_walls, deep)
       for (std::ptrdiff_t b = 0; b < blocks; ++b) {
         const auto bu = static_cast<std::size_t>(b);
-        const auto slab_start = std::chrono::steady_clock::now();
         const auto tally = [&](const ContactOutcome& o, std::int64_t& touching) {
           if (!o.touching) return;
           ++touching;
@@ -523,8 +508,6 @@ void DemSimulation::compute_forces() {
           tally(o, touching_walls);
           wall_step(o, body_walls_.first[k], body_wall_touching_[k], body_wall_buffer_[k]);
         }
-        slab_clock_.seconds[bu] +=
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - slab_start).count();
       }
 #pragma omp for schedule(static)
       for (std::size_t s = 0; s < shared_list_.size(); ++s) {
@@ -569,7 +552,6 @@ void DemSimulation::compute_forces() {
         coord[i] = count;
       }
     }
-    ++slab_clock_.steps;
   }
   touching_pairs_ = touching_pairs;
   touching_walls_ = touching_walls;
@@ -849,33 +831,12 @@ void DemSimulation::build_blocks() {
   for (std::size_t i = 0; i < n; ++i) {
     bin[i] = static_cast<std::uint32_t>(axis_bin(p.position[i][axis], lo, span, kBins));
   }
-  std::vector<double> work(kBins, 0.0);  // whole numbers: exact in a double
-  for (std::uint32_t i : pairs_.first) work[bin[i]] += 1.0;
-  for (std::uint32_t i : walls_.first) work[bin[i]] += 1.0;
+  std::vector<std::uint64_t> work(kBins, 0);
+  for (std::uint32_t i : pairs_.first) ++work[bin[i]];
+  for (std::uint32_t i : walls_.first) ++work[bin[i]];
   for (std::uint32_t i : body_pairs_.first) work[bin[i]] += kElementPairWeight;
-  for (std::uint32_t i : body_walls_.first) work[bin[i]] += 1.0;
-  // Each thread's time in its slab since the last cut, if enough steps were measured,
-  // teaches the profile what a unit of work costs where (SlabCostProfile).
-  if (slab_cost_.axis() != axis) {
-    slab_cost_ = SlabCostProfile(axis, setup_.domain.min[axis], setup_.domain.max[axis]);
-  } else if (slab_clock_.axis == axis && slab_clock_.steps >= kSlabClockSteps &&
-             slab_clock_.seconds.size() == blocks) {
-    slab_cost_.update(slab_clock_.bound, slab_clock_.predicted, slab_clock_.seconds);
-  }
-  const double width = span / static_cast<double>(kBins);
-  for (std::size_t k = 0; k < kBins; ++k) {
-    work[k] *= slab_cost_.factor_at(lo + (static_cast<double>(k) + 0.5) * width);
-  }
+  for (std::uint32_t i : body_walls_.first) ++work[bin[i]];
   const std::vector<std::size_t> cut = equal_weight_cuts(work, blocks);
-  slab_clock_ =
-      SlabClock{axis, {}, std::vector<double>(blocks, 0.0), std::vector<double>(blocks, 0.0), 0};
-  for (std::size_t b = 0; b <= blocks; ++b) {
-    slab_clock_.bound.push_back(b == 0        ? -std::numeric_limits<double>::infinity()
-                                : b == blocks ? std::numeric_limits<double>::infinity()
-                                              : lo + static_cast<double>(cut[b]) * width);
-    if (b == blocks) break;
-    for (std::size_t k = cut[b]; k < cut[b + 1]; ++k) slab_clock_.predicted[b] += work[k];
-  }
   std::vector<std::uint32_t> block_of_bin(kBins);
   for (std::size_t b = 0; b < blocks; ++b) {
     for (std::size_t k = cut[b]; k < cut[b + 1]; ++k)
@@ -902,26 +863,6 @@ void DemSimulation::build_blocks() {
     if (shared_[i]) shared_list_.push_back(i);
   }
   build_pair_runs();
-}
-
-// Whether the slabs, measured over enough steps since the last cut, took times further
-// apart than kSlabImbalance: the run then redraws them from those times (build_blocks).
-bool DemSimulation::slabs_unbalanced() const {
-  if (threads_ <= 1 || slab_clock_.steps < kSlabClockSteps) return false;
-  const std::vector<double>& t = slab_clock_.seconds;
-  double total = 0.0, longest = 0.0;
-  for (const double s : t) {
-    total += s;
-    longest = std::max(longest, s);
-  }
-  return longest * static_cast<double>(t.size()) > (1.0 + kSlabImbalance) * total;
-}
-
-void DemSimulation::recut_slabs(SlabCostProfile cost) {
-  if (threads_ <= 1) return;
-  slab_clock_.steps = 0;  // the given profile, not the clock, weighs this cut
-  slab_cost_ = std::move(cost);
-  build_blocks();
 }
 
 void DemSimulation::build_pair_runs() {

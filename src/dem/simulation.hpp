@@ -17,7 +17,6 @@
 #include "dem/particle_exchange.hpp"
 #include "dem/particle_shape.hpp"
 #include "dem/particle_store.hpp"
-#include "dem/slab_cuts.hpp"
 #include "dem/time_integrator.hpp"
 
 namespace sanguis::dem {
@@ -154,12 +153,6 @@ class DemSimulation {
   // How the thread blocks walk their sphere pairs (empty on one thread), for tests.
   const std::vector<PairRun>& pair_runs() const { return pair_runs_; }
   int threads() const { return threads_; }  // threads in use (small systems run serially)
-  // The threads' slabs (build_blocks): slab b's sphere pairs, for tests.
-  const BlockContacts& slab_pairs() const { return block_pairs_; }
-  // Redraws the threads' slabs now, weighing the work by `cost` (along another axis than
-  // the cut's: by contact counts alone); the run learns its own profile from the time
-  // each slab takes. The results do not depend on where the slabs lie. For tests.
-  void recut_slabs(SlabCostProfile cost);
 
   DemDiagnostics diagnostics() const;
 
@@ -211,7 +204,6 @@ class DemSimulation {
   void build_incidence();
   void build_blocks();
   void build_pair_runs();
-  bool slabs_unbalanced() const;
   void split_body_contacts();
   void pour_particles();
   void check_state() const;
@@ -254,17 +246,6 @@ class DemSimulation {
   // pair_run_offset_[b + 1]), in order (build_pair_runs).
   std::vector<PairRun> pair_runs_;
   std::vector<std::uint32_t> pair_run_offset_;
-  // Where the slabs lie along the cut axis (bound: slabs + 1 coordinates, the ends
-  // infinite), the cost slab_cost_ predicted for each, and the seconds each thread spent
-  // in its slab's contacts over the steps since the cut: what the next cut learns from.
-  // Not part of the state: the results do not depend on the cuts.
-  struct SlabClock {
-    int axis = -1;
-    std::vector<double> bound, predicted, seconds;
-    std::int64_t steps = 0;
-  };
-  SlabClock slab_clock_;
-  SlabCostProfile slab_cost_;
   std::int64_t deep_contacts_ = 0;
   std::mt19937_64 pour_rng_;  // element contacts whose overlap exceeded the crusts
 };

@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <cstring>
-#include <limits>
 #include <vector>
 
 #include "core/config.hpp"
@@ -74,10 +73,7 @@ struct Snapshot {
   std::vector<Vec3> x, v, w, f;
 };
 
-// Every `recut_every` steps (0: never) the slabs are redrawn with a profile that makes
-// one half of the box, along each axis in turn, look three times as costly: the cut
-// moves, and with it which thread sums which particle.
-Snapshot run(int threads, IntegratorKind kind, int recut_every = 0) {
+Snapshot run(int threads, IntegratorKind kind) {
   DemCase c = load_dem_case(ConfigTable::parse_string(kPile, "pile.toml"), "pile.toml");
   c.setup.threads = threads;
   c.setup.particles_per_thread = 1;  // force threads on this small system
@@ -85,31 +81,14 @@ Snapshot run(int threads, IntegratorKind kind, int recut_every = 0) {
   DemSimulation sim(c.setup);
   EXPECT_EQ(sim.threads(), threads);
   std::int64_t contacts_seen = 0;  // the run must exercise contacts, pairs and walls
-  int cuts_moved = 0;
   for (int n = 0; n < 3000; ++n) {
     sim.step();
-    if (recut_every > 0 && n % recut_every == 0) {
-      const int axis = (n / recut_every) % 3;
-      const auto a = static_cast<std::size_t>(axis);
-      const double lo = c.setup.domain.min[a], hi = c.setup.domain.max[a];
-      SlabCostProfile cost(axis, lo, hi);
-      const double inf = std::numeric_limits<double>::infinity();
-      const bool low_slow = (n / recut_every) % 2 == 0;
-      cost.update({-inf, 0.5 * (lo + hi), inf}, {1.0, 1.0},
-                  {low_slow ? 9.0 : 1.0, low_slow ? 1.0 : 9.0});
-      const std::vector<std::uint32_t> before = sim.slab_pairs().offset;
-      sim.recut_slabs(cost);
-      cuts_moved += sim.slab_pairs().offset != before;
-    }
     if (n % 50 == 0) {
       contacts_seen += sim.diagnostics().particle_contacts + sim.diagnostics().wall_contacts;
     }
   }
   EXPECT_GT(contacts_seen, 200);
   EXPECT_GT(sim.neighbor_search().rebuild_count(), 5);
-  if (recut_every > 0) {
-    EXPECT_GT(cuts_moved, 3000 / recut_every / 4) << threads << " threads";
-  }
   if (threads > 1) {  // both ways of walking a slab's sphere pairs are exercised
     const std::vector<PairRun>& runs = sim.pair_runs();
     const auto direct =
@@ -144,19 +123,6 @@ TEST(ThreadDeterminism, OneTwoAndThreeThreadsGiveIdenticalBits) {
       EXPECT_TRUE(bitwise_equal(one.w, many.w)) << threads << " threads";
       EXPECT_TRUE(bitwise_equal(one.f, many.f)) << threads << " threads";
     }
-  }
-}
-
-TEST(ThreadDeterminism, SlabsRedrawnMidRunGiveTheSerialBits) {
-  // What the run does when its clocks find the slabs unbalanced (SlabCostProfile),
-  // forced here every 50 steps with made-up costs.
-  const Snapshot one = run(1, IntegratorKind::kLeapfrog);
-  for (int threads : {2, 3}) {
-    const Snapshot redrawn = run(threads, IntegratorKind::kLeapfrog, 50);
-    EXPECT_TRUE(bitwise_equal(one.x, redrawn.x)) << threads << " threads";
-    EXPECT_TRUE(bitwise_equal(one.v, redrawn.v)) << threads << " threads";
-    EXPECT_TRUE(bitwise_equal(one.w, redrawn.w)) << threads << " threads";
-    EXPECT_TRUE(bitwise_equal(one.f, redrawn.f)) << threads << " threads";
   }
 }
 
