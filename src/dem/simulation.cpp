@@ -19,6 +19,21 @@
 
 namespace sanguis::dem {
 
+namespace {
+
+// With bodies the threads share more, smaller slabs, taken as each thread comes free:
+// an element pair costs a GJK call or a bounding-ball test depending on how the bodies
+// lie, which counting contacts cannot foresee. But every cut shares the particles on
+// both sides, whose contacts go through the gather: as many slabs as leave at most
+// DemSetup::most_shared_fraction of the particles shared (docs/performance.md, "Several slabs per
+// thread for bodies": the 7000-cross benchmark column takes 4 per thread, 8 % shared,
+// and runs about 10 % faster; the 1300 crosses of the experiments' box would share
+// 35 % with 2 per thread and keep 1). Spheres keep one slab per thread, whose particles
+// are that thread's in the integrator loop too (more were slower).
+constexpr std::size_t kBodySlabsPerThread = 4;
+
+}  // namespace
+
 std::pair<double, double> DemSimulation::radius_bounds(const DemSetup& s) {
   // Smallest volume-equivalent radius (a cross's bounding sphere is 3x larger, and a skin
   // from it would swell the lists) and largest bounding radius, particles to come included.
@@ -458,15 +473,14 @@ void DemSimulation::compute_forces() {
         tq[i] = Vec3{};
         coord[i] = 0;
       }
-#pragma omp for schedule(static, 1) reduction(max : worst) \
-    reduction(+ : touching_pairs, touching_walls, deep)
-      for (std::ptrdiff_t b = 0; b < blocks; ++b) {
-        const auto bu = static_cast<std::size_t>(b);
+      // Slab b's contacts; the tallies are the calling thread's reduction copies.
+      const auto run_slab = [&](std::size_t bu, double& slab_worst, std::int64_t& slab_pairs,
+                                std::int64_t& slab_walls, std::int64_t& slab_deep) {
         const auto tally = [&](const ContactOutcome& o, std::int64_t& touching) {
           if (!o.touching) return;
           ++touching;
-          deep += o.deep;
-          worst = std::max(worst, o.overlap_ratio);
+          slab_deep += o.deep;
+          slab_worst = std::max(slab_worst, o.overlap_ratio);
         };
         const std::span<const std::uint32_t> block = block_pairs_.of(bu);
         SpherePairLanes lanes;
@@ -478,7 +492,7 @@ void DemSimulation::compute_forces() {
             evaluate_sphere_pairs(
                 sphere_pairs, [k0](std::size_t e) { return k0 + e; }, count, lanes,
                 [&](std::size_t k, const ContactOutcome& o) {
-                  tally(o, touching_pairs);
+                  tally(o, slab_pairs);
                   if (o.touching) add_to_both(o, pairs_.first[k], pairs_.second[k]);
                 });
           } else {
@@ -486,7 +500,7 @@ void DemSimulation::compute_forces() {
             evaluate_sphere_pairs(
                 sphere_pairs, [ks](std::size_t e) { return std::size_t{ks[e]}; }, count, lanes,
                 [&](std::size_t k, const ContactOutcome& o) {
-                  tally(o, touching_pairs);
+                  tally(o, slab_pairs);
                   pair_step(o, pairs_.first[k], pairs_.second[k], pair_touching_[k],
                             pair_buffer_[k]);
                 });
@@ -494,19 +508,34 @@ void DemSimulation::compute_forces() {
         }
         for (const std::uint32_t k : block_body_pairs_.of(bu)) {
           const ContactOutcome o = body_pair_outcome(k);
-          tally(o, touching_pairs);
+          tally(o, slab_pairs);
           pair_step(o, body_pairs_.first[k], body_pairs_.second[k], body_pair_touching_[k],
                     body_pair_buffer_[k]);
         }
         for (const std::uint32_t k : block_walls_.of(bu)) {
           const ContactOutcome o = wall_outcome(k);
-          tally(o, touching_walls);
+          tally(o, slab_walls);
           wall_step(o, walls_.first[k], wall_touching_[k], wall_buffer_[k]);
         }
         for (const std::uint32_t k : block_body_walls_.of(bu)) {
           const ContactOutcome o = body_wall_outcome(k);
-          tally(o, touching_walls);
+          tally(o, slab_walls);
           wall_step(o, body_walls_.first[k], body_wall_touching_[k], body_wall_buffer_[k]);
+        }
+      };
+      if (blocks > nt) {
+        // Several slabs per thread (bodies, build_blocks), taken as threads come free.
+#pragma omp for schedule(dynamic, 1) reduction(max : worst) \
+    reduction(+ : touching_pairs, touching_walls, deep)
+        for (std::ptrdiff_t b = 0; b < blocks; ++b) {
+          run_slab(static_cast<std::size_t>(b), worst, touching_pairs, touching_walls, deep);
+        }
+      } else {
+        // One slab per thread, thread t slab t: the particles its integrator loop holds.
+#pragma omp for schedule(static, 1) reduction(max : worst) \
+    reduction(+ : touching_pairs, touching_walls, deep)
+        for (std::ptrdiff_t b = 0; b < blocks; ++b) {
+          run_slab(static_cast<std::size_t>(b), worst, touching_pairs, touching_walls, deep);
         }
       }
 #pragma omp for schedule(static)
@@ -811,18 +840,18 @@ void DemSimulation::build_incidence() {
   build_blocks();
 }
 
-// Cuts space into one slab per thread along the longest axis of the particles, with about
-// equal work in each (a contact belongs to the slab of its first particle; an element
-// pair weighs as kElementPairWeight sphere contacts, for its GJK), lists each slab's
-// contacts in increasing index, and marks the particles with a pair in another slab as
-// shared. Slabs, not index ranges: between two storage sorts the particles move away
-// from their place in memory (and with the sort off, storage follows creation order).
+// Cuts space into one slab per thread (up to kBodySlabsPerThread with bodies) along the
+// longest axis of the particles, with about equal work in each (a contact belongs to the
+// slab of its first particle; an element pair weighs as kElementPairWeight sphere
+// contacts, for its GJK), lists each slab's contacts in increasing index, and marks the
+// particles with a pair in another slab as shared. Slabs, not index ranges: between two
+// storage sorts the particles move away from their place in memory (and with the sort
+// off, storage follows creation order).
 void DemSimulation::build_blocks() {
   constexpr std::uint32_t kElementPairWeight = 8;
   constexpr std::size_t kBins = 4096;
   const ParticleStore& p = setup_.particles;
   const std::size_t n = p.size();
-  const auto blocks = static_cast<std::size_t>(threads_);
   Extent extent = Extent::empty_in(setup_.domain.min, setup_.domain.max);
   for (const Vec3& x : p.position) extent.add(x);
   const int axis = extent.longest_axis();
@@ -836,28 +865,36 @@ void DemSimulation::build_blocks() {
   for (std::uint32_t i : walls_.first) ++work[bin[i]];
   for (std::uint32_t i : body_pairs_.first) work[bin[i]] += kElementPairWeight;
   for (std::uint32_t i : body_walls_.first) ++work[bin[i]];
-  const std::vector<std::size_t> cut = equal_weight_cuts(work, blocks);
-  std::vector<std::uint32_t> block_of_bin(kBins);
-  for (std::size_t b = 0; b < blocks; ++b) {
-    for (std::size_t k = cut[b]; k < cut[b + 1]; ++k)
-      block_of_bin[k] = static_cast<std::uint32_t>(b);
-  }
-  std::vector<std::uint32_t> block(n);
-  for (std::size_t i = 0; i < n; ++i) block[i] = block_of_bin[bin[i]];
 
-  block_pairs_.build(pairs_.first, block, blocks);
-  block_walls_.build(walls_.first, block, blocks);
-  block_body_pairs_.build(body_pairs_.first, block, blocks);
-  block_body_walls_.build(body_walls_.first, block, blocks);
-  shared_.assign(n, 0);
+  // The most slabs per thread (kBodySlabsPerThread with bodies, halved as needed) that
+  // leave at most setup_.most_shared_fraction of the particles shared.
+  std::vector<std::uint32_t> block(n), block_of_bin(kBins);
+  std::size_t blocks = 0;
   const auto mark = [&](const std::vector<std::uint32_t>& first,
                         const std::vector<std::uint32_t>& second) {
     for (std::size_t c = 0; c < first.size(); ++c) {
       if (block[first[c]] != block[second[c]]) shared_[first[c]] = shared_[second[c]] = 1;
     }
   };
-  mark(pairs_.first, pairs_.second);
-  mark(body_pairs_.first, body_pairs_.second);
+  for (std::size_t per_thread = has_bodies_ ? kBodySlabsPerThread : 1;; per_thread /= 2) {
+    blocks = static_cast<std::size_t>(threads_) * per_thread;
+    const std::vector<std::size_t> cut = equal_weight_cuts(work, blocks);
+    for (std::size_t b = 0; b < blocks; ++b) {
+      for (std::size_t k = cut[b]; k < cut[b + 1]; ++k)
+        block_of_bin[k] = static_cast<std::uint32_t>(b);
+    }
+    for (std::size_t i = 0; i < n; ++i) block[i] = block_of_bin[bin[i]];
+    shared_.assign(n, 0);
+    mark(pairs_.first, pairs_.second);
+    mark(body_pairs_.first, body_pairs_.second);
+    const auto shared = static_cast<double>(std::count(shared_.begin(), shared_.end(), 1));
+    if (per_thread == 1 || shared <= setup_.most_shared_fraction * static_cast<double>(n)) break;
+  }
+
+  block_pairs_.build(pairs_.first, block, blocks);
+  block_walls_.build(walls_.first, block, blocks);
+  block_body_pairs_.build(body_pairs_.first, block, blocks);
+  block_body_walls_.build(body_walls_.first, block, blocks);
   shared_list_.clear();
   for (std::uint32_t i = 0; i < n; ++i) {
     if (shared_[i]) shared_list_.push_back(i);

@@ -80,6 +80,9 @@ struct DemSetup {
   std::int64_t storage_sort_interval = 2000;
   std::size_t particles_per_thread =
       0;  // fewer per thread: fewer threads (0: 500 with bodies, 4000 spheres)
+  // With bodies each thread takes up to 4 slabs, as many as leave at most this share
+  // of the particles with a contact across slabs (simulation.cpp, kBodySlabsPerThread).
+  double most_shared_fraction = 0.15;
   std::vector<std::string> material_names;
   ContactTable contacts;
   std::vector<Obstacle> obstacles;
@@ -153,6 +156,8 @@ class DemSimulation {
   // How the thread blocks walk their sphere pairs (empty on one thread), for tests.
   const std::vector<PairRun>& pair_runs() const { return pair_runs_; }
   int threads() const { return threads_; }  // threads in use (small systems run serially)
+  // The threads' slabs (build_blocks): slab b's sphere pairs, for tests.
+  const BlockContacts& slab_pairs() const { return block_pairs_; }
 
   DemDiagnostics diagnostics() const;
 
