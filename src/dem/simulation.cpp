@@ -25,11 +25,12 @@ namespace {
 // an element pair costs a GJK call or a bounding-ball test depending on how the bodies
 // lie, which counting contacts cannot foresee. But every cut shares the particles on
 // both sides, whose contacts go through the gather: as many slabs as leave at most
-// DemSetup::most_shared_fraction of the particles shared (docs/performance.md, "Several slabs per
-// thread for bodies": the 7000-cross benchmark column takes 4 per thread, 8 % shared,
-// and runs about 10 % faster; the 1300 crosses of the experiments' box would share
-// 35 % with 2 per thread and keep 1). Spheres keep one slab per thread, whose particles
-// are that thread's in the integrator loop too (more were slower).
+// DemSetup::most_shared_fraction of the particles shared. The 7000-cross benchmark
+// column takes 4 per thread (8 % shared) and runs about 7 % faster; the 1300 crosses of
+// the experiments' box would share 35 % with 2 per thread and keep 1
+// (docs/performance.md, "Where two threads lose their time, and slabs for bodies").
+// Spheres keep one slab per thread, whose particles are that thread's in the
+// integrator loop too (more were slower).
 constexpr std::size_t kBodySlabsPerThread = 4;
 
 }  // namespace
