@@ -2,6 +2,8 @@
 #include "dem/slab_cuts.hpp"
 #include "dem/sphere_pair_kernel.hpp"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -21,13 +23,14 @@ namespace sanguis::dem {
 
 namespace {
 
-// With bodies the threads share more, smaller slabs, taken as each thread comes free:
-// an element pair costs a GJK call or a bounding-ball test depending on how the bodies
-// lie, which counting contacts cannot foresee. But every cut shares the particles on
-// both sides, whose contacts go through the gather: as many slabs as leave at most
+// With bodies each thread owns a run of up to four neighbouring slabs and, when done,
+// takes the last slab of the thread with the most left (SlabQueue): an element pair costs
+// a GJK call or a bounding-ball test depending on how the bodies lie, which counting
+// contacts cannot foresee. But every cut shares the particles on both sides, whose
+// contacts go through the gather: as many slabs as leave at most
 // DemSetup::most_shared_fraction of the particles shared. The 7000-cross benchmark
-// column takes 4 per thread (8 % shared) and runs about 7 % faster; the 1300 crosses of
-// the experiments' box would share 35 % with 2 per thread and keep 1
+// column takes 4 per thread (8 % shared) and runs about 4 % faster in the median; the
+// 1300 crosses of the experiments' box would share 35 % with 2 per thread and keep 1
 // (docs/performance.md, "Where two threads lose their time, and slabs for bodies").
 // Spheres keep one slab per thread, whose particles are that thread's in the
 // integrator loop too (more were slower).
@@ -525,12 +528,31 @@ void DemSimulation::compute_forces() {
         }
       };
       if (blocks > nt) {
-        // Several slabs per thread (bodies, build_blocks), taken as threads come free.
-#pragma omp for schedule(dynamic, 1) reduction(max : worst) \
-    reduction(+ : touching_pairs, touching_walls, deep)
-        for (std::ptrdiff_t b = 0; b < blocks; ++b) {
-          run_slab(static_cast<std::size_t>(b), worst, touching_pairs, touching_walls, deep);
+        // Several slabs per thread (bodies, build_blocks): each thread walks its own run
+        // of neighbouring slabs in order, then takes the last slab of the thread with the
+        // most left. Each keeps to its own stretch of space and memory, as with one slab
+        // per thread, while the cut between the threads moves with the actual cost.
+        // The tallies are sums of integers and a maximum: the same in any order.
+#pragma omp single
+        slab_queue_.start(blocks, omp_get_num_threads());
+        double my_worst = 0.0;
+        std::int64_t my_pairs = 0, my_walls = 0, my_deep = 0;
+        const int me = omp_get_thread_num();
+        for (;;) {
+          std::ptrdiff_t b = -1;
+#pragma omp critical(sanguis_dem_slab_queue)
+          b = slab_queue_.take(me);
+          if (b < 0) break;
+          run_slab(static_cast<std::size_t>(b), my_worst, my_pairs, my_walls, my_deep);
         }
+#pragma omp critical(sanguis_dem_slab_tally)
+        {
+          worst = std::max(worst, my_worst);
+          touching_pairs += my_pairs;
+          touching_walls += my_walls;
+          deep += my_deep;
+        }
+#pragma omp barrier
       } else {
         // One slab per thread, thread t slab t: the particles its integrator loop holds.
 #pragma omp for schedule(static, 1) reduction(max : worst) \
@@ -936,6 +958,25 @@ void DemSimulation::build_pair_runs() {
     if (general_open) pair_runs_.push_back({general_begin, n, false});
     pair_run_offset_[b + 1] = static_cast<std::uint32_t>(pair_runs_.size());
   }
+}
+
+void SlabQueue::start(std::ptrdiff_t slabs, int threads) {
+  next.resize(static_cast<std::size_t>(threads));
+  end.resize(static_cast<std::size_t>(threads));
+  for (int t = 0; t < threads; ++t) {
+    next[static_cast<std::size_t>(t)] = slabs * t / threads;
+    end[static_cast<std::size_t>(t)] = slabs * (t + 1) / threads;
+  }
+}
+
+std::ptrdiff_t SlabQueue::take(int thread) {
+  const auto me = static_cast<std::size_t>(thread);
+  if (next[me] < end[me]) return next[me]++;
+  std::size_t most = 0;
+  for (std::size_t t = 1; t < next.size(); ++t) {
+    if (end[t] - next[t] > end[most] - next[most]) most = t;
+  }
+  return next[most] < end[most] ? --end[most] : -1;
 }
 
 void BlockContacts::build(const std::vector<std::uint32_t>& first,

@@ -132,6 +132,16 @@ struct BlockContacts {
   }
 };
 
+// The threads' slabs when there are more slabs than threads: thread t owns the run
+// [next[t], end[t]) of neighbouring slabs and takes them from the front; a thread with
+// none left takes the last slab of the thread with the most left (compute_forces).
+// Called by one thread at a time.
+struct SlabQueue {
+  std::vector<std::ptrdiff_t> next, end;
+  void start(std::ptrdiff_t slabs, int threads);
+  std::ptrdiff_t take(int thread);  // a slab, or -1 when none is left
+};
+
 class DemSimulation {
  public:
   explicit DemSimulation(DemSetup setup);
@@ -251,6 +261,7 @@ class DemSimulation {
   // pair_run_offset_[b + 1]), in order (build_pair_runs).
   std::vector<PairRun> pair_runs_;
   std::vector<std::uint32_t> pair_run_offset_;
+  SlabQueue slab_queue_;
   std::int64_t deep_contacts_ = 0;
   std::mt19937_64 pour_rng_;  // element contacts whose overlap exceeded the crusts
 };

@@ -126,6 +126,30 @@ TEST(ThreadDeterminism, OneTwoAndThreeThreadsGiveIdenticalBits) {
   }
 }
 
+TEST(SlabQueue, EachThreadWalksItsOwnRunThenTakesTheLastOfTheBusiest) {
+  SlabQueue q;
+  q.start(8, 2);  // thread 0 owns slabs 0-3, thread 1 slabs 4-7
+  EXPECT_EQ(q.take(0), 0);
+  EXPECT_EQ(q.take(1), 4);
+  EXPECT_EQ(q.take(0), 1);
+  EXPECT_EQ(q.take(0), 2);
+  EXPECT_EQ(q.take(0), 3);
+  EXPECT_EQ(q.take(0), 7);  // its own run done: the last of thread 1's
+  EXPECT_EQ(q.take(1), 5);
+  EXPECT_EQ(q.take(0), 6);
+  EXPECT_EQ(q.take(1), -1);
+  EXPECT_EQ(q.take(0), -1);
+  q.start(7, 3);  // runs 0-1, 2-3, 4-6: every slab exactly once
+  std::vector<int> seen(7, 0);
+  for (int round = 0; round < 10; ++round) {
+    for (int thread : {2, 2, 0}) {
+      const std::ptrdiff_t b = q.take(thread);
+      if (b >= 0) ++seen[static_cast<std::size_t>(b)];
+    }
+  }
+  EXPECT_EQ(seen, std::vector<int>(7, 1));
+}
+
 TEST(ThreadDeterminism, FewerThreadsGrantedThanSlabsStillGiveTheSerialBits) {
   // Inside an active parallel region OpenMP grants the simulation's regions a single
   // thread: its three slabs then run one after the other on that thread.
@@ -154,7 +178,7 @@ namespace sanguis::dem {
 namespace {
 
 // Crosses (element contacts by GJK, body-wall contacts) give the same bits too.
-// most_shared_fraction 1: every thread takes four slabs, dynamically.
+// most_shared_fraction 1: every thread owns four slabs and takes others when done.
 std::vector<Vec3> crosses_after(int threads, double most_shared_fraction = 0.15) {
   DemSetup s = testing::falling_crosses(threads, [](int n) { return n; });
   s.most_shared_fraction = most_shared_fraction;
@@ -177,7 +201,7 @@ std::vector<Vec3> crosses_after(int threads, double most_shared_fraction = 0.15)
 }
 
 TEST(ThreadDeterminism, CrossesGiveIdenticalBitsOnOneTwoAndThreeThreads) {
-  // With bodies each thread may take several slabs as it comes free (build_blocks):
+  // With bodies each thread may take several slabs, its own and then others' (SlabQueue):
   // which thread sums which slab changes from step to step, the bits must not.
   const std::vector<Vec3> one = crosses_after(1);
   for (int threads : {2, 3}) {
