@@ -532,27 +532,21 @@ void DemSimulation::compute_forces() {
         // of neighbouring slabs in order, then takes the last slab of the thread with the
         // most left. Each keeps to its own stretch of space and memory, as with one slab
         // per thread, while the cut between the threads moves with the actual cost.
-        // The tallies are sums of integers and a maximum: the same in any order.
+        const int team = omp_get_num_threads();
 #pragma omp single
-        slab_queue_.start(blocks, omp_get_num_threads());
-        double my_worst = 0.0;
-        std::int64_t my_pairs = 0, my_walls = 0, my_deep = 0;
-        const int me = omp_get_thread_num();
-        for (;;) {
-          std::ptrdiff_t b = -1;
+        slab_queue_.start(blocks, team);
+        // Iteration t of the loop runs on thread t (static, 1 over the team).
+#pragma omp for schedule(static, 1) reduction(max : worst) \
+    reduction(+ : touching_pairs, touching_walls, deep)
+        for (int me = 0; me < team; ++me) {
+          for (;;) {
+            std::ptrdiff_t b = -1;
 #pragma omp critical(sanguis_dem_slab_queue)
-          b = slab_queue_.take(me);
-          if (b < 0) break;
-          run_slab(static_cast<std::size_t>(b), my_worst, my_pairs, my_walls, my_deep);
+            b = slab_queue_.take(me);
+            if (b < 0) break;
+            run_slab(static_cast<std::size_t>(b), worst, touching_pairs, touching_walls, deep);
+          }
         }
-#pragma omp critical(sanguis_dem_slab_tally)
-        {
-          worst = std::max(worst, my_worst);
-          touching_pairs += my_pairs;
-          touching_walls += my_walls;
-          deep += my_deep;
-        }
-#pragma omp barrier
       } else {
         // One slab per thread, thread t slab t: the particles its integrator loop holds.
 #pragma omp for schedule(static, 1) reduction(max : worst) \
