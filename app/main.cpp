@@ -259,6 +259,10 @@ int main(int argc, char** argv) {
                    "solver's, 1.15)")
       ->check(CLI::Range(0.0, 2.0));
   bench_cmd
+      ->add_option("--pressure-relaxation", bo.pressure_relaxation,
+                   "flow-cavity: the same for the projections' pressure solves only (A/B)")
+      ->check(CLI::Range(0.0, 2.0));
+  bench_cmd
       ->add_option("--sweeps", bo.sweeps,
                    "flow-cavity: smoothing sweeps before and after the coarse correction "
                    "(default: the solver's, 2)")

@@ -26,6 +26,8 @@ struct BenchOptions {
   // flow-cavity: over-relaxation of the red-black smoother (0: the solver's,
   // MultigridOptions::relaxation), for A/B runs.
   double relaxation = 0.0;
+  // flow-cavity: the same for the projections' (pressure) solves only, after `relaxation`.
+  double pressure_relaxation = 0.0;
   // flow-cavity: red-black sweeps before and after the coarse correction (0: the solver's).
   int sweeps = 0;
   // dem-spheres: lattice sites filled in random order, so that ids (and the storage
