@@ -23,8 +23,8 @@ struct BenchOptions {
   // flow-cavity: multigrid kernels that read the coefficient arrays even where they
   // are constant (MultigridOptions::uniform_coefficient_kernels = false), for A/B runs.
   bool general_kernels = false;
-  // flow-cavity: over-relaxation of the red-black smoother (0: the solver's,
-  // MultigridOptions::relaxation), for A/B runs.
+  // flow-cavity: over-relaxation of the red-black smoother in the pressure and viscous
+  // solves (0: the solver's, NavierStokesOptions), for A/B runs.
   double relaxation = 0.0;
   // flow-cavity: the same for the projections' (pressure) solves only, after `relaxation`.
   double pressure_relaxation = 0.0;
