@@ -198,6 +198,9 @@ struct RunResult {
   std::vector<Comparison> comparisons;  ///< at kCompareSteps (empty for the reference)
   double max_divergence = 0.0;
   double seconds = 0.0;
+  double regrid_seconds = 0.0;  ///< of `seconds`, in the regrids
+  /// V-cycles per step: final projection, predictor projection, the three viscous solves.
+  double pressure_cycles = 0.0, predictor_cycles = 0.0, viscous_cycles = 0.0;
   std::vector<HistoryRow> history;
   std::vector<SliceCell> slice;
 };
@@ -247,8 +250,16 @@ RunResult run(const std::string& name, int min_level, int max_level, double zeta
   const auto start = std::chrono::steady_clock::now();
   double cell_sum = 0.0;
   for (int s = 1; s <= kSteps; ++s) {
-    if (adaptive && s > 1 && (s - 1) % kRegridEvery == 0) regrid();
-    ns.step(kStep);
+    if (adaptive && s > 1 && (s - 1) % kRegridEvery == 0) {
+      const auto regrid_start = std::chrono::steady_clock::now();
+      regrid();
+      r.regrid_seconds +=
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - regrid_start).count();
+    }
+    const StepReport report = ns.step(kStep);
+    r.pressure_cycles += report.pressure_cycles / double(kSteps);
+    r.predictor_cycles += report.predictor_cycles / double(kSteps);
+    r.viscous_cycles += report.viscous_cycles / double(kSteps);
     const double cells = forest.global_blocks() * b3;
     cell_sum += cells;
     r.cells_max = std::max(r.cells_max, cells);
@@ -344,7 +355,8 @@ int main(int argc, char** argv) {
       std::printf(", step %d: max %.3e RMS %.3e", kCompareSteps[n], r.comparisons[n].max,
                   r.comparisons[n].rms);
     }
-    std::printf("\n");
+    std::printf(", V-cycles per step %.2f + %.2f + %.2f, regrid %.1f s\n", r.pressure_cycles,
+                r.predictor_cycles, r.viscous_cycles, r.regrid_seconds);
     std::fflush(stdout);
   }
   const auto mode = uniform ? std::ios::trunc : std::ios::app;
@@ -357,7 +369,8 @@ int main(int argc, char** argv) {
   slice.precision(8);
   if (header) {
     csv << "run,zeta,cells_mean,cells_max,cells_end,cells_uniform_finest,max_mid,rms_mid,max_end,"
-           "rms_end,max_divergence,steps,seconds,threads\n";
+           "rms_end,max_divergence,steps,seconds,threads,regrid_seconds,pressure_cycles,predictor_"
+           "cycles,viscous_cycles\n";
     history << "run,time,kinetic_energy,cells\n";
     slice << "run,x,y,h,difference\n";
   }
@@ -372,7 +385,9 @@ int main(int argc, char** argv) {
         csv << ',' << r.comparisons[n].max << ',' << r.comparisons[n].rms;
       }
     }
-    csv << ',' << r.max_divergence << ',' << kSteps << ',' << r.seconds << ',' << threads << '\n';
+    csv << ',' << r.max_divergence << ',' << kSteps << ',' << r.seconds << ',' << threads << ','
+        << r.regrid_seconds << ',' << r.pressure_cycles << ',' << r.predictor_cycles << ','
+        << r.viscous_cycles << '\n';
     for (const HistoryRow& h : r.history)
       history << r.name << ',' << h.time << ',' << h.energy << ',' << h.cells << '\n';
     for (const SliceCell& c : r.slice)
