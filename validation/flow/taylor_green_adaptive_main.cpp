@@ -42,6 +42,7 @@
 #include "flow/adapt_criterion.hpp"
 #include "flow/mpi_session.hpp"
 #include "flow/navier_stokes.hpp"
+#include "periodic_box.hpp"
 
 using namespace sanguis;
 using namespace sanguis::flow;
@@ -210,35 +211,14 @@ struct RunResult {
 /// `references`; the others are compared with them.
 RunResult run(const std::string& name, int min_level, int max_level, double zeta, int threads,
               std::vector<Snapshot>& references, const std::filesystem::path& out_dir) {
-  ForestSpec spec;
-  spec.trees = {4, 4, 4};
-  spec.tree_length = 0.25;
-  spec.periodic = {true, true, true};
-  spec.level = min_level;
-  spec.block_cells = 8;
-  spec.threads = threads;
-  Forest forest(spec);
-  NavierStokesOptions options;
-  options.pressure.tolerance = 1e-8;
-  options.viscous.tolerance = 1e-8;
-  std::array<FlowBoundary, 6> bcs{};
-  for (auto& bc : bcs) bc.kind = FlowBoundaryKind::Periodic;
-  NavierStokes ns(forest, bcs, Fluid{1.0, kViscosity}, options);
+  Forest forest(validation::periodic_box({4, 4, 4}, min_level, threads));
+  NavierStokes ns(forest, validation::periodic_boundaries(), Fluid{1.0, kViscosity},
+                  validation::tight_solves());
   ns.set_velocity(initial_velocity);
   const bool adaptive = max_level > min_level;
   const bool reference = !adaptive && min_level == kFinestLevel;
   const WaveletCriterion criterion{{zeta, zeta, zeta}, min_level, max_level};
-  auto regrid = [&]() {
-    BlockField* velocity[] = {&ns.velocity()[0], &ns.velocity()[1], &ns.velocity()[2]};
-    return ns.regrid(forest, wavelet_flags(forest, velocity, criterion), {}, max_level);
-  };
-  if (adaptive) {
-    // The initial grid: refine where the exact initial field needs it.
-    for (int pass = 0; pass <= max_level - min_level; ++pass) {
-      regrid();
-      ns.set_velocity(initial_velocity);
-    }
-  }
+  if (adaptive) validation::initial_grid(ns, forest, criterion, initial_velocity);
   const double b3 = std::pow(forest.block_cells(), 3);
   RunResult r;
   r.name = name;
@@ -252,7 +232,7 @@ RunResult run(const std::string& name, int min_level, int max_level, double zeta
   for (int s = 1; s <= kSteps; ++s) {
     if (adaptive && s > 1 && (s - 1) % kRegridEvery == 0) {
       const auto regrid_start = std::chrono::steady_clock::now();
-      regrid();
+      validation::regrid_on_velocity(ns, forest, criterion);
       r.regrid_seconds +=
           std::chrono::duration<double>(std::chrono::steady_clock::now() - regrid_start).count();
     }

@@ -46,6 +46,7 @@
 #include "flow/adapt_criterion.hpp"
 #include "flow/mpi_session.hpp"
 #include "flow/navier_stokes.hpp"
+#include "periodic_box.hpp"
 
 using namespace sanguis;
 using namespace sanguis::flow;
@@ -130,20 +131,9 @@ Vec3 centre_of(const Block& block, int b, int i, int j, int k) {
 
 /// One run: uniform at `min_level` when min_level == max_level, else adaptive.
 RunResult run(const std::string& name, int min_level, int max_level, double zeta, int threads) {
-  ForestSpec spec;
-  spec.trees = {4, 4, g_tilted ? 4 : 1};
-  spec.tree_length = 0.25;
-  spec.periodic = {true, true, true};
-  spec.level = min_level;
-  spec.block_cells = 8;
-  spec.threads = threads;
-  Forest forest(spec);
-  NavierStokesOptions options;
-  options.pressure.tolerance = 1e-8;
-  options.viscous.tolerance = 1e-8;
-  std::array<FlowBoundary, 6> bcs{};
-  for (auto& bc : bcs) bc.kind = FlowBoundaryKind::Periodic;
-  NavierStokes ns(forest, bcs, Fluid{1.0, 0.0}, options);
+  Forest forest(validation::periodic_box({4, 4, g_tilted ? 4 : 1}, min_level, threads));
+  NavierStokes ns(forest, validation::periodic_boundaries(), Fluid{1.0, 0.0},
+                  validation::tight_solves());
   const auto initial = [](const Vec3& x) { return exact(x, 0.0); };
   ns.set_velocity(initial);
   BlockField tracer(forest.local_blocks(), forest.block_cells());
@@ -158,20 +148,7 @@ RunResult run(const std::string& name, int min_level, int max_level, double zeta
   };
   const bool adaptive = max_level > min_level;
   const WaveletCriterion criterion{{zeta, zeta, zeta}, min_level, max_level};
-  auto regrid = [&](bool with_tracer) {
-    BlockField* velocity[] = {&ns.velocity()[0], &ns.velocity()[1], &ns.velocity()[2]};
-    const auto flags = wavelet_flags(forest, velocity, criterion);
-    BlockField* scalars[] = {&tracer};
-    return ns.regrid(forest, flags, with_tracer ? scalars : std::span<BlockField* const>{},
-                     max_level);
-  };
-  if (adaptive) {
-    // The initial grid: refine where the exact initial field needs it.
-    for (int pass = 0; pass <= max_level - min_level; ++pass) {
-      regrid(false);
-      ns.set_velocity(initial);
-    }
-  }
+  if (adaptive) validation::initial_grid(ns, forest, criterion, initial);
   fill_tracer();
   const double mass0 = total(forest, tracer);
   const double b3 = std::pow(forest.block_cells(), 3);
@@ -183,7 +160,10 @@ RunResult run(const std::string& name, int min_level, int max_level, double zeta
   const auto start = std::chrono::steady_clock::now();
   double cell_sum = 0.0;
   for (int s = 0; s < steps; ++s) {
-    if (adaptive && s > 0 && s % 2 == 0) regrid(true);
+    if (adaptive && s > 0 && s % 2 == 0) {
+      BlockField* scalars[] = {&tracer};
+      validation::regrid_on_velocity(ns, forest, criterion, scalars);
+    }
     const double step = std::min(dt, kEnd - ns.time());
     ns.step(step);
     ns.advect_scalar(tracer, step);
