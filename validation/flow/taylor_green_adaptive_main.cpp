@@ -18,10 +18,10 @@
 // differ.
 //
 // The uniform 128^3 run is the reference: its cell velocities at t = 0.75
-// and 1.5 s are kept (OUTDIR/reference_t*.bin, raw doubles, component-major,
-// x fastest) and every other run is compared, cell by cell, with the
-// reference's mean over each of its cells. With --uniform no, the uniform
-// runs are skipped and the reference is read back from those files.
+// and 1.5 s are kept (OUTDIR/reference_step120.bin and reference_step240.bin, raw doubles,
+// component-major, x fastest) and every other run is compared, cell by cell, with the reference's
+// mean over each of its cells. With --uniform no, the uniform runs are skipped and the reference is
+// read back from those files.
 //
 // Writes OUTDIR/taylor_green_adaptive.csv (one row per run: cells, cell
 // differences against the reference, wall time), OUTDIR/taylor_green_history.csv
