@@ -1,4 +1,4 @@
-"""Shared by the flow validation scripts: reading our .vtu frames, cell boxes,
+"""Shared by the flow validation scripts: reading our .vtu frames and CSV files, cell boxes,
 centre-line profiles, running variants of a case file."""
 import base64
 import csv
@@ -70,10 +70,15 @@ def last_frame(runs, name):
     return frames[-1]
 
 
+def read_text_rows(path):
+    """The rows of a CSV file with a header, as dicts of strings."""
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
 def read_rows(path):
     """The rows of a diagnostics.csv, every value as a float."""
-    with open(path, newline="") as f:
-        return [{k: float(v) for k, v in r.items()} for r in csv.DictReader(f)]
+    return [{k: float(v) for k, v in r.items()} for r in read_text_rows(path)]
 
 
 def draw_speed_and_blocks(fig, ax, lo, hi, speed, block, label, fraction, linewidth):

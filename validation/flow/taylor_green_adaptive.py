@@ -32,7 +32,6 @@ Usage: /usr/bin/python3 validation/flow/taylor_green_adaptive.py [--build build]
            [--replot]
 """
 import argparse
-import csv
 import json
 import subprocess
 import sys
@@ -40,6 +39,9 @@ import time
 from pathlib import Path
 
 import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _cavity_common import read_text_rows as read_rows  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 RESULTS = ROOT / "validation" / "flow" / "results"
@@ -49,11 +51,6 @@ REFERENCE = "uniform 128^3"
 CHECKED = "adaptive zeta 0.01"
 CELL_TOLERANCE = 1e-2  # u0
 ENERGY_TOLERANCE = 5e-3  # relative
-
-
-def read_rows(path):
-    with open(path, newline="") as f:
-        return list(csv.DictReader(f))
 
 
 def main():

@@ -43,7 +43,6 @@ Usage: /usr/bin/python3 validation/flow/vortex_adaptive.py [--build build] [--th
            [--tilted] [--replot]
 """
 import argparse
-import csv
 import json
 import subprocess
 import sys
@@ -51,6 +50,9 @@ import time
 from pathlib import Path
 
 import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _cavity_common import read_text_rows as read_rows  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 RESULTS = ROOT / "validation" / "flow" / "results"
@@ -76,11 +78,6 @@ def exact_v(x, tilted=False):
     across = r - np.outer(r @ axis, axis)
     g = amplitude / SIGMA**2 * np.exp(-(across * across).sum(axis=1) / (2 * SIGMA**2))
     return g * np.cross(axis, across)[:, 1]
-
-
-def read_rows(path):
-    with open(path, newline="") as f:
-        return list(csv.DictReader(f))
 
 
 def main():
