@@ -545,7 +545,7 @@ void Forest::exchange_scoped(std::span<BlockField* const> fields, int width, boo
           const int nonzero = (ox != 0) + (oy != 0) + (oz != 0);
           if (nonzero == 0 || (faces_only && nonzero > 1)) continue;
           if (finer_face >= 0 && (nonzero != 1 || offset_face(ox, oy, oz) != finer_face)) continue;
-          const Neighbour nb =
+          const Neighbour& nb =
               block.neighbours[static_cast<std::size_t>(neighbour_slot(ox, oy, oz))];
           if (nb.link == Link::Boundary) continue;
           if (finer_face >= 0 && nb.jump != LevelJump::Finer) continue;

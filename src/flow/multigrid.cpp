@@ -260,6 +260,14 @@ Multigrid::Multigrid(const Forest& forest, const std::array<BcKind, 6>& kinds)
     levels_.push_back(std::move(level));
   }
   shifted_rhs_ = BlockField(n, forest.block_cells());
+  if (composite_) {
+    interface_blocks_ = forest.blocks_beside_finer();
+    interface_blocks_.insert(interface_blocks_.end(), forest.blocks_beside_coarser().begin(),
+                             forest.blocks_beside_coarser().end());
+    std::sort(interface_blocks_.begin(), interface_blocks_.end());
+    interface_blocks_.erase(std::unique(interface_blocks_.begin(), interface_blocks_.end()),
+                            interface_blocks_.end());
+  }
   set_coefficients(nullptr, nullptr);
 }
 
@@ -566,12 +574,72 @@ void Multigrid::fill_block_ghosts(int blk, BlockField& x, const ScalarBoundary* 
   }
 }
 
-void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc,
-                       int sweeps) {
+void Multigrid::relax_block(int level, int blk, BlockField& x, const BlockField& rhs,
+                            const ScalarBoundary* bc, int colour) const {
   const Level& lv = levels_[D(level)];
   const BlockLayout L = x.layout();
   const int b = L.cells;
   const std::array<std::ptrdiff_t, 3> s{L.stride(0), L.stride(1), L.stride(2)};
+  const Block& block = forest_.block(blk);
+  const double h = block.length / b;
+  const double inv_h2 = 1.0 / (h * h);
+  const auto parity = static_cast<int>((block.coord[0] + block.coord[1] + block.coord[2]) * b) & 1;
+  const BlockCoefficients k{lv.alpha.block(blk),
+                            {lv.beta[0].block(blk), lv.beta[1].block(blk), lv.beta[2].block(blk)}};
+  double* xb = x.block(blk);
+  const double* rb = rhs.block(blk);
+  // Dirichlet faces of this block with the quadratic closure (finest level):
+  // ghost = (8 g - 6 x0 + x1)/3 depends on x0 with weight -2.
+  std::array<bool, 6> dirichlet{}, matched{};
+  bool any = false;
+  if (composite_) {
+    // Coarse-fine faces seen from the coarse side: the ghost carries the
+    // matched fine flux, which moves with this cell through the fine
+    // ghosts interpolated from it (see kMatchedDiagonal below).
+    for (int d = 0; d < 3; ++d)
+      for (int side = 0; side < 2; ++side) {
+        std::array<int, 3> o{0, 0, 0};
+        o[D(d)] = side == 0 ? -1 : 1;
+        const bool on =
+            block.neighbours[D(neighbour_slot(o[0], o[1], o[2]))].jump == LevelJump::Finer;
+        matched[D(face_index(d, side))] = on;
+        any = any || on;
+      }
+  }
+  if (bc != nullptr) {
+    for (int d = 0; d < 3; ++d)
+      for (int side = 0; side < 2; ++side) {
+        std::array<int, 3> o{0, 0, 0};
+        o[D(d)] = side == 0 ? -1 : 1;
+        const bool on =
+            block.neighbours[D(neighbour_slot(o[0], o[1], o[2]))].link == Link::Boundary &&
+            kinds_[D(face_index(d, side))] == BcKind::Dirichlet;
+        dirichlet[D(face_index(d, side))] = on;
+        any = any || on;
+      }
+  }
+  const auto at = static_cast<std::size_t>(blk);
+  if (constant_kernels_ && lv.block_constant[at]) {
+    relax_constant(xb, rb, L, (parity + colour) & 1, lv.block_alpha[at], lv.block_beta[at], inv_h2,
+                   omega_, dirichlet, matched);
+    return;
+  }
+  for (int kk = 0; kk < b; ++kk)
+    for (int j = 0; j < b; ++j)
+      for (int i = ((kk + j + parity + colour) & 1); i < b; i += 2) {
+        const std::ptrdiff_t c = L.index(i, j, kk);
+        const double implicit =
+            any ? closure_implicit(
+                      {i, j, kk}, b, dirichlet, matched, [&](int d) { return k.beta[D(d)][c]; },
+                      [&](int d) { return k.beta[D(d)][c + s[D(d)]]; })
+                : 0.0;
+        xb[c] += omega_ * (relaxed_value(xb, rb[c], k, c, s, inv_h2, implicit) - xb[c]);
+      }
+}
+
+void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc,
+                       int sweeps, const std::vector<std::int32_t>* only) {
+  const int b = x.layout().cells;
   // With an even b (the colours match across periodic faces) each block fills
   // its face ghosts towards same-level blocks of this rank and its boundary
   // ghosts right before it relaxes, while its cells are in cache, instead of
@@ -587,65 +655,9 @@ void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const Sc
       } else {
         fill_ghosts(level, x, bc, true);  // the 7-point stencil reads face ghosts only
       }
-      const auto relax_block = [&](int blk) {
+      const auto relax = [&](int blk) {
         if (fused) fill_block_ghosts(blk, x, bc, 1 - colour);
-        const Block& block = forest_.block(blk);
-        const double h = block.length / b;
-        const double inv_h2 = 1.0 / (h * h);
-        const auto parity =
-            static_cast<int>((block.coord[0] + block.coord[1] + block.coord[2]) * b) & 1;
-        const BlockCoefficients k{
-            lv.alpha.block(blk),
-            {lv.beta[0].block(blk), lv.beta[1].block(blk), lv.beta[2].block(blk)}};
-        double* xb = x.block(blk);
-        const double* rb = rhs.block(blk);
-        // Dirichlet faces of this block with the quadratic closure (finest level):
-        // ghost = (8 g - 6 x0 + x1)/3 depends on x0 with weight -2.
-        std::array<bool, 6> dirichlet{}, matched{};
-        bool any = false;
-        if (composite_) {
-          // Coarse-fine faces seen from the coarse side: the ghost carries the
-          // matched fine flux, which moves with this cell through the fine
-          // ghosts interpolated from it (see kMatchedDiagonal below).
-          for (int d = 0; d < 3; ++d)
-            for (int side = 0; side < 2; ++side) {
-              std::array<int, 3> o{0, 0, 0};
-              o[D(d)] = side == 0 ? -1 : 1;
-              const bool on =
-                  block.neighbours[D(neighbour_slot(o[0], o[1], o[2]))].jump == LevelJump::Finer;
-              matched[D(face_index(d, side))] = on;
-              any = any || on;
-            }
-        }
-        if (bc != nullptr) {
-          for (int d = 0; d < 3; ++d)
-            for (int side = 0; side < 2; ++side) {
-              std::array<int, 3> o{0, 0, 0};
-              o[D(d)] = side == 0 ? -1 : 1;
-              const bool on =
-                  block.neighbours[D(neighbour_slot(o[0], o[1], o[2]))].link == Link::Boundary &&
-                  kinds_[D(face_index(d, side))] == BcKind::Dirichlet;
-              dirichlet[D(face_index(d, side))] = on;
-              any = any || on;
-            }
-        }
-        const auto at = static_cast<std::size_t>(blk);
-        if (constant_kernels_ && lv.block_constant[at]) {
-          relax_constant(xb, rb, L, (parity + colour) & 1, lv.block_alpha[at], lv.block_beta[at],
-                         inv_h2, omega_, dirichlet, matched);
-          return;
-        }
-        for (int kk = 0; kk < b; ++kk)
-          for (int j = 0; j < b; ++j)
-            for (int i = ((kk + j + parity + colour) & 1); i < b; i += 2) {
-              const std::ptrdiff_t c = L.index(i, j, kk);
-              const double implicit = any ? closure_implicit(
-                                                {i, j, kk}, b, dirichlet, matched,
-                                                [&](int d) { return k.beta[D(d)][c]; },
-                                                [&](int d) { return k.beta[D(d)][c + s[D(d)]]; })
-                                          : 0.0;
-              xb[c] += omega_ * (relaxed_value(xb, rb[c], k, c, s, inv_h2, implicit) - xb[c]);
-            }
+        relax_block(level, blk, x, rhs, bc, colour);
       };
       // In a half-sweep each block writes only its own cells and ghosts, and
       // reads other blocks only through ghosts copied from cells of the
@@ -653,10 +665,12 @@ void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const Sc
       // colour runs backwards over each thread's blocks and starts on those
       // the first one left in cache (what a grid larger than the cache
       // saves), with the same bits.
-      if (colour == 0) {
-        forest_.for_each_block(relax_block);
+      if (only != nullptr) {
+        forest_.for_each_listed(*only, relax);
+      } else if (colour == 0) {
+        forest_.for_each_block(relax);
       } else {
-        forest_.for_each_block_backward(relax_block);
+        forest_.for_each_block_backward(relax);
       }
     }
   }
@@ -756,6 +770,8 @@ void Multigrid::vcycle(int level, BlockField& x, const BlockField& rhs, const Sc
     return;
   }
   smooth(level, x, rhs, bc, pre_sweeps_);
+  if (composite_ && interface_sweeps_ > 0)
+    smooth(level, x, rhs, bc, interface_sweeps_, &interface_blocks_);
   Level& fine = levels_[D(level)];
   Level& coarse = levels_[D(level + 1)];
   compute_residual(level, x, rhs, bc, fine.res, false);  // restricted, no norm
@@ -791,6 +807,8 @@ void Multigrid::vcycle(int level, BlockField& x, const BlockField& rhs, const Sc
           if (weight > 0.0) x(blk, i, j, k) += value / weight;
         }
   });
+  if (composite_ && interface_sweeps_ > 0)
+    smooth(level, x, rhs, bc, interface_sweeps_, &interface_blocks_);
   smooth(level, x, rhs, bc, post_sweeps_);
 }
 
@@ -867,6 +885,7 @@ void Multigrid::take_options(const MultigridOptions& options) {
   post_sweeps_ = options.post_sweeps;
   omega_ = options.relaxation;
   constant_kernels_ = options.constant_coefficient_kernels;
+  interface_sweeps_ = options.interface_sweeps;
 }
 
 void Multigrid::relax(BlockField& x, const BlockField& rhs, const ScalarBoundary& bc, int sweeps,

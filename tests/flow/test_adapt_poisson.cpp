@@ -116,7 +116,8 @@ TEST(AdaptPoisson, HelmholtzWithVariableCoefficientOnTheRefinedOctant) {
 
 /// Periodic Poisson on 4^3 blocks of 8^3 cells with the level-2 blocks at
 /// `refined` refined once: V-cycles and reduction per cycle.
-MultigridReport solve_with_refined_blocks(const std::vector<std::array<std::int64_t, 3>>& refined) {
+MultigridReport solve_with_refined_blocks(const std::vector<std::array<std::int64_t, 3>>& refined,
+                                          int interface_sweeps = 0) {
   ForestSpec spec;
   spec.level = 2;
   spec.periodic = {true, true, true};
@@ -135,10 +136,13 @@ MultigridReport solve_with_refined_blocks(const std::vector<std::array<std::int6
   BlockField x(forest.local_blocks(), forest.block_cells());
   MultigridOptions options;
   options.tolerance = 1e-10;
+  options.interface_sweeps = interface_sweeps;
   const auto r = mg.solve(x, testing::sample(forest, testing::periodic_source), bc, options);
-  std::printf("  %zu blocks refined: %d V-cycles, %.1fx per cycle, max error %.3e\n",
-              refined.size(), r.cycles, r.mean_reduction(),
-              testing::max_error(forest, x, testing::periodic_exact));
+  std::printf(
+      "  %zu blocks refined, %d interface sweep(s): %d V-cycles, %.1fx per cycle, max "
+      "error %.3e\n",
+      refined.size(), interface_sweeps, r.cycles, r.mean_reduction(),
+      testing::max_error(forest, x, testing::periodic_exact));
   return r;
 }
 
@@ -160,6 +164,43 @@ TEST(AdaptPoisson, ConcaveRefinedRegionsConvergeAsFast) {
   // Measured 8.9x: below the 10x target (issue #7, open); this bound only
   // guards against a regression towards the diverging relaxation.
   EXPECT_GT(corner.mean_reduction(), 8.0);
+}
+
+/// The blocks of a level-2 forest (4^3 blocks) that a fixed hash picks, 4 in
+/// 10 of them: refined regions of every shape, most blocks beside a
+/// coarse-fine face.
+std::vector<std::array<std::int64_t, 3>> scattered_blocks() {
+  std::vector<std::array<std::int64_t, 3>> picked;
+  for (std::int64_t k = 0; k < 4; ++k)
+    for (std::int64_t j = 0; j < 4; ++j)
+      for (std::int64_t i = 0; i < 4; ++i)
+        if (((i * 73856093) ^ (j * 19349663) ^ (k * 83492791)) % 10 < 4)
+          picked.push_back({i, j, k});
+  return picked;
+}
+
+TEST(AdaptPoisson, ExtraSweepsBesideCoarseFineFacesConvergeFaster) {
+  // Issue #7 asks the composite V-cycle to converge as fast per cycle as the
+  // uniform one (16.1x per cycle on this problem asymptotically, 15.2x mean).
+  // It does not yet:
+  // measured 8.9x on the concave corner and 7.8x on the scattered refinement
+  // (22 of the 64 blocks).
+  // One extra sweep on the blocks beside coarse-fine faces
+  // (MultigridOptions::interface_sweeps) recovers part of it: 11.4x and 12.0x (10 V-cycles instead
+  // of 11 and 12), at the cost of that sweep.
+  const auto scattered = scattered_blocks();
+  ASSERT_GE(scattered.size(), 16u);
+  const std::vector<std::array<std::int64_t, 3>> corner{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 0},
+                                                        {1, 0, 1}, {0, 1, 1}, {1, 1, 1}};
+  std::printf("extra sweeps beside coarse-fine faces, periodic Poisson, V(2,2):\n");
+  for (const auto& refined : {corner, scattered}) {
+    const auto plain = solve_with_refined_blocks(refined, 0);
+    const auto extra = solve_with_refined_blocks(refined, 1);
+    ASSERT_TRUE(plain.converged);
+    ASSERT_TRUE(extra.converged);
+    EXPECT_LE(extra.cycles, plain.cycles);
+    EXPECT_GT(extra.mean_reduction(), 1.15 * plain.mean_reduction());
+  }
 }
 
 TEST(AdaptPoisson, TwoThreadsGiveTheOneThreadAnswerBitForBit) {
