@@ -254,7 +254,9 @@ Multigrid::Multigrid(const Forest& forest, const std::array<BcKind, 6>& kinds)
     level.alpha = BlockField(n, b, ghost);
     level.beta = make_vector_field(n, b, ghost);
     level.active = BlockField(n, b, ghost);
-    if (composite_ && b >= 2) {
+    // Across ranks the fine fluxes of match_fluxes() travel in these; one
+    // process reads them in place (match_fluxes_local) and needs none.
+    if (composite_ && b >= 2 && forest.ranks() > 1) {
       for (BlockField& flux : level.face_flux) flux = BlockField(n, b, ghost);
     }
     levels_.push_back(std::move(level));

@@ -129,7 +129,8 @@ class Multigrid {
     BlockField x, rhs, res, alpha;
     FaceField beta;
     BlockField active;  ///< 1 where the cell takes part (some open face or alpha > 0), else 0
-    std::array<BlockField, 6> face_flux;  ///< composite grids: fine-side fluxes by face
+    /// Composite grids on several ranks: fine-side fluxes by face.
+    std::array<BlockField, 6> face_flux;
     /// Per local block: 1 where alpha (>= 0) and beta (> 0) are each one value
     /// on the block's cells and faces 0..b and every cell is active; the values.
     std::vector<unsigned char> block_constant;

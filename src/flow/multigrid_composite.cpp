@@ -32,7 +32,7 @@ constexpr std::size_t D(int d) {
 // value x + h G / beta that yields that flux through the coarse stencil.
 void Multigrid::match_fluxes(int level, BlockField& x) {
   Level& lv = levels_[D(level)];
-  if (lv.face_flux[0].blocks() == 0) return;  // one cell per block: the gathered bottom level
+  if (lv.cells < 2) return;  // one cell per block: the gathered bottom level
   if (forest_.ranks() == 1) {
     match_fluxes_local(level, x);
     return;
