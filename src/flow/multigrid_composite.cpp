@@ -17,6 +17,20 @@ constexpr std::size_t D(int d) {
   return static_cast<std::size_t>(d);
 }
 
+/// body(blk, nb, d, side) for each face (d, side) of each local block with
+/// finer blocks across it (nb: that neighbour), on the forest's threads.
+template <typename Body>
+void for_each_face_to_finer(const Forest& forest, Body&& body) {
+  forest.for_each_listed(forest.blocks_beside_finer(), [&](int blk) {
+    const Block& block = forest.block(blk);
+    for (int d = 0; d < 3; ++d)
+      for (int side = 0; side < 2; ++side) {
+        const Neighbour& nb = block.neighbours[face_neighbour_slot(d, side)];
+        if (nb.jump == LevelJump::Finer) body(blk, nb, d, side);
+      }
+  });
+}
+
 }  // namespace
 
 // Flux matching at coarse-fine faces. A cell's residual is
@@ -65,22 +79,17 @@ void Multigrid::match_fluxes(int level, BlockField& x) {
     for (int side = 0; side < 2; ++side) {
       forest_.exchange_from_finer(lv.face_flux[D(face_index(d, side))], face_index(d, 1 - side));
     }
-  forest_.for_each_listed(forest_.blocks_beside_finer(), [&](int blk) {
-    const Block& block = forest_.block(blk);
-    const double h = block.length / b;
+  for_each_face_to_finer(forest_, [&](int blk, const Neighbour&, int d, int side) {
+    const double h = forest_.block(blk).length / b;
     double* xb = x.block(blk);
-    for (int d = 0; d < 3; ++d)
-      for (int side = 0; side < 2; ++side) {
-        if (block.neighbours[face_neighbour_slot(d, side)].jump != LevelJump::Finer) continue;
-        // The fine blocks stored their fluxes under their own face: the opposite one.
-        const double* fine = lv.face_flux[D(face_index(d, 1 - side))].block(blk);
-        const double* beta = lv.beta[D(d)].block(blk);
-        for_face_cells(L, d, side, [&](std::ptrdiff_t c, std::ptrdiff_t g) {
-          const double beta_face = side == 0 ? beta[c] : beta[g];
-          const double fine_flux = -2.0 * fine[g];
-          if (beta_face > 0.0) xb[g] = xb[c] + h * fine_flux / beta_face;
-        });
-      }
+    // The fine blocks stored their fluxes under their own face: the opposite one.
+    const double* fine = lv.face_flux[D(face_index(d, 1 - side))].block(blk);
+    const double* beta = lv.beta[D(d)].block(blk);
+    for_face_cells(L, d, side, [&](std::ptrdiff_t c, std::ptrdiff_t g) {
+      const double beta_face = side == 0 ? beta[c] : beta[g];
+      const double fine_flux = -2.0 * fine[g];
+      if (beta_face > 0.0) xb[g] = xb[c] + h * fine_flux / beta_face;
+    });
   });
 }
 
@@ -96,74 +105,68 @@ void Multigrid::match_fluxes_local(int level, BlockField& x) {
   Level& lv = levels_[D(level)];
   const BlockLayout L = x.layout();
   const int b = L.cells;
-  forest_.for_each_listed(forest_.blocks_beside_finer(), [&](int blk) {
-    const Block& block = forest_.block(blk);
-    const double h = block.length / b;
+  for_each_face_to_finer(forest_, [&](int blk, const Neighbour& nb, int d, int side) {
+    const double h = forest_.block(blk).length / b;
     double* xb = x.block(blk);
-    for (int d = 0; d < 3; ++d)
-      for (int side = 0; side < 2; ++side) {
-        const Neighbour& nb = block.neighbours[face_neighbour_slot(d, side)];
-        if (nb.jump != LevelJump::Finer) continue;
-        const double* beta = lv.beta[D(d)].block(blk);
-        // The fine cells of the face layer: index 0 along d in the children
-        // above an upper face, b - 1 in those below a lower one; their ghost
-        // towards this block one step further; their face coefficient on the
-        // face they share with this block.
-        const int layer_bit = side == 0 ? 1 : 0;
-        const int fine_layer = side == 0 ? b - 1 : 0;
-        const std::ptrdiff_t towards = side == 0 ? L.stride(d) : -L.stride(d);
-        const std::ptrdiff_t beta_shift = side == 0 ? L.stride(d) : 0;
-        // The fine fluxes of the 4 children, by fine cell along the face's
-        // lower (lo) and higher (hi) tangential axis.
-        const int lo = d == 0 ? 1 : 0, hi = d == 2 ? 1 : 2;
-        const int w = 2 * b;
-        thread_local std::vector<double> fine_flux;
-        fine_flux.resize(static_cast<std::size_t>(w) * w);
-        for (int c_hi = 0; c_hi < 2; ++c_hi)
-          for (int c_lo = 0; c_lo < 2; ++c_lo) {
-            const int child = (layer_bit << d) | (c_lo << lo) | (c_hi << hi);
-            const int fine_blk = nb.children[D(child)].index;
-            const double* xf = x.block(fine_blk);
-            const double* beta_f = lv.beta[D(d)].block(fine_blk);
-            const double h_f = forest_.block(fine_blk).length / b;
-            // A constant-coefficient block's beta is one value: the same
-            // number, without a pass over its face array.
-            const bool constant = lv.block_constant[D(fine_blk)] != 0;
-            const double beta_constant = lv.block_beta[D(fine_blk)];
-            for (int q = 0; q < b; ++q)
-              for (int p = 0; p < b; ++p) {
-                std::array<int, 3> n{};
-                n[D(d)] = fine_layer;
-                n[D(lo)] = p;
-                n[D(hi)] = q;
-                const std::ptrdiff_t f = L.index(n[0], n[1], n[2]);
-                const double beta_face = constant ? beta_constant : beta_f[f + beta_shift];
-                fine_flux[D((c_hi * b + q) * w + c_lo * b + p)] =
-                    beta_face * (xf[f + towards] - xf[f]) / h_f;
-              }
-          }
+    const double* beta = lv.beta[D(d)].block(blk);
+    // The fine cells of the face layer: index 0 along d in the children
+    // above an upper face, b - 1 in those below a lower one; their ghost
+    // towards this block one step further; their face coefficient on the
+    // face they share with this block.
+    const int layer_bit = side == 0 ? 1 : 0;
+    const int fine_layer = side == 0 ? b - 1 : 0;
+    const std::ptrdiff_t towards = side == 0 ? L.stride(d) : -L.stride(d);
+    const std::ptrdiff_t beta_shift = side == 0 ? L.stride(d) : 0;
+    // The fine fluxes of the 4 children, by fine cell along the face's
+    // lower (lo) and higher (hi) tangential axis.
+    const int lo = d == 0 ? 1 : 0, hi = d == 2 ? 1 : 2;
+    const int w = 2 * b;
+    thread_local std::vector<double> fine_flux;
+    fine_flux.resize(static_cast<std::size_t>(w) * w);
+    for (int c_hi = 0; c_hi < 2; ++c_hi)
+      for (int c_lo = 0; c_lo < 2; ++c_lo) {
+        const int child = (layer_bit << d) | (c_lo << lo) | (c_hi << hi);
+        const int fine_blk = nb.children[D(child)].index;
+        const double* xf = x.block(fine_blk);
+        const double* beta_f = lv.beta[D(d)].block(fine_blk);
+        const double h_f = forest_.block(fine_blk).length / b;
+        // A constant-coefficient block's beta is one value: the same
+        // number, without a pass over its face array.
+        const bool constant = lv.block_constant[D(fine_blk)] != 0;
+        const double beta_constant = lv.block_beta[D(fine_blk)];
         for (int q = 0; q < b; ++q)
           for (int p = 0; p < b; ++p) {
             std::array<int, 3> n{};
-            n[D(d)] = side == 0 ? 0 : b - 1;
+            n[D(d)] = fine_layer;
             n[D(lo)] = p;
             n[D(hi)] = q;
-            const std::ptrdiff_t c = L.index(n[0], n[1], n[2]);
-            const std::ptrdiff_t g = side == 0 ? c - L.stride(d) : c + L.stride(d);
-            // The exchange's order: the higher axis' offset outer, the lower's inner.
-            const double* row0 = fine_flux.data() + D(2 * q * w + 2 * p);
-            const double* row1 = row0 + w;
-            double sum = 0.0;
-            sum += row0[0];
-            sum += row0[1];
-            sum += row1[0];
-            sum += row1[1];
-            const double beta_face = lv.block_constant[D(blk)] != 0 ? lv.block_beta[D(blk)]
-                                     : side == 0                    ? beta[c]
-                                                                    : beta[g];
-            const double matched = -2.0 * (sum / 8.0);
-            if (beta_face > 0.0) xb[g] = xb[c] + h * matched / beta_face;
+            const std::ptrdiff_t f = L.index(n[0], n[1], n[2]);
+            const double beta_face = constant ? beta_constant : beta_f[f + beta_shift];
+            fine_flux[D((c_hi * b + q) * w + c_lo * b + p)] =
+                beta_face * (xf[f + towards] - xf[f]) / h_f;
           }
+      }
+    for (int q = 0; q < b; ++q)
+      for (int p = 0; p < b; ++p) {
+        std::array<int, 3> n{};
+        n[D(d)] = side == 0 ? 0 : b - 1;
+        n[D(lo)] = p;
+        n[D(hi)] = q;
+        const std::ptrdiff_t c = L.index(n[0], n[1], n[2]);
+        const std::ptrdiff_t g = side == 0 ? c - L.stride(d) : c + L.stride(d);
+        // The exchange's order: the higher axis' offset outer, the lower's inner.
+        const double* row0 = fine_flux.data() + D(2 * q * w + 2 * p);
+        const double* row1 = row0 + w;
+        double sum = 0.0;
+        sum += row0[0];
+        sum += row0[1];
+        sum += row1[0];
+        sum += row1[1];
+        const double beta_face = lv.block_constant[D(blk)] != 0 ? lv.block_beta[D(blk)]
+                                 : side == 0                    ? beta[c]
+                                                                : beta[g];
+        const double matched = -2.0 * (sum / 8.0);
+        if (beta_face > 0.0) xb[g] = xb[c] + h * matched / beta_face;
       }
   });
 }
