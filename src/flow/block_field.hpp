@@ -75,6 +75,14 @@ class BlockField {
   double operator()(int b, int i, int j, int k) const { return block(b)[layout_.index(i, j, k)]; }
 
   void fill(double value) { data_.assign(data_.size(), value); }
+  /// Every value zero on `blocks` blocks of the given layout, in the storage
+  /// the field already has when it is large enough (a regrid that reuses its
+  /// fields touches no fresh page; the storage never shrinks).
+  void reshape(int blocks, int cells_per_block, int ghost = kGhost) {
+    layout_ = {cells_per_block, ghost};
+    blocks_ = blocks;
+    data_.assign(static_cast<std::size_t>(blocks * layout_.size()), 0.0);
+  }
   [[nodiscard]] std::vector<double>& raw() { return data_; }
   [[nodiscard]] const std::vector<double>& raw() const { return data_; }
 
@@ -92,6 +100,11 @@ using FaceField = std::array<BlockField, 3>;
 inline VectorField make_vector_field(int blocks, int cells, int ghost = kGhost) {
   return {BlockField(blocks, cells, ghost), BlockField(blocks, cells, ghost),
           BlockField(blocks, cells, ghost)};
+}
+
+/// BlockField::reshape for the three components.
+inline void reshape(std::array<BlockField, 3>& field, int blocks, int cells, int ghost = kGhost) {
+  for (BlockField& component : field) component.reshape(blocks, cells, ghost);
 }
 
 }  // namespace sanguis::flow

@@ -231,7 +231,7 @@ double MultigridReport::mean_reduction() const {
 }
 
 Multigrid::Multigrid(const Forest& forest, const std::array<BcKind, 6>& kinds)
-    : forest_(forest), kinds_(kinds), composite_(!forest.uniform()) {
+    : forest_(forest), kinds_(kinds) {
   for (int d = 0; d < 3; ++d) {
     const bool periodic = forest.spec().periodic[D(d)];
     for (int side = 0; side < 2; ++side) {
@@ -241,31 +241,42 @@ Multigrid::Multigrid(const Forest& forest, const std::array<BcKind, 6>& kinds)
       }
     }
   }
-  const int n = forest.local_blocks();
-  for (int b = forest.block_cells(); b >= 1; b /= 2) {
+  rebuild();
+}
+
+void Multigrid::rebuild() {
+  composite_ = !forest_.uniform();
+  const int n = forest_.local_blocks();
+  std::size_t m = 0;
+  for (int b = forest_.block_cells(); b >= 1; b /= 2, ++m) {
+    if (levels_.size() == m) levels_.emplace_back();
     // The finest level shares the layout of the caller's fields; coarser
     // ones keep the one ghost layer their smoother and prolongation read.
-    const int ghost = b == forest.block_cells() ? kGhost : 1;
-    Level level;
+    const int ghost = b == forest_.block_cells() ? kGhost : 1;
+    Level& level = levels_[m];
     level.cells = b;
-    level.x = BlockField(n, b, ghost);
-    level.rhs = BlockField(n, b, ghost);
-    level.res = BlockField(n, b, ghost);
-    level.alpha = BlockField(n, b, ghost);
-    level.beta = make_vector_field(n, b, ghost);
-    level.active = BlockField(n, b, ghost);
+    level.x.reshape(n, b, ghost);
+    level.rhs.reshape(n, b, ghost);
+    level.res.reshape(n, b, ghost);
+    level.alpha.reshape(n, b, ghost);
+    reshape(level.beta, n, b, ghost);
+    level.active.reshape(n, b, ghost);
     // Across ranks the fine fluxes of match_fluxes() travel in these; one
     // process reads them in place (match_fluxes_local) and needs none.
-    if (composite_ && b >= 2 && forest.ranks() > 1) {
-      for (BlockField& flux : level.face_flux) flux = BlockField(n, b, ghost);
+    for (BlockField& flux : level.face_flux) {
+      if (composite_ && b >= 2 && forest_.ranks() > 1) {
+        flux.reshape(n, b, ghost);
+      } else {
+        flux = BlockField();
+      }
     }
-    levels_.push_back(std::move(level));
   }
-  shifted_rhs_ = BlockField(n, forest.block_cells());
+  shifted_rhs_.reshape(n, forest_.block_cells());
+  interface_blocks_.clear();
   if (composite_) {
-    interface_blocks_ = forest.blocks_beside_finer();
-    interface_blocks_.insert(interface_blocks_.end(), forest.blocks_beside_coarser().begin(),
-                             forest.blocks_beside_coarser().end());
+    interface_blocks_ = forest_.blocks_beside_finer();
+    interface_blocks_.insert(interface_blocks_.end(), forest_.blocks_beside_coarser().begin(),
+                             forest_.blocks_beside_coarser().end());
     std::sort(interface_blocks_.begin(), interface_blocks_.end());
     interface_blocks_.erase(std::unique(interface_blocks_.begin(), interface_blocks_.end()),
                             interface_blocks_.end());

@@ -33,8 +33,8 @@
 // coarse cells). On one process the coarse block reads the fine fluxes in
 // place; across ranks they travel through an exchange (the same bits). The bottom level (one cell
 // per block) is the graph of leaves, gathered on every rank and solved by CG with a two-point flux
-// between blocks of different size (distance 1.5 h_fine). A forest that adapts needs a new
-// Multigrid.
+// between blocks of different size (distance 1.5 h_fine). A forest that adapts needs a
+// rebuild() (or a new Multigrid).
 
 #include <array>
 #include <vector>
@@ -88,6 +88,11 @@ class Multigrid {
   /// kinds: the boundary condition kind on each domain face (periodic
   /// directions must say Periodic).
   Multigrid(const Forest& forest, const std::array<BcKind, 6>& kinds);
+
+  /// After the forest has changed (Forest::adapt): the levels for its new
+  /// blocks, in the storage of the old ones where it is large enough, and
+  /// the coefficients reset (alpha 0, beta 1), as a new Multigrid would have.
+  void rebuild();
 
   /// Coefficients of (1): alpha per cell (nullptr: 0) and beta per face
   /// (nullptr: 1), on the finest layout; beta must be valid on faces 0..b of
