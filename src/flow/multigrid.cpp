@@ -608,7 +608,7 @@ void Multigrid::relax_block(int level, int blk, BlockField& x, const BlockField&
   if (composite_) {
     // Coarse-fine faces seen from the coarse side: the ghost carries the
     // matched fine flux, which moves with this cell through the fine
-    // ghosts interpolated from it (see kMatchedDiagonal below).
+    // ghosts interpolated from it (see kMatchedDiagonal and closure_implicit).
     for (int d = 0; d < 3; ++d)
       for (int side = 0; side < 2; ++side) {
         std::array<int, 3> o{0, 0, 0};
