@@ -109,17 +109,26 @@ void Multigrid::match_fluxes_local(int level, BlockField& x) {
     const double h = forest_.block(blk).length / b;
     double* xb = x.block(blk);
     const double* beta = lv.beta[D(d)].block(blk);
-    // The fine cells of the face layer: index 0 along d in the children
-    // above an upper face, b - 1 in those below a lower one; their ghost
-    // towards this block one step further; their face coefficient on the
-    // face they share with this block.
-    const int layer_bit = side == 0 ? 1 : 0;
-    const int fine_layer = side == 0 ? b - 1 : 0;
-    const std::ptrdiff_t towards = side == 0 ? L.stride(d) : -L.stride(d);
-    const std::ptrdiff_t beta_shift = side == 0 ? L.stride(d) : 0;
-    // The fine fluxes of the 4 children, by fine cell along the face's
-    // lower (lo) and higher (hi) tangential axis.
+    // The face's cells by (p, q), p along its lower tangential axis (lo), q
+    // along the higher (hi). This block's face layer is 0 along d for a lower
+    // face, b - 1 for an upper one; its ghost lies one step outward. The
+    // fine children's layer is the opposite one, their ghost one step back
+    // towards this block; beta of a cell's lower face sits at the cell, of
+    // its upper face one step up.
     const int lo = d == 0 ? 1 : 0, hi = d == 2 ? 1 : 2;
+    const std::ptrdiff_t s_lo = L.stride(lo), s_hi = L.stride(hi);
+    const std::ptrdiff_t outward = side == 0 ? -L.stride(d) : L.stride(d);
+    const auto layer_start = [&](int layer) {
+      std::array<int, 3> n{};
+      n[D(d)] = layer;
+      return L.index(n[0], n[1], n[2]);
+    };
+    const std::ptrdiff_t coarse_start = layer_start(side == 0 ? 0 : b - 1);
+    const std::ptrdiff_t fine_start = layer_start(side == 0 ? b - 1 : 0);
+    const std::ptrdiff_t coarse_beta_shift = side == 0 ? 0 : L.stride(d);
+    const std::ptrdiff_t fine_beta_shift = side == 0 ? L.stride(d) : 0;
+    const int layer_bit = side == 0 ? 1 : 0;  // the children's bit along d
+    // The fine fluxes of the 4 children, by fine cell (2b per axis).
     const int w = 2 * b;
     thread_local std::vector<double> fine_flux;
     fine_flux.resize(static_cast<std::size_t>(w) * w);
@@ -128,32 +137,25 @@ void Multigrid::match_fluxes_local(int level, BlockField& x) {
         const int child = (layer_bit << d) | (c_lo << lo) | (c_hi << hi);
         const int fine_blk = nb.children[D(child)].index;
         const double* xf = x.block(fine_blk);
-        const double* beta_f = lv.beta[D(d)].block(fine_blk);
+        const double* beta_f = lv.beta[D(d)].block(fine_blk) + fine_beta_shift;
         const double h_f = forest_.block(fine_blk).length / b;
         // A constant-coefficient block's beta is one value: the same
         // number, without a pass over its face array.
         const bool constant = lv.block_constant[D(fine_blk)] != 0;
         const double beta_constant = lv.block_beta[D(fine_blk)];
-        for (int q = 0; q < b; ++q)
+        double* row = fine_flux.data() + D(c_hi * b * w + c_lo * b);
+        for (int q = 0; q < b; ++q, row += w)
           for (int p = 0; p < b; ++p) {
-            std::array<int, 3> n{};
-            n[D(d)] = fine_layer;
-            n[D(lo)] = p;
-            n[D(hi)] = q;
-            const std::ptrdiff_t f = L.index(n[0], n[1], n[2]);
-            const double beta_face = constant ? beta_constant : beta_f[f + beta_shift];
-            fine_flux[D((c_hi * b + q) * w + c_lo * b + p)] =
-                beta_face * (xf[f + towards] - xf[f]) / h_f;
+            const std::ptrdiff_t f = fine_start + p * s_lo + q * s_hi;
+            const double beta_face = constant ? beta_constant : beta_f[f];
+            row[p] = beta_face * (xf[f - outward] - xf[f]) / h_f;
           }
       }
+    const bool constant = lv.block_constant[D(blk)] != 0;
+    const double beta_constant = lv.block_beta[D(blk)];
     for (int q = 0; q < b; ++q)
       for (int p = 0; p < b; ++p) {
-        std::array<int, 3> n{};
-        n[D(d)] = side == 0 ? 0 : b - 1;
-        n[D(lo)] = p;
-        n[D(hi)] = q;
-        const std::ptrdiff_t c = L.index(n[0], n[1], n[2]);
-        const std::ptrdiff_t g = side == 0 ? c - L.stride(d) : c + L.stride(d);
+        const std::ptrdiff_t c = coarse_start + p * s_lo + q * s_hi;
         // The exchange's order: the higher axis' offset outer, the lower's inner.
         const double* row0 = fine_flux.data() + D(2 * q * w + 2 * p);
         const double* row1 = row0 + w;
@@ -162,11 +164,9 @@ void Multigrid::match_fluxes_local(int level, BlockField& x) {
         sum += row0[1];
         sum += row1[0];
         sum += row1[1];
-        const double beta_face = lv.block_constant[D(blk)] != 0 ? lv.block_beta[D(blk)]
-                                 : side == 0                    ? beta[c]
-                                                                : beta[g];
+        const double beta_face = constant ? beta_constant : beta[c + coarse_beta_shift];
         const double matched = -2.0 * (sum / 8.0);
-        if (beta_face > 0.0) xb[g] = xb[c] + h * matched / beta_face;
+        if (beta_face > 0.0) xb[c + outward] = xb[c] + h * matched / beta_face;
       }
   });
 }
