@@ -63,6 +63,24 @@ inline AxisWeights axis_weights(int fine, int coarse_cells) {
   return a;
 }
 
+/// The composite operator's fine ghost across a coarse-fine face (the
+/// multigrid's rule, Forest::exchange with CoarseGhosts::Composite):
+///   g = kGhostCoarse c + kGhostFace x_f + kGhostSecond x_f2,
+/// the quadratic along the face normal through c, the coarse layer beside the
+/// face interpolated across the face (quadratic, axis_weights) to the fine
+/// cell's line, at the coarse cell's centre (1.5 h_f beyond the fine cell
+/// x_f), and the two fine cells x_f, x_f2 inside, evaluated at the ghost's
+/// centre (h_f beyond x_f): Lagrange weights 8/15, 2/3, -1/5 on the nodes
+/// 1.5, 0, -1 (in h_f from x_f) at 1. Exact for quadratics, so the ghost error
+/// is O(h^3) and the flux error O(h^2), as for the interpolation from the
+/// coarse block alone above, whose weights along the normal (1.41, -0.56,
+/// 0.16: an extrapolation over three coarse cells) make the coarse cell's
+/// row far from an M-matrix and slowed the multigrid's smoother there
+/// (Johansen & Colella 1998 use fine cells the same way; docs/theory/flow.md).
+inline constexpr double kGhostCoarse = 8.0 / 15.0;
+inline constexpr double kGhostFace = 2.0 / 3.0;
+inline constexpr double kGhostSecond = -1.0 / 5.0;
+
 /// Value at the centre of the fine cell `fine` (per direction, fine cells
 /// counted from the coarse block's lower corner, each in [0, 2b)).
 inline double interpolate_from_coarse(const CellReader& coarse, int coarse_cells,

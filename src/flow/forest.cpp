@@ -386,6 +386,68 @@ void fill_from_coarser(const Block& block, const std::array<int, 3>& o,
   }
 }
 
+/// The ghosts of a fine block across the face towards offset o (one nonzero
+/// component, along d) from the coarser neighbour there, by the composite
+/// operator's rule (CoarseGhosts::Composite): the first layer
+/// kGhostCoarse c + kGhostFace x_f + kGhostSecond x_f2, c the coarse layer
+/// beside the face interpolated across it (the tensor-product weights of
+/// fill_from_coarser with, along d, the coarse cell that holds the ghost: its
+/// centre, not the ghost's); deeper layers as fill_from_coarser.
+void fill_composite_face_ghosts(const Block& block, const std::array<int, 3>& o,
+                                const std::array<Range, 3>& r, const CellReader& coarse,
+                                BlockField& field, int blk) {
+  int d = 0;
+  while (o[static_cast<std::size_t>(d)] == 0) ++d;
+  const auto dd = static_cast<std::size_t>(d);
+  const int side = o[dd] < 0 ? 0 : 1;
+  const int b = field.cells();
+  const int first = side == 0 ? -1 : b;  // the first ghost layer along d
+  if (r[dd].end - r[dd].begin > 1) {     // the deeper layers: interpolated
+    std::array<Range, 3> deeper = r;
+    if (side == 0) {
+      deeper[dd].end = first;
+    } else {
+      deeper[dd].begin = first + 1;
+    }
+    fill_from_coarser(block, o, deeper, coarse, field, blk);
+  }
+  // The coarse layer beside the face, across it: the weights along d pick the
+  // coarse cell under the first ghost layer (coarse cells counted from the
+  // coarse block's lower face: b - 1 below this block, 0 above).
+  const int lo = d == 0 ? 1 : 0, hi = d == 2 ? 1 : 2;
+  const int layer = side == 0 ? b - 1 : 0;
+  const int off_lo = static_cast<int>((block.coord[static_cast<std::size_t>(lo)]) & 1) * b;
+  const int off_hi = static_cast<int>((block.coord[static_cast<std::size_t>(hi)]) & 1) * b;
+  const BlockLayout& L = field.layout();
+  double* dst = field.block(blk);
+  const std::ptrdiff_t inward = side == 0 ? L.stride(d) : -L.stride(d);
+  std::array<int, 3> n{};
+  std::array<int, 3> m{};
+  n[dd] = side == 0 ? 0 : b - 1;  // this block's cell beside the face
+  m[dd] = layer;
+  for (int q = 0; q < b; ++q) {
+    const AxisWeights wh = axis_weights(off_hi + q, b);
+    n[static_cast<std::size_t>(hi)] = q;
+    for (int p = 0; p < b; ++p) {
+      const AxisWeights wl = axis_weights(off_lo + p, b);
+      n[static_cast<std::size_t>(lo)] = p;
+      double across = 0.0;
+      for (int c = 0; c < wh.count; ++c) {
+        m[static_cast<std::size_t>(hi)] = wh.first + c;
+        double row = 0.0;
+        for (int a = 0; a < wl.count; ++a) {
+          m[static_cast<std::size_t>(lo)] = wl.first + a;
+          row += wl.w[static_cast<std::size_t>(a)] * coarse(m[0], m[1], m[2]);
+        }
+        across += wh.w[static_cast<std::size_t>(c)] * row;
+      }
+      const std::ptrdiff_t cell = L.index(n[0], n[1], n[2]);
+      dst[cell - inward] =
+          kGhostCoarse * across + kGhostFace * dst[cell] + kGhostSecond * dst[cell + inward];
+    }
+  }
+}
+
 /// Ghosts of a coarse block in the region towards offset o from the finer
 /// children there: the mean of the 8 fine cells of each ghost cell. Fine
 /// cells that would lie in a child not touching the block (ghosts deeper
@@ -463,8 +525,9 @@ void fill_from_finer(const std::array<int, 3>& o, const std::array<Range, 3>& r,
 
 }  // namespace
 
-void Forest::exchange(std::span<BlockField* const> fields, int width, bool faces_only) const {
-  exchange_scoped(fields, width, faces_only, -1);
+void Forest::exchange(std::span<BlockField* const> fields, int width, bool faces_only,
+                      CoarseGhosts coarse_ghosts) const {
+  exchange_scoped(fields, width, faces_only, -1, false, coarse_ghosts);
 }
 
 void Forest::copy_face_ghosts(BlockField& field, int blk, int colour) const {
@@ -501,13 +564,15 @@ void Forest::exchange_from_finer(BlockField& field, int face) const {
   exchange_scoped(one, 1, true, face);
 }
 
-void Forest::exchange_face_ghosts_but_local_same_level(BlockField& field) const {
+void Forest::exchange_face_ghosts_but_local_same_level(BlockField& field,
+                                                       CoarseGhosts coarse_ghosts) const {
   BlockField* one[] = {&field};
-  exchange_scoped(one, 1, true, -1, true);
+  exchange_scoped(one, 1, true, -1, true, coarse_ghosts);
 }
 
 void Forest::exchange_scoped(std::span<BlockField* const> fields, int width, bool faces_only,
-                             int finer_face, bool skip_local_same_level) const {
+                             int finer_face, bool skip_local_same_level,
+                             CoarseGhosts coarse_ghosts) const {
   if (fields.empty()) return;
   const BlockLayout layout = fields[0]->layout();
   const int b = layout.cells;
@@ -568,7 +633,12 @@ void Forest::exchange_scoped(std::span<BlockField* const> fields, int width, boo
                     {1, b, std::ptrdiff_t{b} * b}};
               };
               if (nb.jump == LevelJump::Coarser) {
-                fill_from_coarser(block, o, r, reader({nb.link, nb.index}), *fields[f], blk);
+                if (coarse_ghosts == CoarseGhosts::Composite && nonzero == 1 && b >= 2) {
+                  fill_composite_face_ghosts(block, o, r, reader({nb.link, nb.index}), *fields[f],
+                                             blk);
+                } else {
+                  fill_from_coarser(block, o, r, reader({nb.link, nb.index}), *fields[f], blk);
+                }
               } else {
                 std::array<CellReader, 8> children{};
                 for (std::size_t c = 0; c < 8; ++c) {

@@ -80,6 +80,15 @@ struct Neighbour {
   std::array<BlockRef, 8> children{};
 };
 
+/// How exchange() fills the first ghost layer of a fine block across a face
+/// towards a coarser block. Interpolated: from the coarse block alone
+/// (quadratic per direction, interpolate_from_coarse), what every field's
+/// stencils read. Composite: the multigrid operator's ghost, the quadratic
+/// along the normal through the coarse layer (interpolated across the face)
+/// and the block's own two cells beside the face (kGhostCoarse, coarse_fine.hpp);
+/// deeper layers, edges and corners as Interpolated.
+enum class CoarseGhosts : std::uint8_t { Interpolated, Composite };
+
 /// The deepest level p8est blocks may reach (P8EST_QMAXLEVEL).
 inline constexpr int kForestMaxLevel = 18;
 
@@ -154,10 +163,12 @@ class Forest {
   /// block's interior, for all the given fields (same b). Boundary ghosts are left for
   /// boundary.hpp. With `faces_only` the edge and corner ghosts are left as they are (7-point
   /// stencils read face ghosts only).
-  void exchange(std::span<BlockField* const> fields, int width, bool faces_only = false) const;
-  void exchange(BlockField& field, int width, bool faces_only = false) const {
+  void exchange(std::span<BlockField* const> fields, int width, bool faces_only = false,
+                CoarseGhosts coarse_ghosts = CoarseGhosts::Interpolated) const;
+  void exchange(BlockField& field, int width, bool faces_only = false,
+                CoarseGhosts coarse_ghosts = CoarseGhosts::Interpolated) const {
     BlockField* one[] = {&field};
-    exchange(one, width, faces_only);
+    exchange(one, width, faces_only, coarse_ghosts);
   }
 
   /// Only the ghost layer (width 1) beyond face `face` (2 d + side) of the
@@ -168,7 +179,8 @@ class Forest {
   void exchange_from_finer(BlockField& field, int face) const;
   /// exchange(field, 1, true) without the faces copy_face_ghosts() fills: the
   /// faces towards blocks of another level or on another rank. Collective.
-  void exchange_face_ghosts_but_local_same_level(BlockField& field) const;
+  void exchange_face_ghosts_but_local_same_level(
+      BlockField& field, CoarseGhosts coarse_ghosts = CoarseGhosts::Interpolated) const;
 
   /// Whether every face neighbour of every block is a block of the same level
   /// on this rank (or the domain boundary): one rank, a uniform forest. Then
@@ -253,7 +265,8 @@ class Forest {
   /// exchange(); with finer_face >= 0 only that face of blocks beside finer
   /// ones; with skip_local_same_level not the faces copy_face_ghosts() fills.
   void exchange_scoped(std::span<BlockField* const> fields, int width, bool faces_only,
-                       int finer_face, bool skip_local_same_level = false) const;
+                       int finer_face, bool skip_local_same_level = false,
+                       CoarseGhosts coarse_ghosts = CoarseGhosts::Interpolated) const;
   void build_blocks();
   void build_ghost_tables();
   void build_neighbours();

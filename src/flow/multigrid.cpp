@@ -40,24 +40,41 @@ inline double relaxed_value(const double* x, double rhs, const BlockCoefficients
   return den > 0.0 ? num / den : x[c];  // a cell cut off on all sides (solid) keeps its value
 }
 
+/// The finest level's operator is the flow's: its fine ghosts beside a
+/// coarser block are interpolated from the coarse block alone
+/// (CoarseGhosts::Interpolated, the ghosts every field's stencils read; the
+/// discretisation the flow validations measured). The coarser multigrid
+/// levels, which only have to approximate it, take the composite rule
+/// (CoarseGhosts::Composite, coarse_fine.hpp): along the normal the
+/// interpolated ghost extrapolates over three coarse cells with weights
+/// 1.41, -0.56, 0.16, which makes the coarse cell's row far from an M-matrix,
+/// and the coarse-grid correction near the interfaces poor. Measured per
+/// V(2,2) cycle (test_adapt_poisson: the refined octant, periodic and
+/// Dirichlet at two resolutions, Helmholtz at two, the blob, the concave
+/// corner, 22 scattered blocks; uniform 4^3 blocks: 15.2x):
+///   interpolated on every level:       13.0/11.6, 15.7/14.5, 16.5/15.0, 10.2, 8.9, 7.8x
+///   composite on the coarser levels:   19.3/15.7, 19.7/18.3, 21.7/19.5, 14.7, 11.3, 11.1x (kept)
+///   composite on every level:          19.6/15.8, 20.0/18.5, 22.1/19.6, 15.6, 14.9, 13.7x
+/// The last changes the flow's discretisation at coarse-fine faces: the
+/// manufactured Poisson solutions got 12-28 % more accurate beside them, but
+/// the refined Taylor-Green test's velocity error rose by 15 % (1.60e-3
+/// against 1.39e-3), and explicit viscous terms (Crank-Nicolson, the
+/// transpose term of variable viscosity) must then read the same ghosts or
+/// the step goes unstable; not taken (docs/performance.md).
+inline bool composite_ghosts_on(int level) {
+  return level > 0;
+}
+
 /// Coarse cell n of a block of b cells beside a finer block across face
 /// (d, side): the weight of the cell itself in the mean of the 4 fine ghost
-/// values across that face beside it (the fine ghosts are interpolated from
-/// the coarse block's interior, coarse_fine.hpp; the mean of a tensor
-/// product over the 2 x 2 transverse positions is the product of the means).
-/// The matched ghost is x_c - (h_c / h_f) (fine ghost - fine cell), so it
-/// moves with the cell as 1 - 2 w: the relaxation needs that in its diagonal.
-/// Diagonal of a matched face in the relaxation: kMatchedDiagonal w beta.
-/// The exact linearisation is 2 w; 1.5 w (with the 1.15 over-relaxation
-/// everywhere) converges faster, measured per V(2,2) cycle on the refined
-/// octant (periodic 13.0/11.6x, Dirichlet 15.7/14.5x, Helmholtz 16.5/15.0x)
-/// and on the concave regions of test_adapt_poisson (10.2x and 8.9x),
-/// against 12.1/11.0, 12.3/13.0, 13.2/13.6, 8.9 and 8.7x with 2 w, and 9.9
-/// and 5.7x on the concave regions with 1 w (a cell with three matched faces
-/// then relaxes too close to the Gauss-Seidel limit).
-constexpr double kMatchedDiagonal = 1.5;
-
-inline double fine_ghost_self_weight(const std::array<int, 3>& n, int d, int side, int b) {
+/// values across that face beside it (the mean of a tensor product over the
+/// 2 x 2 transverse positions is the product of the means; along the normal
+/// the interpolated ghost's weight on the coarse layer, or the composite
+/// rule's kGhostCoarse). The matched ghost is x_c - (h_c / h_f) (fine ghost -
+/// fine cell), so it moves with the cell as 1 - 2 w, and the exact
+/// linearisation puts 2 w beta on the diagonal for that face.
+inline double fine_ghost_self_weight(const std::array<int, 3>& n, int d, int side, int b,
+                                     bool composite) {
   double w = 1.0;
   for (int e = 0; e < 3; ++e) {
     const int ne = n[D(e)];
@@ -66,11 +83,33 @@ inline double fine_ghost_self_weight(const std::array<int, 3>& n, int d, int sid
       const int slot = ne - a.first;
       return slot >= 0 && slot < a.count ? a.w[D(slot)] : 0.0;
     };
-    w *= e == d ? weight_on(side == 0 ? 0 : 2 * b - 1)
-                : 0.5 * (weight_on(2 * ne) + weight_on(2 * ne + 1));
+    if (e != d) {
+      w *= 0.5 * (weight_on(2 * ne) + weight_on(2 * ne + 1));
+    } else {
+      w *= composite ? kGhostCoarse : weight_on(side == 0 ? 0 : 2 * b - 1);
+    }
   }
   return w;
 }
+
+/// The relaxation's diagonal for a matched face: (matched_diagonal) w beta,
+/// and for a face of a fine cell towards a coarser block (composite ghosts,
+/// which hold kGhostFace of the cell itself: exactly (1 - kGhostFace) beta)
+/// kFineFaceDiagonal beta. Lighter than exact, they over-relax the cells at
+/// the interface a little more than the rest. Measured per V(2,2) cycle (the
+/// cases above, composite on the coarser levels):
+///   finest level, matched 2 w (exact) / 1.5 w (kept) / 1 w / 2.5 w:
+///     17.9/15.5 ... 12.3, 11.3x / 19.3/15.7 ... 11.3, 11.1x / 14.9/14.9 ... 5.3, 4.0x /
+///     15.9/14.7 ... 12.0, 10.0x
+///   coarser levels, matched and fine face 1 w, 0 (kept) / 1.5 w, 0 / 1 w, 1/3 / 2 w, 1/3:
+///     11.3, 11.1x / 11.1, 10.7x / 10.7, 10.2x / 10.3, 9.6x (corner, scattered)
+/// On the finest level 1.5 w was chosen (2026-11-23) against 2 w and 1 w,
+/// because a cell with three matched faces relaxes too close to the
+/// Gauss-Seidel limit with 1 w (5.7x on the corner).
+inline double matched_diagonal(bool composite) {
+  return composite ? 1.0 : 1.5;
+}
+constexpr double kFineFaceDiagonal = 0.0;
 
 /// (A x)_c = alpha x_c - div(beta grad x)_c, eq. (1).
 inline double applied(const double* x, const BlockCoefficients& k, std::ptrdiff_t c,
@@ -84,29 +123,45 @@ inline double applied(const double* x, const BlockCoefficients& k, std::ptrdiff_
   return ax;
 }
 
+/// The faces of a block whose ghosts move with the cells beside them, by
+/// face_index: Dirichlet faces with the quadratic closure (the finest level),
+/// coarse-fine faces seen from the coarse side (matched fluxes) and from the
+/// fine side (the composite ghost, kGhostFace of the cell itself).
+struct ClosedFaces {
+  std::array<bool, 6> dirichlet{}, matched{}, coarser{};
+  bool composite = false;  ///< composite_ghosts_on(level): the rule of the coarse-fine ghosts
+};
+
 /// The part of cell n's ghost values that moves with the cell itself (the
 /// `implicit` of relaxed_value): 2 beta per Dirichlet face (quadratic closure
-/// ghost = (8 g - 6 x0 + x1)/3) and (kMatchedDiagonal w - 1) beta per matched
-/// coarse-fine face. A matched ghost moves with the cell as 1 - 2 w
-/// (fine_ghost_self_weight): exactly, its face has 2 w beta on the diagonal
-/// (kMatchedDiagonal w beta is used, see there). Treating the ghost as fixed
+/// ghost = (8 g - 6 x0 + x1)/3), (matched_diagonal() w - 1) beta per matched
+/// coarse-fine face and, with composite ghosts, (kFineFaceDiagonal - 1) beta
+/// per face towards a coarser block. A matched ghost moves with the cell as
+/// 1 - 2 w (fine_ghost_self_weight): exactly, its face has 2 w beta on the
+/// diagonal (matched_diagonal() w beta is used, see there). Treating the ghost as fixed
 /// relative to the cell (beta removed from the diagonal, as first written)
 /// makes Gauss-Seidel diverge at coarse cells with finer blocks across two or
 /// three faces (concave refined regions). beta_lo(d), beta_hi(d): the cell's
 /// lower and upper face coefficients along d.
 template <typename Low, typename High>
-double closure_implicit(const std::array<int, 3>& n, int b, const std::array<bool, 6>& dirichlet,
-                        const std::array<bool, 6>& matched, Low beta_lo, High beta_hi) {
+double closure_implicit(const std::array<int, 3>& n, int b, const ClosedFaces& faces, Low beta_lo,
+                        High beta_hi) {
+  const auto& [dirichlet, matched, coarser, composite] = faces;
+  const double matched_weight = matched_diagonal(composite);
   double implicit = 0.0;
   for (int d = 0; d < 3; ++d) {
     const bool low = n[D(d)] == 0, high = n[D(d)] == b - 1;
+    if (coarser[D(face_index(d, 0))] && low) implicit += (kFineFaceDiagonal - 1.0) * beta_lo(d);
+    if (coarser[D(face_index(d, 1))] && high) implicit += (kFineFaceDiagonal - 1.0) * beta_hi(d);
     if (dirichlet[D(face_index(d, 0))] && low) implicit += 2.0 * beta_lo(d);
     if (dirichlet[D(face_index(d, 1))] && high) implicit += 2.0 * beta_hi(d);
     if (matched[D(face_index(d, 0))] && low) {
-      implicit += (kMatchedDiagonal * fine_ghost_self_weight(n, d, 0, b) - 1.0) * beta_lo(d);
+      implicit +=
+          (matched_weight * fine_ghost_self_weight(n, d, 0, b, composite) - 1.0) * beta_lo(d);
     }
     if (matched[D(face_index(d, 1))] && high) {
-      implicit += (kMatchedDiagonal * fine_ghost_self_weight(n, d, 1, b) - 1.0) * beta_hi(d);
+      implicit +=
+          (matched_weight * fine_ghost_self_weight(n, d, 1, b, composite) - 1.0) * beta_hi(d);
     }
   }
   return implicit;
@@ -115,13 +170,11 @@ double closure_implicit(const std::array<int, 3>& n, int b, const std::array<boo
 /// Red-black Gauss-Seidel on the cells of one colour (i + j + k + first even)
 /// of a block whose alpha and beta are constants: relaxed_value, the same
 /// operations in the same order, with the implicit part of smooth() (the
-/// quadratic Dirichlet closure of the faces flagged in `dirichlet`, the
-/// matched coarse-fine faces flagged in `matched`), without the coefficient
-/// loads (the smoother is memory-bound).
+/// quadratic Dirichlet closure and the coarse-fine faces of `faces`), without the coefficient loads (the
+/// smoother is memory-bound).
 inline void relax_constant(double* x, const double* rhs, const BlockLayout& L, int first,
                            double alpha, double beta, double inv_h2, double omega,
-                           const std::array<bool, 6>& dirichlet,
-                           const std::array<bool, 6>& matched) {
+                           const ClosedFaces& faces) {
   const int b = L.cells;
   const std::ptrdiff_t sy = L.stride(1), sz = L.stride(2);
   auto diagonal = [&](double implicit) {
@@ -130,7 +183,8 @@ inline void relax_constant(double* x, const double* rhs, const BlockLayout& L, i
     return den;
   };
   std::array<bool, 6> closed{};
-  for (std::size_t f = 0; f < 6; ++f) closed[f] = dirichlet[f] || matched[f];
+  for (std::size_t f = 0; f < 6; ++f)
+    closed[f] = faces.dirichlet[f] || faces.matched[f] || faces.coarser[f];
   const double interior = diagonal(0.0);
   const bool x_faces = closed[D(face_index(0, 0))] || closed[D(face_index(0, 1))];
   for (int k = 0; k < b; ++k)
@@ -146,7 +200,7 @@ inline void relax_constant(double* x, const double* rhs, const BlockLayout& L, i
         double den = interior;
         if (closure_row) {
           const auto constant = [beta](int) { return beta; };
-          implicit = closure_implicit({i, j, k}, b, dirichlet, matched, constant, constant);
+          implicit = closure_implicit({i, j, k}, b, faces, constant, constant);
           den = diagonal(implicit);
         }
         double num = f[i] + implicit * inv_h2 * row[i];
@@ -272,15 +326,6 @@ void Multigrid::rebuild() {
     }
   }
   shifted_rhs_.reshape(n, forest_.block_cells());
-  interface_blocks_.clear();
-  if (composite_) {
-    interface_blocks_ = forest_.blocks_beside_finer();
-    interface_blocks_.insert(interface_blocks_.end(), forest_.blocks_beside_coarser().begin(),
-                             forest_.blocks_beside_coarser().end());
-    std::sort(interface_blocks_.begin(), interface_blocks_.end());
-    interface_blocks_.erase(std::unique(interface_blocks_.begin(), interface_blocks_.end()),
-                            interface_blocks_.end());
-  }
   set_coefficients(nullptr, nullptr);
 }
 
@@ -561,9 +606,20 @@ void Multigrid::coarse_solve() {
   }
 }
 
+namespace {
+
+/// The coarse-fine ghosts of the operator on `level` (composite_ghosts_on);
+/// values alone (the prolongation) are interpolated.
+CoarseGhosts ghost_rule(int level, bool operator_ghosts) {
+  return operator_ghosts && composite_ghosts_on(level) ? CoarseGhosts::Composite
+                                                       : CoarseGhosts::Interpolated;
+}
+
+}  // namespace
+
 void Multigrid::fill_ghosts(int level, BlockField& x, const ScalarBoundary* bc, bool faces_only,
                             bool match) {
-  forest_.exchange(x, 1, faces_only);
+  forest_.exchange(x, 1, faces_only, ghost_rule(level, match));
   if (bc) {
     fill_boundary_ghosts(forest_, x, *bc, 1, false);
   } else {
@@ -573,7 +629,9 @@ void Multigrid::fill_ghosts(int level, BlockField& x, const ScalarBoundary* bc, 
 }
 
 void Multigrid::fill_ghosts_between_blocks_apart(int level, BlockField& x) {
-  if (!forest_.faces_local_same_level()) forest_.exchange_face_ghosts_but_local_same_level(x);
+  if (!forest_.faces_local_same_level()) {
+    forest_.exchange_face_ghosts_but_local_same_level(x, ghost_rule(level, true));
+  }
   if (composite_) match_fluxes(level, x);
 }
 
@@ -603,20 +661,20 @@ void Multigrid::relax_block(int level, int blk, BlockField& x, const BlockField&
   const double* rb = rhs.block(blk);
   // Dirichlet faces of this block with the quadratic closure (finest level):
   // ghost = (8 g - 6 x0 + x1)/3 depends on x0 with weight -2.
-  std::array<bool, 6> dirichlet{}, matched{};
+  ClosedFaces faces;
   bool any = false;
   if (composite_) {
-    // Coarse-fine faces seen from the coarse side: the ghost carries the
-    // matched fine flux, which moves with this cell through the fine
-    // ghosts interpolated from it (see kMatchedDiagonal and closure_implicit).
+    // Coarse-fine faces. Seen from the coarse side the ghost carries the
+    // matched fine flux, which moves with this cell through the fine ghosts
+    // interpolated from it; seen from the fine side a composite ghost holds
+    // kGhostFace of the cell itself (see matched_diagonal and closure_implicit).
+    faces.composite = composite_ghosts_on(level);
     for (int d = 0; d < 3; ++d)
       for (int side = 0; side < 2; ++side) {
-        std::array<int, 3> o{0, 0, 0};
-        o[D(d)] = side == 0 ? -1 : 1;
-        const bool on =
-            block.neighbours[D(neighbour_slot(o[0], o[1], o[2]))].jump == LevelJump::Finer;
-        matched[D(face_index(d, side))] = on;
-        any = any || on;
+        const LevelJump jump = block.neighbours[D(face_neighbour_slot(d, side))].jump;
+        faces.matched[D(face_index(d, side))] = jump == LevelJump::Finer;
+        faces.coarser[D(face_index(d, side))] = faces.composite && jump == LevelJump::Coarser;
+        any = any || faces.matched[D(face_index(d, side))] || faces.coarser[D(face_index(d, side))];
       }
   }
   if (bc != nullptr) {
@@ -627,14 +685,14 @@ void Multigrid::relax_block(int level, int blk, BlockField& x, const BlockField&
         const bool on =
             block.neighbours[D(neighbour_slot(o[0], o[1], o[2]))].link == Link::Boundary &&
             kinds_[D(face_index(d, side))] == BcKind::Dirichlet;
-        dirichlet[D(face_index(d, side))] = on;
+        faces.dirichlet[D(face_index(d, side))] = on;
         any = any || on;
       }
   }
   const auto at = static_cast<std::size_t>(blk);
   if (constant_kernels_ && lv.block_constant[at]) {
     relax_constant(xb, rb, L, (parity + colour) & 1, lv.block_alpha[at], lv.block_beta[at], inv_h2,
-                   omega_, dirichlet, matched);
+                   omega_, faces);
     return;
   }
   for (int kk = 0; kk < b; ++kk)
@@ -643,7 +701,7 @@ void Multigrid::relax_block(int level, int blk, BlockField& x, const BlockField&
         const std::ptrdiff_t c = L.index(i, j, kk);
         const double implicit =
             any ? closure_implicit(
-                      {i, j, kk}, b, dirichlet, matched, [&](int d) { return k.beta[D(d)][c]; },
+                      {i, j, kk}, b, faces, [&](int d) { return k.beta[D(d)][c]; },
                       [&](int d) { return k.beta[D(d)][c + s[D(d)]]; })
                 : 0.0;
         xb[c] += omega_ * (relaxed_value(xb, rb[c], k, c, s, inv_h2, implicit) - xb[c]);
@@ -651,7 +709,7 @@ void Multigrid::relax_block(int level, int blk, BlockField& x, const BlockField&
 }
 
 void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc,
-                       int sweeps, const std::vector<std::int32_t>* only) {
+                       int sweeps) {
   const int b = x.layout().cells;
   // With an even b (the colours match across periodic faces) each block fills
   // its face ghosts towards same-level blocks of this rank and its boundary
@@ -678,9 +736,7 @@ void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const Sc
       // colour runs backwards over each thread's blocks and starts on those
       // the first one left in cache (what a grid larger than the cache
       // saves), with the same bits.
-      if (only != nullptr) {
-        forest_.for_each_listed(*only, relax);
-      } else if (colour == 0) {
+      if (colour == 0) {
         forest_.for_each_block(relax);
       } else {
         forest_.for_each_block_backward(relax);
@@ -783,8 +839,6 @@ void Multigrid::vcycle(int level, BlockField& x, const BlockField& rhs, const Sc
     return;
   }
   smooth(level, x, rhs, bc, pre_sweeps_);
-  if (composite_ && interface_sweeps_ > 0)
-    smooth(level, x, rhs, bc, interface_sweeps_, &interface_blocks_);
   Level& fine = levels_[D(level)];
   Level& coarse = levels_[D(level + 1)];
   compute_residual(level, x, rhs, bc, fine.res, false);  // restricted, no norm
@@ -820,8 +874,6 @@ void Multigrid::vcycle(int level, BlockField& x, const BlockField& rhs, const Sc
           if (weight > 0.0) x(blk, i, j, k) += value / weight;
         }
   });
-  if (composite_ && interface_sweeps_ > 0)
-    smooth(level, x, rhs, bc, interface_sweeps_, &interface_blocks_);
   smooth(level, x, rhs, bc, post_sweeps_);
 }
 
@@ -898,7 +950,6 @@ void Multigrid::take_options(const MultigridOptions& options) {
   post_sweeps_ = options.post_sweeps;
   omega_ = options.relaxation;
   constant_kernels_ = options.constant_coefficient_kernels;
-  interface_sweeps_ = options.interface_sweeps;
 }
 
 void Multigrid::relax(BlockField& x, const BlockField& rhs, const ScalarBoundary& bc, int sweeps,

@@ -66,12 +66,6 @@ struct MultigridOptions {
   /// caller refills them anyway (the viscous solves: the velocity's ghosts
   /// are filled again before anything reads them), saving a full exchange.
   bool fill_ghosts_on_return = true;
-  /// Composite grids: extra red-black sweeps on the blocks beside coarse-fine
-  /// faces after each pre-smoothing and before each post-smoothing. 1 raises
-  /// the residual reduction per V-cycle from 7.8-8.9x to 11.4-12.0x where
-  /// most blocks touch a coarse-fine face (test_adapt_poisson.cpp), but there
-  /// it costs more time than the cycles it saves: off by default.
-  int interface_sweeps = 0;
 };
 
 struct MultigridReport {
@@ -156,9 +150,8 @@ class Multigrid {
   /// ghosts towards same-level blocks of this rank (`colour` as in
   /// Forest::copy_face_ghosts) and its boundary ghosts.
   void fill_block_ghosts(int blk, BlockField& x, const ScalarBoundary* bc, int colour) const;
-  /// `sweeps` red-black sweeps over every block, or over the listed ones only.
-  void smooth(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc, int sweeps,
-              const std::vector<std::int32_t>* only = nullptr);
+  /// `sweeps` red-black sweeps over every block.
+  void smooth(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc, int sweeps);
   /// One half-sweep (the cells of `colour`) of block `blk`, ghosts filled.
   void relax_block(int level, int blk, BlockField& x, const BlockField& rhs,
                    const ScalarBoundary* bc, int colour) const;
@@ -212,8 +205,6 @@ class Multigrid {
   std::vector<double> block_squares_;  ///< per local block: sum of squares (rms, residuals)
   int pre_sweeps_ = 2;
   int post_sweeps_ = 2;
-  int interface_sweeps_ = 0;
-  std::vector<std::int32_t> interface_blocks_;  ///< local blocks beside finer or coarser ones
   double omega_ = 1.0;
   bool constant_kernels_ = true;  ///< MultigridOptions::constant_coefficient_kernels of the solve
 };

@@ -38,7 +38,7 @@ void expect_second_order_and_fast(const RefinedPoissonResult& coarse,
   // The same at the cells beside the coarse-fine faces, where the quadratic
   // ghost interpolation and the flux matching act (first order would be 1).
   EXPECT_GT(std::log2(coarse.interface_error / fine.interface_error), 1.8);
-  // The composite V(2,2) cycle: measured 11.6-15.7x per cycle (uniform
+  // The composite V(2,2) cycle: measured 15.7-19.7x per cycle (uniform
   // grids: 14-20x); 10x is the milestone's target.
   EXPECT_GT(coarse.report.mean_reduction(), 10.0);
   EXPECT_GT(fine.report.mean_reduction(), 10.0);
@@ -117,7 +117,7 @@ TEST(AdaptPoisson, HelmholtzWithVariableCoefficientOnTheRefinedOctant) {
 /// Periodic Poisson on 4^3 blocks of 8^3 cells with the level-2 blocks at
 /// `refined` refined once: V-cycles and reduction per cycle.
 MultigridReport solve_with_refined_blocks(const std::vector<std::array<std::int64_t, 3>>& refined,
-                                          int interface_sweeps = 0) {
+                                          const char* name) {
   ForestSpec spec;
   spec.level = 2;
   spec.periodic = {true, true, true};
@@ -136,34 +136,11 @@ MultigridReport solve_with_refined_blocks(const std::vector<std::array<std::int6
   BlockField x(forest.local_blocks(), forest.block_cells());
   MultigridOptions options;
   options.tolerance = 1e-10;
-  options.interface_sweeps = interface_sweeps;
   const auto r = mg.solve(x, testing::sample(forest, testing::periodic_source), bc, options);
-  std::printf(
-      "  %zu blocks refined, %d interface sweep(s): %d V-cycles, %.1fx per cycle, max "
-      "error %.3e\n",
-      refined.size(), interface_sweeps, r.cycles, r.mean_reduction(),
-      testing::max_error(forest, x, testing::periodic_exact));
+  std::printf("  %-30s %2zu blocks refined: %2d V-cycles, %.1fx per cycle, max error %.3e\n", name,
+              refined.size(), r.cycles, r.mean_reduction(),
+              testing::max_error(forest, x, testing::periodic_exact));
   return r;
-}
-
-TEST(AdaptPoisson, ConcaveRefinedRegionsConvergeAsFast) {
-  // Refined regions with re-entrant edges and corners, as the wavelet
-  // criterion makes around a moving blob (found by
-  // test_navier_stokes_adaptive): coarse blocks with finer neighbours across
-  // two faces (the blob) or three (an octant of 2 x 2 x 2 blocks refined but
-  // for one corner block). The relaxation that lagged the matched fluxes
-  // diverged on both (0.7x per cycle, residual growing).
-  std::printf("concave refined regions, periodic Poisson, V(2,2):\n");
-  const auto blob = solve_with_refined_blocks(
-      {{0, 1, 2}, {1, 0, 1}, {1, 0, 2}, {1, 1, 1}, {1, 1, 2}, {2, 1, 1}, {2, 1, 2}});
-  const auto corner = solve_with_refined_blocks(
-      {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 0}, {1, 0, 1}, {0, 1, 1}, {1, 1, 1}});
-  EXPECT_TRUE(blob.converged);
-  EXPECT_TRUE(corner.converged);
-  EXPECT_GT(blob.mean_reduction(), 10.0);  // the milestone's 10x, as on the octant (10.2x)
-  // Measured 8.9x: below the 10x target (issue #7, open); this bound only
-  // guards against a regression towards the diverging relaxation.
-  EXPECT_GT(corner.mean_reduction(), 8.0);
 }
 
 /// The blocks of a level-2 forest (4^3 blocks) that a fixed hash picks, 4 in
@@ -179,27 +156,37 @@ std::vector<std::array<std::int64_t, 3>> scattered_blocks() {
   return picked;
 }
 
-TEST(AdaptPoisson, ExtraSweepsBesideCoarseFineFacesConvergeFaster) {
+TEST(AdaptPoisson, CompositeCyclesConvergeNearlyAsFastAsUniformOnes) {
   // Issue #7 asks the composite V-cycle to converge as fast per cycle as the
-  // uniform one (16.1x per cycle on this problem asymptotically, 15.2x mean).
-  // It does not yet:
-  // measured 8.9x on the concave corner and 7.8x on the scattered refinement
-  // (22 of the 64 blocks).
-  // One extra sweep on the blocks beside coarse-fine faces
-  // (MultigridOptions::interface_sweeps) recovers part of it: 11.4x and 12.0x (10 V-cycles instead
-  // of 11 and 12), at the cost of that sweep.
+  // uniform one. Refined regions with re-entrant edges and corners, as the
+  // wavelet criterion makes around a moving blob (found by
+  // test_navier_stokes_adaptive): coarse blocks with finer neighbours across
+  // two faces (the blob) or three (an octant of 2 x 2 x 2 blocks refined but
+  // for one corner block), and 22 blocks picked by a hash. Measured against
+  // the uniform 15.2x (9 cycles): 14.7x (9 cycles), 11.3x and 11.1x (10
+  // cycles), with composite coarse-fine ghosts on the coarser multigrid
+  // levels (multigrid.cpp, composite_ghosts_on). With interpolated ghosts on
+  // every level (before 2026-11-25) they were 10.2x, 8.9x and 7.8x (10-12
+  // cycles), and a relaxation that lagged the matched fluxes diverged on the
+  // first two. So the rate is 0.73-0.97 of the uniform one, not yet equal.
+  std::printf("periodic Poisson, V(2,2), uniform against composite grids:\n");
+  const auto uniform = solve_with_refined_blocks({}, "uniform");
+  const auto blob = solve_with_refined_blocks(
+      {{0, 1, 2}, {1, 0, 1}, {1, 0, 2}, {1, 1, 1}, {1, 1, 2}, {2, 1, 1}, {2, 1, 2}}, "blob");
+  const auto corner = solve_with_refined_blocks(
+      {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 0}, {1, 0, 1}, {0, 1, 1}, {1, 1, 1}},
+      "octant but a corner block");
   const auto scattered = scattered_blocks();
   ASSERT_GE(scattered.size(), 16u);
-  const std::vector<std::array<std::int64_t, 3>> corner{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 0},
-                                                        {1, 0, 1}, {0, 1, 1}, {1, 1, 1}};
-  std::printf("extra sweeps beside coarse-fine faces, periodic Poisson, V(2,2):\n");
-  for (const auto& refined : {corner, scattered}) {
-    const auto plain = solve_with_refined_blocks(refined, 0);
-    const auto extra = solve_with_refined_blocks(refined, 1);
-    ASSERT_TRUE(plain.converged);
-    ASSERT_TRUE(extra.converged);
-    EXPECT_LE(extra.cycles, plain.cycles);
-    EXPECT_GT(extra.mean_reduction(), 1.15 * plain.mean_reduction());
+  const auto hashed = solve_with_refined_blocks(scattered, "scattered");
+  ASSERT_TRUE(uniform.converged);
+  for (const auto* r : {&blob, &corner, &hashed}) {
+    ASSERT_TRUE(r->converged);
+    // The results are the same bits on every run and thread count, so these
+    // bounds only catch a regression: at least 0.7 of the uniform rate (the
+    // interpolated ghosts gave 0.51-0.67) and at most one cycle more.
+    EXPECT_GT(r->mean_reduction(), 0.7 * uniform.mean_reduction());
+    EXPECT_LE(r->cycles, uniform.cycles + 1);
   }
 }
 
