@@ -425,11 +425,14 @@ void fill_composite_face_ghosts(const Block& block, const std::array<int, 3>& o,
   std::array<int, 3> m{};
   n[dd] = side == 0 ? 0 : b - 1;  // this block's cell beside the face
   m[dd] = layer;
+  thread_local std::vector<AxisWeights> across_lo;
+  across_lo.clear();
+  for (int p = 0; p < b; ++p) across_lo.push_back(axis_weights(off_lo + p, b));
   for (int q = 0; q < b; ++q) {
     const AxisWeights wh = axis_weights(off_hi + q, b);
     n[static_cast<std::size_t>(hi)] = q;
     for (int p = 0; p < b; ++p) {
-      const AxisWeights wl = axis_weights(off_lo + p, b);
+      const AxisWeights& wl = across_lo[static_cast<std::size_t>(p)];
       n[static_cast<std::size_t>(lo)] = p;
       double across = 0.0;
       for (int c = 0; c < wh.count; ++c) {

@@ -170,8 +170,8 @@ double closure_implicit(const std::array<int, 3>& n, int b, const ClosedFaces& f
 /// Red-black Gauss-Seidel on the cells of one colour (i + j + k + first even)
 /// of a block whose alpha and beta are constants: relaxed_value, the same
 /// operations in the same order, with the implicit part of smooth() (the
-/// quadratic Dirichlet closure and the coarse-fine faces of `faces`), without the coefficient loads (the
-/// smoother is memory-bound).
+/// quadratic Dirichlet closure and the coarse-fine faces of `faces`), without the coefficient loads
+/// (the smoother is memory-bound).
 inline void relax_constant(double* x, const double* rhs, const BlockLayout& L, int first,
                            double alpha, double beta, double inv_h2, double omega,
                            const ClosedFaces& faces) {

@@ -151,7 +151,8 @@ class Multigrid {
   /// Forest::copy_face_ghosts) and its boundary ghosts.
   void fill_block_ghosts(int blk, BlockField& x, const ScalarBoundary* bc, int colour) const;
   /// `sweeps` red-black sweeps over every block.
-  void smooth(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc, int sweeps);
+  void smooth(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc,
+              int sweeps);
   /// One half-sweep (the cells of `colour`) of block `blk`, ghosts filled.
   void relax_block(int level, int blk, BlockField& x, const BlockField& rhs,
                    const ScalarBoundary* bc, int colour) const;
