@@ -17,6 +17,7 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <vector>
 
 namespace sanguis::flow {
 
@@ -61,6 +62,22 @@ inline AxisWeights axis_weights(int fine, int coarse_cells) {
     a.count = 1;
   }
   return a;
+}
+
+/// axis_weights(fine, coarse_cells) for fine = 0 .. 2 coarse_cells - 1, in a
+/// table kept per thread and per block size (the ghost fills call it for
+/// every face, at every multigrid level).
+inline const AxisWeights* axis_weight_table(int coarse_cells) {
+  thread_local std::vector<std::vector<AxisWeights>> tables;
+  const auto at = static_cast<std::size_t>(coarse_cells);
+  if (tables.size() <= at) tables.resize(at + 1);
+  std::vector<AxisWeights>& table = tables[at];
+  if (table.empty()) {
+    for (int fine = 0; fine < 2 * coarse_cells; ++fine) {
+      table.push_back(axis_weights(fine, coarse_cells));
+    }
+  }
+  return table.data();
 }
 
 /// The composite operator's fine ghost across a coarse-fine face (the

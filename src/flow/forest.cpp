@@ -331,18 +331,16 @@ void fill_from_coarser(const Block& block, const std::array<int, 3>& o,
   // time (x, then y, then z: the same operations in the same order as
   // interpolate_from_coarse, so the same bits, with ~4x fewer of them on a
   // face region): the weights per fine index, then the coarse rows needed.
-  thread_local std::array<std::vector<AxisWeights>, 3> w;
+  std::array<const AxisWeights*, 3> w{};
   std::array<int, 3> lo{}, hi{};  // coarse cells read, per direction
+  const AxisWeights* table = axis_weight_table(b);
   for (std::size_t d = 0; d < 3; ++d) {
-    w[d].clear();
-    lo[d] = b;
-    hi[d] = 0;
-    for (int n = r[d].begin; n < r[d].end; ++n) {
-      const AxisWeights a = axis_weights(child_offset[d] + n + r[d].shift, b);
-      w[d].push_back(a);
-      lo[d] = std::min(lo[d], a.first);
-      hi[d] = std::max(hi[d], a.first + a.count);
-    }
+    // The fine indices of the region are consecutive, and the weights'
+    // first cell grows with them.
+    w[d] = table + (child_offset[d] + r[d].begin + r[d].shift);
+    const AxisWeights& last = w[d][r[d].end - r[d].begin - 1];
+    lo[d] = w[d][0].first;
+    hi[d] = last.first + last.count;
   }
   const int ni = r[0].end - r[0].begin, nj = r[1].end - r[1].begin, nk = r[2].end - r[2].begin;
   const int cy = hi[1] - lo[1], cz = hi[2] - lo[2];
@@ -350,7 +348,7 @@ void fill_from_coarser(const Block& block, const std::array<int, 3>& o,
   rows.assign(static_cast<std::size_t>(ni) * cy * cz, 0.0);
   planes.assign(static_cast<std::size_t>(ni) * nj * cz, 0.0);
   for (int i = 0; i < ni; ++i) {
-    const AxisWeights& ax = w[0][static_cast<std::size_t>(i)];
+    const AxisWeights& ax = w[0][i];
     for (int y = 0; y < cy; ++y)
       for (int z = 0; z < cz; ++z) {
         double row = 0.0;
@@ -362,7 +360,7 @@ void fill_from_coarser(const Block& block, const std::array<int, 3>& o,
   }
   for (int i = 0; i < ni; ++i)
     for (int j = 0; j < nj; ++j) {
-      const AxisWeights& ay = w[1][static_cast<std::size_t>(j)];
+      const AxisWeights& ay = w[1][j];
       for (int z = 0; z < cz; ++z) {
         double plane = 0.0;
         for (int c = 0; c < ay.count; ++c) {
@@ -373,7 +371,7 @@ void fill_from_coarser(const Block& block, const std::array<int, 3>& o,
       }
     }
   for (int k = 0; k < nk; ++k) {
-    const AxisWeights& az = w[2][static_cast<std::size_t>(k)];
+    const AxisWeights& az = w[2][k];
     for (int j = 0; j < nj; ++j)
       for (int i = 0; i < ni; ++i) {
         double value = 0.0;
@@ -425,14 +423,13 @@ void fill_composite_face_ghosts(const Block& block, const std::array<int, 3>& o,
   std::array<int, 3> m{};
   n[dd] = side == 0 ? 0 : b - 1;  // this block's cell beside the face
   m[dd] = layer;
-  thread_local std::vector<AxisWeights> across_lo;
-  across_lo.clear();
-  for (int p = 0; p < b; ++p) across_lo.push_back(axis_weights(off_lo + p, b));
+  const AxisWeights* across_lo = axis_weight_table(b) + off_lo;
+  const AxisWeights* across_hi = axis_weight_table(b) + off_hi;
   for (int q = 0; q < b; ++q) {
-    const AxisWeights wh = axis_weights(off_hi + q, b);
+    const AxisWeights& wh = across_hi[q];
     n[static_cast<std::size_t>(hi)] = q;
     for (int p = 0; p < b; ++p) {
-      const AxisWeights& wl = across_lo[static_cast<std::size_t>(p)];
+      const AxisWeights& wl = across_lo[p];
       n[static_cast<std::size_t>(lo)] = p;
       double across = 0.0;
       for (int c = 0; c < wh.count; ++c) {
