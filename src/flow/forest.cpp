@@ -317,9 +317,12 @@ Range ghost_range(int o, int b, int width) {
 /// neighbour there: quadratic interpolation of its interior. The region's
 /// cells, shifted by r.shift, count from the lower corner of the same-level
 /// block at coord + o, which is child ((coord + o) & 1) of the coarse block.
+/// With centre_axis >= 0 (a region one cell deep along it) the value along
+/// that axis is the coarse cell's own, at its centre, not the interpolant at
+/// the ghost's (the coarse layer across a face, fill_composite_face_ghosts).
 void fill_from_coarser(const Block& block, const std::array<int, 3>& o,
                        const std::array<Range, 3>& r, const CellReader& coarse, BlockField& field,
-                       int blk) {
+                       int blk, int centre_axis = -1) {
   const int b = field.cells();
   std::array<int, 3> child_offset{};
   for (std::size_t d = 0; d < 3; ++d) {
@@ -334,10 +337,17 @@ void fill_from_coarser(const Block& block, const std::array<int, 3>& o,
   std::array<const AxisWeights*, 3> w{};
   std::array<int, 3> lo{}, hi{};  // coarse cells read, per direction
   const AxisWeights* table = axis_weight_table(b);
+  AxisWeights centre;  // the coarse cell under the region, weight 1 (count 1)
   for (std::size_t d = 0; d < 3; ++d) {
     // The fine indices of the region are consecutive, and the weights'
     // first cell grows with them.
-    w[d] = table + (child_offset[d] + r[d].begin + r[d].shift);
+    const int fine = child_offset[d] + r[d].begin + r[d].shift;
+    if (static_cast<int>(d) == centre_axis) {
+      centre.first = fine >> 1;
+      w[d] = &centre;
+    } else {
+      w[d] = table + fine;
+    }
     const AxisWeights& last = w[d][r[d].end - r[d].begin - 1];
     lo[d] = w[d][0].first;
     hi[d] = last.first + last.count;
@@ -409,43 +419,26 @@ void fill_composite_face_ghosts(const Block& block, const std::array<int, 3>& o,
     }
     fill_from_coarser(block, o, deeper, coarse, field, blk);
   }
-  // The coarse layer beside the face, across it: the weights along d pick the
-  // coarse cell under the first ghost layer (coarse cells counted from the
-  // coarse block's lower face: b - 1 below this block, 0 above).
+  // The coarse layer beside the face, interpolated across it, into the first
+  // ghost layer; then the quadratic along d through it and this block's two
+  // cells beside the face.
+  std::array<Range, 3> layer = r;
+  layer[dd] = {first, first + 1, r[dd].shift};
+  fill_from_coarser(block, o, layer, coarse, field, blk, d);
   const int lo = d == 0 ? 1 : 0, hi = d == 2 ? 1 : 2;
-  const int layer = side == 0 ? b - 1 : 0;
-  const int off_lo = static_cast<int>((block.coord[static_cast<std::size_t>(lo)]) & 1) * b;
-  const int off_hi = static_cast<int>((block.coord[static_cast<std::size_t>(hi)]) & 1) * b;
   const BlockLayout& L = field.layout();
   double* dst = field.block(blk);
   const std::ptrdiff_t inward = side == 0 ? L.stride(d) : -L.stride(d);
   std::array<int, 3> n{};
-  std::array<int, 3> m{};
   n[dd] = side == 0 ? 0 : b - 1;  // this block's cell beside the face
-  m[dd] = layer;
-  const AxisWeights* across_lo = axis_weight_table(b) + off_lo;
-  const AxisWeights* across_hi = axis_weight_table(b) + off_hi;
-  for (int q = 0; q < b; ++q) {
-    const AxisWeights& wh = across_hi[q];
-    n[static_cast<std::size_t>(hi)] = q;
+  for (int q = 0; q < b; ++q)
     for (int p = 0; p < b; ++p) {
-      const AxisWeights& wl = across_lo[p];
       n[static_cast<std::size_t>(lo)] = p;
-      double across = 0.0;
-      for (int c = 0; c < wh.count; ++c) {
-        m[static_cast<std::size_t>(hi)] = wh.first + c;
-        double row = 0.0;
-        for (int a = 0; a < wl.count; ++a) {
-          m[static_cast<std::size_t>(lo)] = wl.first + a;
-          row += wl.w[static_cast<std::size_t>(a)] * coarse(m[0], m[1], m[2]);
-        }
-        across += wh.w[static_cast<std::size_t>(c)] * row;
-      }
+      n[static_cast<std::size_t>(hi)] = q;
       const std::ptrdiff_t cell = L.index(n[0], n[1], n[2]);
-      dst[cell - inward] =
-          kGhostCoarse * across + kGhostFace * dst[cell] + kGhostSecond * dst[cell + inward];
+      double& ghost = dst[cell - inward];
+      ghost = kGhostCoarse * ghost + kGhostFace * dst[cell] + kGhostSecond * dst[cell + inward];
     }
-  }
 }
 
 /// Ghosts of a coarse block in the region towards offset o from the finer
