@@ -7,6 +7,7 @@ import json
 import os
 import re
 import time
+import tomllib
 import xml.etree.ElementTree as ET
 
 import numpy as np
@@ -42,6 +43,17 @@ def read_pvd(path):
     base = os.path.dirname(os.path.abspath(path))
     return [(float(d.get("timestep")), os.path.join(base, d.get("file")))
             for d in root.iter("DataSet")]
+
+
+def gate_removal_time(case_path):
+    """remove_at_s of the case's obstacle named "gate" [s]: the one place the opening
+    time is set, so that the scripts continuing a pour of that case agree with it."""
+    with open(case_path, "rb") as f:
+        case = tomllib.load(f)
+    for obstacle in case.get("obstacle", []):
+        if obstacle.get("name") == "gate":
+            return float(obstacle["remove_at_s"])
+    raise ValueError(f"{case_path}: no obstacle named 'gate' with remove_at_s")
 
 
 def regime_name(summary):
