@@ -5,7 +5,8 @@ cases/dem/dam-break-crosses-memory.toml pours 300 crosses (Table 3.1) behind a g
 and lets them settle until the gate is removed (t = 3.0 s, the case's remove_at_s).
 The pour runs once; its final checkpoint is copied twice and continued for 0.8 s: as
 is (tangential memory, eq. 2.6) and with memory = false on both interactions
-(dashpot with Coulomb limit: no tangential spring). The same initial microstructure, as in the thesis.
+(dashpot with Coulomb limit: no tangential spring). The same initial microstructure,
+as in the thesis.
 
 The thesis' observation: without memory "the granular column slowly deforms and
 overpacks at the bottom of the pile, while it should remain static in that region";
