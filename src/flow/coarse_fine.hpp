@@ -94,6 +94,13 @@ inline const AxisWeights* axis_weight_table(int coarse_cells) {
 /// 0.16: an extrapolation over three coarse cells) make the coarse cell's
 /// row far from an M-matrix and slowed the multigrid's smoother there
 /// (Johansen & Colella 1998 use fine cells the same way; docs/theory/flow.md).
+/// Whether a block of `block_cells` cells per side can take the composite
+/// ghost: it needs two of its own cells behind the face (x_f and x_f2 below).
+/// Forest::exchange and the multigrid's relaxation decide by it alike.
+inline bool composite_ghost_fits(int block_cells) {
+  return block_cells >= 2;
+}
+
 inline constexpr double kGhostCoarse = 8.0 / 15.0;
 inline constexpr double kGhostFace = 2.0 / 3.0;
 inline constexpr double kGhostSecond = -1.0 / 5.0;

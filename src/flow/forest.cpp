@@ -626,7 +626,8 @@ void Forest::exchange_scoped(std::span<BlockField* const> fields, int width, boo
                     {1, b, std::ptrdiff_t{b} * b}};
               };
               if (nb.jump == LevelJump::Coarser) {
-                if (coarse_ghosts == CoarseGhosts::Composite && nonzero == 1 && b >= 2) {
+                if (coarse_ghosts == CoarseGhosts::Composite && nonzero == 1 &&
+                    composite_ghost_fits(b)) {
                   fill_composite_face_ghosts(block, o, r, reader({nb.link, nb.index}), *fields[f],
                                              blk);
                 } else {

@@ -677,7 +677,7 @@ void Multigrid::relax_block(int level, int blk, BlockField& x, const BlockField&
     // matched fine flux, which moves with this cell through the fine ghosts
     // interpolated from it; seen from the fine side a composite ghost holds
     // kGhostFace of the cell itself (see matched_diagonal and closure_implicit).
-    faces.composite = composite_ghosts_on(level) && b >= 2;  // as Forest::exchange decides
+    faces.composite = composite_ghosts_on(level) && composite_ghost_fits(b);
     for (int d = 0; d < 3; ++d)
       for (int side = 0; side < 2; ++side) {
         const LevelJump jump = block.neighbours[D(face_neighbour_slot(d, side))].jump;
