@@ -17,7 +17,7 @@
 namespace sanguis::dem {
 namespace {
 
-constexpr double kRadius = 1e-3;
+constexpr double kBeadRadius = 1e-3;
 
 // A 1 cm periodic cell: a square layer of 5 x 5 glued beads (spacing one diameter,
 // centres at z = R) and four spheres released above it, off the hollows.
@@ -72,14 +72,14 @@ mean_velocity_below_m_s = 1e-6
 check_after_s = 0.2
 )";
 
-DemCase load(const std::string& text) {
+DemCase load_rough_floor(const std::string& text) {
   return load_dem_case(ConfigTable::parse_string(text, "rough.toml"), "rough.toml");
 }
 
 TEST(FixedParticles, SpheresRestInTheHollowsOfAGluedLayerThatNeverMoves) {
   const auto dir = std::filesystem::temp_directory_path() / "sanguis_test_fixed_particles";
   std::filesystem::remove_all(dir);
-  const DemCase c = load(kRoughFloor);
+  const DemCase c = load_rough_floor(kRoughFloor);
   const ParticleStore& start = c.setup.particles;
   ASSERT_EQ(start.size(), 29u);
   for (std::size_t i = 0; i < 25; ++i) EXPECT_TRUE(start.is_fixed(i)) << i;
@@ -99,7 +99,7 @@ TEST(FixedParticles, SpheresRestInTheHollowsOfAGluedLayerThatNeverMoves) {
     }
     ++mobile;
     // Resting on four beads of a square layer: the centre is sqrt(2) R above theirs (z = R).
-    EXPECT_NEAR(p.position[i].z, kRadius + std::sqrt(2.0) * kRadius, 0.02 * kRadius)
+    EXPECT_NEAR(p.position[i].z, kBeadRadius + std::sqrt(2.0) * kBeadRadius, 0.02 * kBeadRadius)
         << "sphere " << k;
     EXPECT_LT(norm(p.velocity[i]), 1e-4);
   }
@@ -126,7 +126,7 @@ TEST(FixedParticles, AFixedGroupCannotBePouredOrMoving) {
   const std::string lattice = "arrangement = \"lattice\"\nfixed = true";
   const auto expect_error = [&](const std::string& text, const std::string& key) {
     try {
-      load(text);
+      load_rough_floor(text);
       ADD_FAILURE() << "expected an InputError on " << key;
     } catch (const InputError& e) {
       EXPECT_EQ(e.key(), key) << e.what();
@@ -155,7 +155,7 @@ TEST(FixedParticles, AGluedOnlyMaterialNeedsInteractionsOnlyWithMobileOnes) {
   without.insert(without.find("[[obstacle]]"),
                  "[[material]]\nname = \"base\"\ndensity_kg_m3 = 2500.0\n");
   try {
-    load(without);
+    load_rough_floor(without);
     ADD_FAILURE() << "expected an InputError on the glass-base pair";
   } catch (const InputError& e) {
     EXPECT_EQ(e.key(), "interaction");
@@ -167,7 +167,7 @@ TEST(FixedParticles, AGluedOnlyMaterialNeedsInteractionsOnlyWithMobileOnes) {
               "[[interaction]]\nmaterials = [\"glass\", \"base\"]\nnormal_restitution = 0.3\n"
               "tangential_restitution = 0.3\nmax_overlap_ratio = 0.01\n"
               "max_impact_velocity_m_s = 0.5\nfriction = 0.5\n");
-  const DemCase c = load(with);  // no base-base, no base-wall pair needed
+  const DemCase c = load_rough_floor(with);  // no base-base, no base-wall pair needed
   ASSERT_EQ(c.setup.particles.size(), 29u);
   for (std::size_t i = 0; i < 25; ++i) EXPECT_TRUE(c.setup.particles.is_fixed(i)) << i;
   DemSimulation sim(c.setup);

@@ -20,7 +20,6 @@
 namespace sanguis::geometry {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
 
 void expect_mat_near(const Mat3& a, const Mat3& b, double tol) {
   for (int i = 0; i < 3; ++i)
@@ -29,7 +28,7 @@ void expect_mat_near(const Mat3& a, const Mat3& b, double tol) {
 
 TEST(MassProperties, ClosedFormsOfThePrimitives) {
   MassProperties m = mass_properties(Sphere{2.0});
-  EXPECT_NEAR(m.volume, 32.0 * kPi / 3.0, 1e-13);
+  EXPECT_NEAR(m.volume, 32.0 * std::numbers::pi / 3.0, 1e-13);
   EXPECT_NEAR(m.inertia_about_centroid(0, 0), 0.4 * m.volume * 4.0, 1e-12);
 
   m = mass_properties(Box{{1, 2, 3}});  // 2 x 4 x 6
@@ -38,18 +37,18 @@ TEST(MassProperties, ClosedFormsOfThePrimitives) {
                   Mat3::diagonal({48.0 * 13 / 3, 48.0 * 10 / 3, 48.0 * 5 / 3}), 1e-12);
 
   m = mass_properties(Cylinder{1.0, 2.0});  // height 4
-  EXPECT_NEAR(m.volume, 4.0 * kPi, 1e-14);
-  EXPECT_NEAR(m.inertia_about_centroid(2, 2), 2.0 * kPi, 1e-14);
-  EXPECT_NEAR(m.inertia_about_centroid(0, 0), 4.0 * kPi * (0.25 + 16.0 / 12.0), 1e-13);
+  EXPECT_NEAR(m.volume, 4.0 * std::numbers::pi, 1e-14);
+  EXPECT_NEAR(m.inertia_about_centroid(2, 2), 2.0 * std::numbers::pi, 1e-14);
+  EXPECT_NEAR(m.inertia_about_centroid(0, 0), 4.0 * std::numbers::pi * (0.25 + 16.0 / 12.0), 1e-13);
 
   m = mass_properties(Cone{1.0, 4.0});
-  EXPECT_NEAR(m.volume, 4.0 * kPi / 3.0, 1e-14);
+  EXPECT_NEAR(m.volume, 4.0 * std::numbers::pi / 3.0, 1e-14);
   EXPECT_EQ(m.centroid, (Vec3{0, 0, 0}));
   EXPECT_NEAR(m.inertia_about_centroid(2, 2), 0.3 * m.volume, 1e-14);
   EXPECT_NEAR(m.inertia_about_centroid(1, 1), m.volume * (3.0 / 20.0 + 3.0 / 80.0 * 16.0), 1e-13);
 
   m = mass_properties(Ellipsoid{{1, 2, 3}});
-  EXPECT_NEAR(m.volume, 8.0 * kPi, 1e-13);
+  EXPECT_NEAR(m.volume, 8.0 * std::numbers::pi, 1e-13);
   EXPECT_NEAR(m.inertia_about_centroid(0, 0), 0.2 * m.volume * 13.0, 1e-12);
   EXPECT_THROW(mass_properties(Triangle{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}), std::invalid_argument);
 }
@@ -123,7 +122,7 @@ TEST(MassProperties, OverlappingSpheresWithinTheStatedBound) {
   // Two unit spheres d = 1 apart: union = 2 V - lens, lens = pi (4r + d)(2r - d)^2 / 12.
   const double d = 1.0;
   const Composite pair = {{Sphere{1.0}, {}, {}}, {Sphere{1.0}, {d, 0, 0}, {}}};
-  const double exact = 2.0 * 4.0 / 3.0 * kPi - kPi * (4.0 + d) * std::pow(2.0 - d, 2) / 12.0;
+  const double exact = 2.0 * 4.0 / 3.0 * std::numbers::pi - std::numbers::pi * (4.0 + d) * std::pow(2.0 - d, 2) / 12.0;
   double previous_bound = exact;
   for (const int resolution : {16, 32, 64}) {
     const MassProperties m = composite_mass_properties(pair, resolution);
