@@ -20,7 +20,6 @@
 namespace sanguis::geometry {
 namespace {
 
-
 void expect_mat_near(const Mat3& a, const Mat3& b, double tol) {
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) EXPECT_NEAR(a(i, j), b(i, j), tol) << "(" << i << "," << j << ")";
@@ -122,7 +121,8 @@ TEST(MassProperties, OverlappingSpheresWithinTheStatedBound) {
   // Two unit spheres d = 1 apart: union = 2 V - lens, lens = pi (4r + d)(2r - d)^2 / 12.
   const double d = 1.0;
   const Composite pair = {{Sphere{1.0}, {}, {}}, {Sphere{1.0}, {d, 0, 0}, {}}};
-  const double exact = 2.0 * 4.0 / 3.0 * std::numbers::pi - std::numbers::pi * (4.0 + d) * std::pow(2.0 - d, 2) / 12.0;
+  const double exact = 2.0 * 4.0 / 3.0 * std::numbers::pi -
+                       std::numbers::pi * (4.0 + d) * std::pow(2.0 - d, 2) / 12.0;
   double previous_bound = exact;
   for (const int resolution : {16, 32, 64}) {
     const MassProperties m = composite_mass_properties(pair, resolution);
