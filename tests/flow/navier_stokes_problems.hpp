@@ -1,6 +1,7 @@
 #pragma once
 // Helpers shared by the Navier-Stokes tests (uniform, refined, adaptive):
-// all-periodic boundaries, a deterministic rough field, volume integrals.
+// all-periodic boundaries, the sheared channel, the periodic cube forest, a
+// deterministic rough field, volume integrals.
 
 #include <array>
 #include <cmath>
@@ -14,6 +15,24 @@ inline std::array<FlowBoundary, 6> all_periodic() {
   std::array<FlowBoundary, 6> bcs{};
   for (auto& bc : bcs) bc.kind = FlowBoundaryKind::Periodic;
   return bcs;
+}
+
+/// Channel periodic in x and z, walls at y = 0 and y = H (the upper one moving with `lid`).
+inline std::array<FlowBoundary, 6> channel(double lid) {
+  auto bcs = all_periodic();
+  bcs[face_index(1, 0)].kind = FlowBoundaryKind::Wall;
+  bcs[face_index(1, 1)].kind = FlowBoundaryKind::Wall;
+  bcs[face_index(1, 1)].wall_velocity = {lid, 0.0, 0.0};
+  return bcs;
+}
+
+/// Periodic unit cube, 8 blocks of 8^3 cells (16^3 cells).
+inline ForestSpec periodic_cube(int threads = 1) {
+  ForestSpec spec;
+  spec.level = 1;
+  spec.periodic = {true, true, true};
+  spec.threads = threads;
+  return spec;
 }
 
 /// The lid-driven cavity: walls all round, the lid y = max moving along x at 1.

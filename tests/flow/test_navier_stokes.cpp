@@ -17,18 +17,10 @@ namespace {
 
 using testing::all_periodic;
 using testing::cell_centre;
+using testing::channel;
 using testing::kPi;
 using testing::rough;
 using testing::total;
-
-/// Channel periodic in x and z, walls at y = 0 and y = H (the upper one moving with `lid`).
-std::array<FlowBoundary, 6> channel(double lid) {
-  auto bcs = all_periodic();
-  bcs[face_index(1, 0)].kind = FlowBoundaryKind::Wall;
-  bcs[face_index(1, 1)].kind = FlowBoundaryKind::Wall;
-  bcs[face_index(1, 1)].wall_velocity = {lid, 0.0, 0.0};
-  return bcs;
-}
 
 /// Taylor-Green vortex in the unit square (periodic, one block thick in z),
 /// max velocity error at t_end with dt proportional to h.

@@ -23,17 +23,9 @@ using testing::all_periodic;
 using testing::block_centre;
 using testing::cell_centre;
 using testing::kPi;
+using testing::periodic_cube;
 using testing::rough;
 using testing::total;
-
-/// Periodic unit cube, 8 blocks of 8^3 cells (16^3 cells).
-ForestSpec periodic_cube(int threads = 1) {
-  ForestSpec spec;
-  spec.level = 1;
-  spec.periodic = {true, true, true};
-  spec.threads = threads;
-  return spec;
-}
 
 /// One flag per local block from a predicate on the block.
 template <typename Decide>

@@ -20,19 +20,12 @@ namespace {
 
 using testing::all_periodic;
 using testing::cell_centre;
+using testing::channel;
 using testing::kPi;
+using testing::periodic_cube;
 using testing::refine_where;
 using testing::rough;
 using testing::total;
-
-/// Channel periodic in x and z, walls at y = 0 and y = H (the upper one moving with `lid`).
-std::array<FlowBoundary, 6> refined_channel(double lid) {
-  auto bcs = all_periodic();
-  bcs[face_index(1, 0)].kind = FlowBoundaryKind::Wall;
-  bcs[face_index(1, 1)].kind = FlowBoundaryKind::Wall;
-  bcs[face_index(1, 1)].wall_velocity = {lid, 0.0, 0.0};
-  return bcs;
-}
 
 /// Periodic unit cube, 16^3 cells in 8 blocks, the two blocks at x, y < 1/2
 /// refined: coarse-fine faces along x and y, edges and corners included.
@@ -40,15 +33,8 @@ void refine_two_blocks(Forest& forest) {
   refine_where(forest, [](const Vec3& c) { return c.x < 0.5 && c.y < 0.5; });
 }
 
-ForestSpec refined_periodic_cube() {
-  ForestSpec spec;
-  spec.level = 1;
-  spec.periodic = {true, true, true};
-  return spec;
-}
-
 TEST(FlowRefinedNavierStokes, ProjectionLeavesEveryCellDivergenceFree) {
-  Forest forest(refined_periodic_cube());
+  Forest forest(periodic_cube());
   refine_two_blocks(forest);
   ASSERT_EQ(forest.max_level(), forest.min_level() + 1);
   NavierStokesOptions options;
@@ -69,7 +55,7 @@ TEST(FlowRefinedNavierStokes, ProjectionLeavesEveryCellDivergenceFree) {
 }
 
 TEST(FlowRefinedNavierStokes, TracerAndFluxesAreConservedAcrossCoarseFineFaces) {
-  Forest forest(refined_periodic_cube());
+  Forest forest(periodic_cube());
   refine_two_blocks(forest);
   NavierStokesOptions options;
   options.pressure.tolerance = 1e-10;
@@ -105,7 +91,7 @@ TEST(FlowRefinedNavierStokes, TracerAndFluxesAreConservedAcrossCoarseFineFaces) 
 }
 
 TEST(FlowRefinedNavierStokes, TimeStepFollowsTheCflConditionOnTheFinestCells) {
-  Forest forest(refined_periodic_cube());
+  Forest forest(periodic_cube());
   refine_two_blocks(forest);
   NavierStokesOptions options;
   options.cfl = 0.8;
@@ -118,7 +104,7 @@ TEST(FlowRefinedNavierStokes, TimeStepFollowsTheCflConditionOnTheFinestCells) {
 
 TEST(FlowRefinedNavierStokes, TwoThreadsGiveTheOneThreadAnswerBitForBit) {
   auto run = [](int threads) {
-    ForestSpec spec = refined_periodic_cube();
+    ForestSpec spec = periodic_cube();
     spec.threads = threads;
     Forest forest(spec);
     refine_two_blocks(forest);
@@ -283,7 +269,7 @@ TEST(FlowRefinedNavierStokes, CouetteAcrossARefinedBandIsExactlyLinear) {
   NavierStokesOptions options;
   options.pressure.tolerance = 1e-10;
   options.viscous.tolerance = 1e-10;
-  NavierStokes ns(forest, refined_channel(U), Fluid{rho, mu}, options);
+  NavierStokes ns(forest, channel(U), Fluid{rho, mu}, options);
   ns.set_velocity([](const Vec3&) { return Vec3{}; });
   for (int s = 0; s < 500; ++s) ns.step(dt);  // 50 diffusion times H^2 rho / mu
   const auto [worst, cross] = profile_deviation(forest, ns, [&](double y) { return U * y / H; });
@@ -302,7 +288,7 @@ TEST(FlowRefinedNavierStokes, PoiseuilleFlowRateAcrossARefinedBand) {
   NavierStokesOptions options;
   options.dt_max = 0.01;
   options.viscous.tolerance = 1e-10;
-  NavierStokes ns(forest, refined_channel(0.0), Fluid{1.0, mu}, options);
+  NavierStokes ns(forest, channel(0.0), Fluid{1.0, mu}, options);
   ns.set_velocity([](const Vec3&) { return Vec3{}; });
   ns.set_body_force([G](const Vec3&) { return Vec3{G, 0.0, 0.0}; });
   for (int s = 0; s < 300; ++s) ns.step(ns.stable_dt());  // 3 diffusion times
@@ -348,7 +334,7 @@ std::pair<double, double> layered_couette(Viscosity&& mu, Exact&& exact) {
   options.dt_max = 0.01;
   options.pressure.tolerance = 1e-10;
   options.viscous.tolerance = 1e-10;
-  NavierStokes ns(forest, refined_channel(1.0), Fluid{1.0, 1.0}, options);
+  NavierStokes ns(forest, channel(1.0), Fluid{1.0, 1.0}, options);
   ns.set_viscosity(mu);
   ns.set_velocity([](const Vec3&) { return Vec3{}; });
   for (int s = 0; s < 400; ++s) ns.step(ns.stable_dt());
@@ -399,7 +385,7 @@ TEST(FlowRefinedNavierStokes, ViscousForceIntegratesToZeroOnAPeriodicRefinedFore
   // face share (the coarse face takes the fine faces' mean), so its volume
   // integral vanishes to round-off. This is the explicit part of the step
   // (the grad u^T stress, the Crank-Nicolson half).
-  Forest forest(refined_periodic_cube());
+  Forest forest(periodic_cube());
   refine_two_blocks(forest);
   NavierStokes ns(forest, all_periodic(), Fluid{1.0, 1.0});
   ns.set_viscosity([](const Vec3& x) {
