@@ -176,6 +176,30 @@ double closure_implicit(const std::array<int, 3>& n, int b, const ClosedFaces& f
   return implicit;
 }
 
+/// Per face (face_index order), the cells of the block across it when that
+/// is a same-level block of this process, else null (the stencil reads the
+/// ghost layer). The fused smoother reads such neighbours in place instead of
+/// copying their face into the ghost layer first: the same values, so the
+/// same bits (Forest::copy_face_ghosts took 15 % of the 64^3 cavity with 8^3
+/// blocks, docs/performance.md).
+struct AcrossFaces {
+  std::array<const double*, 6> cells{};
+};
+
+/// The AcrossFaces of block `blk` of x.
+AcrossFaces same_level_neighbours(const Forest& forest, const BlockField& x, int blk) {
+  AcrossFaces across;
+  const Block& block = forest.block(blk);
+  for (int d = 0; d < 3; ++d)
+    for (int side = 0; side < 2; ++side) {
+      const Neighbour& nb = block.neighbours[D(face_neighbour_slot(d, side))];
+      if (nb.link == Link::Local && nb.jump == LevelJump::Same) {
+        across.cells[D(face_index(d, side))] = x.block(nb.index);
+      }
+    }
+  return across;
+}
+
 /// Red-black Gauss-Seidel on the cells of one colour (i + j + k + first even)
 /// of a block whose alpha and beta are constants: relaxed_value, the same
 /// operations in the same order, with the implicit part of smooth() (the
@@ -183,7 +207,7 @@ double closure_implicit(const std::array<int, 3>& n, int b, const ClosedFaces& f
 /// (the smoother is memory-bound).
 inline void relax_constant(double* x, const double* rhs, const BlockLayout& L, int first,
                            double alpha, double beta, double inv_h2, double omega,
-                           const ClosedFaces& faces) {
+                           const ClosedFaces& faces, const AcrossFaces& across) {
   const int b = L.cells;
   const std::ptrdiff_t sy = L.stride(1), sz = L.stride(2);
   auto diagonal = [&](double implicit) {
@@ -204,7 +228,27 @@ inline void relax_constant(double* x, const double* rhs, const BlockLayout& L, i
                                (j == b - 1 && closed[D(face_index(1, 1))]) ||
                                (k == 0 && closed[D(face_index(2, 0))]) ||
                                (k == b - 1 && closed[D(face_index(2, 1))]);
-      for (int i = (k + j + first) & 1; i < b; i += 2) {
+      // The neighbouring rows, in this block or, across a face to a
+      // same-level block of this process, in that block (its cells of the
+      // other colour: no block writes them in this half-sweep).
+      const double* y_lo =
+          j > 0 || !across.cells[2] ? row - sy : across.cells[2] + L.index(0, b - 1, k);
+      const double* y_hi =
+          j < b - 1 || !across.cells[3] ? row + sy : across.cells[3] + L.index(0, 0, k);
+      const double* z_lo =
+          k > 0 || !across.cells[4] ? row - sz : across.cells[4] + L.index(0, j, b - 1);
+      const double* z_hi =
+          k < b - 1 || !across.cells[5] ? row + sz : across.cells[5] + L.index(0, j, 0);
+      const int i_first = (k + j + first) & 1;
+      // Along x the row's two ghosts, written here from the neighbours (one
+      // value each, in a cache line the row reads anyway) when this colour
+      // has the end cell beside them: the other colour's end cells are being
+      // written, so only this colour's outer neighbours are read.
+      if (i_first == 0 && across.cells[0]) row[-1] = across.cells[0][L.index(b - 1, j, k)];
+      if (((b - 1 - i_first) & 1) == 0 && across.cells[1]) {
+        row[b] = across.cells[1][L.index(0, j, k)];
+      }
+      for (int i = i_first; i < b; i += 2) {
         double implicit = 0.0;
         double den = interior;
         if (closure_row) {
@@ -214,8 +258,8 @@ inline void relax_constant(double* x, const double* rhs, const BlockLayout& L, i
         }
         double num = f[i] + implicit * inv_h2 * row[i];
         num += inv_h2 * (beta * row[i - 1] + beta * row[i + 1]);
-        num += inv_h2 * (beta * row[i - sy] + beta * row[i + sy]);
-        num += inv_h2 * (beta * row[i - sz] + beta * row[i + sz]);
+        num += inv_h2 * (beta * y_lo[i] + beta * y_hi[i]);
+        num += inv_h2 * (beta * z_lo[i] + beta * z_hi[i]);
         row[i] += omega * (num / den - row[i]);
       }
     }
@@ -227,20 +271,33 @@ inline void relax_constant(double* x, const double* rhs, const BlockLayout& L, i
 /// when kSquares (else 0: the V-cycle's residual needs no norm, and its loop
 /// then vectorises without the ordered sum).
 template <bool kSquares>
-inline double residual_constant(const double* x, const double* rhs, double* r, const BlockLayout& L,
-                                double alpha, double beta, double inv_h2) {
+inline double residual_constant(double* x, const double* rhs, double* r, const BlockLayout& L,
+                                double alpha, double beta, double inv_h2,
+                                const AcrossFaces& across) {
   const int b = L.cells;
   const std::ptrdiff_t sy = L.stride(1), sz = L.stride(2);
   double squares = 0.0;
   for (int k = 0; k < b; ++k)
     for (int j = 0; j < b; ++j) {
       const std::ptrdiff_t row = L.index(0, j, k);
-      const double* xr = x + row;
+      double* xr = x + row;
+      // The neighbouring rows and the row's ghosts along x as in
+      // relax_constant (no cell is written meanwhile).
+      const double* y_lo =
+          j > 0 || !across.cells[2] ? xr - sy : across.cells[2] + L.index(0, b - 1, k);
+      const double* y_hi =
+          j < b - 1 || !across.cells[3] ? xr + sy : across.cells[3] + L.index(0, 0, k);
+      const double* z_lo =
+          k > 0 || !across.cells[4] ? xr - sz : across.cells[4] + L.index(0, j, b - 1);
+      const double* z_hi =
+          k < b - 1 || !across.cells[5] ? xr + sz : across.cells[5] + L.index(0, j, 0);
+      if (across.cells[0]) xr[-1] = across.cells[0][L.index(b - 1, j, k)];
+      if (across.cells[1]) xr[b] = across.cells[1][L.index(0, j, k)];
       for (int i = 0; i < b; ++i) {
         double ax = alpha * xr[i];
         ax -= inv_h2 * (beta * (xr[i + 1] - xr[i]) - beta * (xr[i] - xr[i - 1]));
-        ax -= inv_h2 * (beta * (xr[i + sy] - xr[i]) - beta * (xr[i] - xr[i - sy]));
-        ax -= inv_h2 * (beta * (xr[i + sz] - xr[i]) - beta * (xr[i] - xr[i - sz]));
+        ax -= inv_h2 * (beta * (y_hi[i] - xr[i]) - beta * (xr[i] - y_lo[i]));
+        ax -= inv_h2 * (beta * (z_hi[i] - xr[i]) - beta * (xr[i] - z_lo[i]));
         const double value = rhs[row + i] - ax;  // the general residual's factor active is 1 here
         r[row + i] = value;
         if constexpr (kSquares) squares += value * value;
@@ -644,9 +701,9 @@ void Multigrid::fill_ghosts_between_blocks_apart(int level, BlockField& x) {
   if (composite_) match_fluxes(level, x);
 }
 
-void Multigrid::fill_block_ghosts(int blk, BlockField& x, const ScalarBoundary* bc,
-                                  int colour) const {
-  forest_.copy_face_ghosts(x, blk, colour);
+void Multigrid::fill_block_ghosts(int blk, BlockField& x, const ScalarBoundary* bc, int colour,
+                                  bool same_level) const {
+  if (same_level) forest_.copy_face_ghosts(x, blk, colour);
   if (bc) {
     fill_block_boundary_ghosts(forest_, x, blk, bc->kind, &bc->value, 1, colour);
   } else {
@@ -655,7 +712,7 @@ void Multigrid::fill_block_ghosts(int blk, BlockField& x, const ScalarBoundary* 
 }
 
 void Multigrid::relax_block(int level, int blk, BlockField& x, const BlockField& rhs,
-                            const ScalarBoundary* bc, int colour) const {
+                            const ScalarBoundary* bc, int colour, bool in_place) const {
   const Level& lv = levels_[D(level)];
   const BlockLayout L = x.layout();
   const int b = L.cells;
@@ -700,8 +757,9 @@ void Multigrid::relax_block(int level, int blk, BlockField& x, const BlockField&
   }
   const auto at = static_cast<std::size_t>(blk);
   if (constant_kernels_ && lv.block_constant[at]) {
+    const AcrossFaces across = in_place ? same_level_neighbours(forest_, x, blk) : AcrossFaces{};
     relax_constant(xb, rb, L, (parity + colour) & 1, lv.block_alpha[at], lv.block_beta[at], inv_h2,
-                   omega_, faces);
+                   omega_, faces, across);
     return;
   }
   for (int kk = 0; kk < b; ++kk)
@@ -728,6 +786,7 @@ void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const Sc
   // on any number of threads. The other faces (level jumps, other ranks, and
   // the matched fluxes) are filled first, as before.
   const bool fused = b % 2 == 0;
+  const Level& lv = levels_[D(level)];
   for (int sweep = 0; sweep < sweeps; ++sweep) {
     for (int colour = 0; colour < 2; ++colour) {
       if (fused) {
@@ -735,13 +794,17 @@ void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const Sc
       } else {
         fill_ghosts(level, x, bc, true);  // the 7-point stencil reads face ghosts only
       }
+      // A block of the constant-coefficient kernels reads its same-level
+      // neighbours of this process in place instead (relax_constant).
       const auto relax = [&](int blk) {
-        if (fused) fill_block_ghosts(blk, x, bc, 1 - colour);
-        relax_block(level, blk, x, rhs, bc, colour);
+        const bool in_place =
+            fused && constant_kernels_ && lv.block_constant[static_cast<std::size_t>(blk)];
+        if (fused) fill_block_ghosts(blk, x, bc, 1 - colour, !in_place);
+        relax_block(level, blk, x, rhs, bc, colour, in_place);
       };
       // In a half-sweep each block writes only its own cells and ghosts, and
-      // reads other blocks only through ghosts copied from cells of the
-      // colour no block writes in it; so its block order is free. The second
+      // reads other blocks only through ghosts copied from, or in place in,
+      // cells of the colour no block writes in it; so its block order is free. The second
       // colour runs backwards over each thread's blocks and starts on those
       // the first one left in cache (what a grid larger than the cache
       // saves), with the same bits.
@@ -755,7 +818,8 @@ void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const Sc
 }
 
 void Multigrid::compute_residual(int level, BlockField& x, const BlockField& rhs,
-                                 const ScalarBoundary* bc, BlockField& r, bool squares_wanted) {
+                                 const ScalarBoundary* bc, BlockField& r, bool squares_wanted,
+                                 bool ghosts_wanted) {
   const Level& lv = levels_[D(level)];
   const BlockLayout L = x.layout();
   const int b = L.cells;
@@ -763,22 +827,26 @@ void Multigrid::compute_residual(int level, BlockField& x, const BlockField& rhs
   fill_ghosts_between_blocks_apart(level, x);  // the rest block by block, as in smooth()
   block_squares_.resize(static_cast<std::size_t>(forest_.local_blocks()));
   forest_.for_each_block([&](int blk) {
-    fill_block_ghosts(blk, x, bc, -1);
+    const auto at = static_cast<std::size_t>(blk);
+    // The constant-coefficient blocks read their same-level neighbours of
+    // this process in place (residual_constant), unless the ghosts are wanted.
+    const bool in_place = !ghosts_wanted && constant_kernels_ && lv.block_constant[at];
+    fill_block_ghosts(blk, x, bc, -1, !in_place);
     const double h = forest_.block(blk).length / b;
     const double inv_h2 = 1.0 / (h * h);
     const BlockCoefficients k{
         lv.alpha.block(blk), {lv.beta[0].block(blk), lv.beta[1].block(blk), lv.beta[2].block(blk)}};
-    const double* xb = x.block(blk);
+    double* xb = x.block(blk);
     const double* fb = rhs.block(blk);
     const double* ab = lv.active.block(blk);
     double* rb = r.block(blk);
-    const auto at = static_cast<std::size_t>(blk);
     if (constant_kernels_ && lv.block_constant[at]) {
+      const AcrossFaces across = in_place ? same_level_neighbours(forest_, x, blk) : AcrossFaces{};
       block_squares_[at] = squares_wanted
                                ? residual_constant<true>(xb, fb, rb, L, lv.block_alpha[at],
-                                                         lv.block_beta[at], inv_h2)
+                                                         lv.block_beta[at], inv_h2, across)
                                : residual_constant<false>(xb, fb, rb, L, lv.block_alpha[at],
-                                                          lv.block_beta[at], inv_h2);
+                                                          lv.block_beta[at], inv_h2, across);
       return;
     }
     double squares = 0.0;
@@ -951,7 +1019,7 @@ void Multigrid::shift_interior(BlockField& f, double by) const {
 
 void Multigrid::residual(BlockField& x, const BlockField& rhs, const ScalarBoundary& bc,
                          BlockField& r) {
-  compute_residual(0, x, rhs, &bc, r);
+  compute_residual(0, x, rhs, &bc, r, true, true);
 }
 
 void Multigrid::take_options(const MultigridOptions& options) {

@@ -148,20 +148,27 @@ class Multigrid {
   void fill_ghosts_between_blocks_apart(int level, BlockField& x);
   /// The rest of fill_ghosts(.., faces_only) for block `blk` alone: its face
   /// ghosts towards same-level blocks of this rank (`colour` as in
-  /// Forest::copy_face_ghosts) and its boundary ghosts.
-  void fill_block_ghosts(int blk, BlockField& x, const ScalarBoundary* bc, int colour) const;
+  /// Forest::copy_face_ghosts; not when !same_level, for a smoother that reads
+  /// those neighbours in place) and its boundary ghosts.
+  void fill_block_ghosts(int blk, BlockField& x, const ScalarBoundary* bc, int colour,
+                         bool same_level = true) const;
   /// `sweeps` red-black sweeps over every block.
   void smooth(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc,
               int sweeps);
-  /// One half-sweep (the cells of `colour`) of block `blk`, ghosts filled.
+  /// One half-sweep (the cells of `colour`) of block `blk`, ghosts filled;
+  /// with `in_place` a constant-coefficient block reads the cells of its
+  /// same-level neighbours of this rank in place (their ghosts not copied).
   void relax_block(int level, int blk, BlockField& x, const BlockField& rhs,
-                   const ScalarBoundary* bc, int colour) const;
+                   const ScalarBoundary* bc, int colour, bool in_place = false) const;
   /// r = rhs - A x on `level`, and each block's sum of r^2 into
   /// block_squares_ (one pass: summed as r is written; root_mean_square()),
   /// unless !squares_wanted (the V-cycle's residual, only restricted): then
-  /// the constant-coefficient blocks' sums are not formed.
+  /// the constant-coefficient blocks' sums are not formed. Unless
+  /// ghosts_wanted, the constant-coefficient blocks read their same-level
+  /// neighbours of this rank in place, and x's ghosts towards them are left
+  /// as they were.
   void compute_residual(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc,
-                        BlockField& r, bool squares_wanted = true);
+                        BlockField& r, bool squares_wanted = true, bool ghosts_wanted = false);
   void vcycle(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc);
   void coarse_solve();
   void build_coarse_operator();
