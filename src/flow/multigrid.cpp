@@ -186,6 +186,21 @@ struct AcrossFaces {
   std::array<const double*, 6> cells{};
 };
 
+/// The rows beside row (j, k) along y and z (y_lo, y_hi, z_lo, z_hi): in
+/// the block itself (its ghost layer at a face without a neighbour in
+/// `across`), or in the same-level neighbour across that face.
+[[gnu::always_inline]] inline std::array<const double*, 4> neighbour_rows(const double* row,
+                                                                          const BlockLayout& L,
+                                                                          const AcrossFaces& across,
+                                                                          int j, int k) {
+  const int b = L.cells;
+  const std::ptrdiff_t sy = L.stride(1), sz = L.stride(2);
+  return {j > 0 || !across.cells[2] ? row - sy : across.cells[2] + L.index(0, b - 1, k),
+          j < b - 1 || !across.cells[3] ? row + sy : across.cells[3] + L.index(0, 0, k),
+          k > 0 || !across.cells[4] ? row - sz : across.cells[4] + L.index(0, j, b - 1),
+          k < b - 1 || !across.cells[5] ? row + sz : across.cells[5] + L.index(0, j, 0)};
+}
+
 /// The AcrossFaces of block `blk` of x.
 AcrossFaces same_level_neighbours(const Forest& forest, const BlockField& x, int blk) {
   AcrossFaces across;
@@ -209,7 +224,6 @@ inline void relax_constant(double* x, const double* rhs, const BlockLayout& L, i
                            double alpha, double beta, double inv_h2, double omega,
                            const ClosedFaces& faces, const AcrossFaces& across) {
   const int b = L.cells;
-  const std::ptrdiff_t sy = L.stride(1), sz = L.stride(2);
   auto diagonal = [&](double implicit) {
     double den = alpha + implicit * inv_h2;
     for (int d = 0; d < 3; ++d) den += inv_h2 * (beta + beta);
@@ -228,17 +242,9 @@ inline void relax_constant(double* x, const double* rhs, const BlockLayout& L, i
                                (j == b - 1 && closed[D(face_index(1, 1))]) ||
                                (k == 0 && closed[D(face_index(2, 0))]) ||
                                (k == b - 1 && closed[D(face_index(2, 1))]);
-      // The neighbouring rows, in this block or, across a face to a
-      // same-level block of this process, in that block (its cells of the
-      // other colour: no block writes them in this half-sweep).
-      const double* y_lo =
-          j > 0 || !across.cells[2] ? row - sy : across.cells[2] + L.index(0, b - 1, k);
-      const double* y_hi =
-          j < b - 1 || !across.cells[3] ? row + sy : across.cells[3] + L.index(0, 0, k);
-      const double* z_lo =
-          k > 0 || !across.cells[4] ? row - sz : across.cells[4] + L.index(0, j, b - 1);
-      const double* z_hi =
-          k < b - 1 || !across.cells[5] ? row + sz : across.cells[5] + L.index(0, j, 0);
+      // The neighbouring rows (a neighbour's cells of the other colour: no
+      // block writes them in this half-sweep).
+      const auto [y_lo, y_hi, z_lo, z_hi] = neighbour_rows(row, L, across, j, k);
       const int i_first = (k + j + first) & 1;
       // Along x the row's two ghosts, written here from the neighbours (one
       // value each, in a cache line the row reads anyway) when this colour
@@ -275,7 +281,6 @@ inline double residual_constant(double* x, const double* rhs, double* r, const B
                                 double alpha, double beta, double inv_h2,
                                 const AcrossFaces& across) {
   const int b = L.cells;
-  const std::ptrdiff_t sy = L.stride(1), sz = L.stride(2);
   double squares = 0.0;
   for (int k = 0; k < b; ++k)
     for (int j = 0; j < b; ++j) {
@@ -283,14 +288,7 @@ inline double residual_constant(double* x, const double* rhs, double* r, const B
       double* xr = x + row;
       // The neighbouring rows and the row's ghosts along x as in
       // relax_constant (no cell is written meanwhile).
-      const double* y_lo =
-          j > 0 || !across.cells[2] ? xr - sy : across.cells[2] + L.index(0, b - 1, k);
-      const double* y_hi =
-          j < b - 1 || !across.cells[3] ? xr + sy : across.cells[3] + L.index(0, 0, k);
-      const double* z_lo =
-          k > 0 || !across.cells[4] ? xr - sz : across.cells[4] + L.index(0, j, b - 1);
-      const double* z_hi =
-          k < b - 1 || !across.cells[5] ? xr + sz : across.cells[5] + L.index(0, j, 0);
+      const auto [y_lo, y_hi, z_lo, z_hi] = neighbour_rows(xr, L, across, j, k);
       if (across.cells[0]) xr[-1] = across.cells[0][L.index(b - 1, j, k)];
       if (across.cells[1]) xr[b] = across.cells[1][L.index(0, j, k)];
       for (int i = 0; i < b; ++i) {
