@@ -802,10 +802,10 @@ void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const Sc
       };
       // In a half-sweep each block writes only its own cells and ghosts, and
       // reads other blocks only through ghosts copied from, or in place in,
-      // cells of the colour no block writes in it; so its block order is free. The second
-      // colour runs backwards over each thread's blocks and starts on those
-      // the first one left in cache (what a grid larger than the cache
-      // saves), with the same bits.
+      // cells of the colour no block writes in it; so its block order is
+      // free. The second colour runs backwards over each thread's blocks and
+      // starts on those the first one left in cache (what a grid larger than
+      // the cache saves), with the same bits.
       if (colour == 0) {
         forest_.for_each_block(relax);
       } else {
