@@ -64,7 +64,9 @@ struct MultigridOptions {
   bool constant_coefficient_kernels = true;
   /// Fill x's ghosts (neighbours and bc) before returning. false where the
   /// caller refills them anyway (the viscous solves: the velocity's ghosts
-  /// are filled again before anything reads them), saving a full exchange.
+  /// are filled again before anything reads them), saving a full exchange;
+  /// x's ghosts are then stale (the constant-coefficient kernels read
+  /// same-level neighbours in place and leave those ghosts as they were).
   bool fill_ghosts_on_return = true;
 };
 
