@@ -178,10 +178,10 @@ double closure_implicit(const std::array<int, 3>& n, int b, const ClosedFaces& f
 
 /// Per face (face_index order), the cells of the block across it when that
 /// is a same-level block of this process, else null (the stencil reads the
-/// ghost layer). The fused smoother reads such neighbours in place instead of
-/// copying their face into the ghost layer first: the same values, so the
-/// same bits (Forest::copy_face_ghosts took 15 % of the 64^3 cavity with 8^3
-/// blocks, docs/performance.md).
+/// ghost layer). The fused smoother and the V-cycle's residual read such
+/// neighbours in place instead of copying their face into the ghost layer
+/// first: the same values, so the same bits (Forest::copy_face_ghosts took 15 % of the 64^3 cavity
+/// with 8^3 blocks, docs/performance.md).
 struct AcrossFaces {
   std::array<const double*, 6> cells{};
 };
