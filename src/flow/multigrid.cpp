@@ -22,22 +22,39 @@ struct BlockCoefficients {
   std::array<const double*, 3> beta;
 };
 
-/// The new value of cell c under Gauss-Seidel for eq. (1). `implicit`
-/// (times inv_h2) is added to the diagonal and, times the old value, to the
-/// numerator: the part of the ghost values that depends on the cell itself
-/// (quadratic Dirichlet closure), treated implicitly.
-inline double relaxed_value(const double* x, double rhs, const BlockCoefficients& k,
+/// The cells around cell i of a row: the row itself (its neighbours along x
+/// at i - 1 and i + 1, ghosts at the ends) and the rows beside it along y
+/// and z, in this block (cells or ghost layer) or in a same-level neighbour
+/// read in place (neighbour_rows).
+struct RowStencil {
+  const double* row;
+  std::array<const double*, 4> beside;  ///< y_lo, y_hi, z_lo, z_hi
+  [[nodiscard]] double low(int d, int i) const {
+    return d == 0 ? row[i - 1] : beside[D(2 * d - 2)][i];
+  }
+  [[nodiscard]] double high(int d, int i) const {
+    return d == 0 ? row[i + 1] : beside[D(2 * d - 1)][i];
+  }
+};
+
+/// The new value of cell c (cell i of the row of `x`) under Gauss-Seidel
+/// for eq. (1). `implicit` (times inv_h2) is added to the diagonal and,
+/// times the old value, to the numerator: the part of the ghost values that
+/// depends on the cell itself (quadratic Dirichlet closure), treated
+/// implicitly. `s`: the coefficient arrays' strides (the faces of c are c
+/// and c + s[d]).
+inline double relaxed_value(const RowStencil& x, int i, double rhs, const BlockCoefficients& k,
                             std::ptrdiff_t c, const std::array<std::ptrdiff_t, 3>& s, double inv_h2,
                             double implicit = 0.0) {
-  double num = rhs + implicit * inv_h2 * x[c];
+  double num = rhs + implicit * inv_h2 * x.row[i];
   double den = k.alpha[c] + implicit * inv_h2;
   for (int d = 0; d < 3; ++d) {
     const double lo = k.beta[D(d)][c];
     const double hi = k.beta[D(d)][c + s[D(d)]];
-    num += inv_h2 * (lo * x[c - s[D(d)]] + hi * x[c + s[D(d)]]);
+    num += inv_h2 * (lo * x.low(d, i) + hi * x.high(d, i));
     den += inv_h2 * (lo + hi);
   }
-  return den > 0.0 ? num / den : x[c];  // a cell cut off on all sides (solid) keeps its value
+  return den > 0.0 ? num / den : x.row[i];  // a cell cut off on all sides (solid) keeps its value
 }
 
 /// The finest level's operator is the flow's: its fine ghosts beside a
@@ -120,14 +137,16 @@ inline double matched_diagonal(bool composite) {
 }
 constexpr double kFineFaceDiagonal = 0.0;
 
-/// (A x)_c = alpha x_c - div(beta grad x)_c, eq. (1).
-inline double applied(const double* x, const BlockCoefficients& k, std::ptrdiff_t c,
+/// (A x)_c = alpha x_c - div(beta grad x)_c, eq. (1), at cell c (cell i of
+/// the row of `x`).
+inline double applied(const RowStencil& x, int i, const BlockCoefficients& k, std::ptrdiff_t c,
                       const std::array<std::ptrdiff_t, 3>& s, double inv_h2) {
-  double ax = k.alpha[c] * x[c];
+  const double centre = x.row[i];
+  double ax = k.alpha[c] * centre;
   for (int d = 0; d < 3; ++d) {
     const double lo = k.beta[D(d)][c];
     const double hi = k.beta[D(d)][c + s[D(d)]];
-    ax -= inv_h2 * (hi * (x[c + s[D(d)]] - x[c]) - lo * (x[c] - x[c - s[D(d)]]));
+    ax -= inv_h2 * (hi * (x.high(d, i) - centre) - lo * (centre - x.low(d, i)));
   }
   return ax;
 }
@@ -215,6 +234,18 @@ AcrossFaces same_level_neighbours(const Forest& forest, const BlockField& x, int
   return across;
 }
 
+/// The row's two ghosts along x, copied from the same-level neighbours read
+/// in place (one value each, in a cache line the row reads anyway). In a
+/// half-sweep only where this colour has the end cell beside the ghost: the
+/// other colour's end cells are being written by the neighbour's thread.
+[[gnu::always_inline]] inline void pull_row_x_ghosts(double* row, const BlockLayout& L,
+                                                     const AcrossFaces& across, int j, int k,
+                                                     bool low, bool high) {
+  const int b = L.cells;
+  if (low && across.cells[0]) row[-1] = across.cells[0][L.index(b - 1, j, k)];
+  if (high && across.cells[1]) row[b] = across.cells[1][L.index(0, j, k)];
+}
+
 /// Red-black Gauss-Seidel on the cells of one colour (i + j + k + first even)
 /// of a block whose alpha and beta are constants: relaxed_value, the same
 /// operations in the same order, with the implicit part of smooth() (the
@@ -246,14 +277,7 @@ inline void relax_constant(double* x, const double* rhs, const BlockLayout& L, i
       // block writes them in this half-sweep).
       const auto [y_lo, y_hi, z_lo, z_hi] = neighbour_rows(row, L, across, j, k);
       const int i_first = (k + j + first) & 1;
-      // Along x the row's two ghosts, written here from the neighbours (one
-      // value each, in a cache line the row reads anyway) when this colour
-      // has the end cell beside them: the other colour's end cells are being
-      // written, so only this colour's outer neighbours are read.
-      if (i_first == 0 && across.cells[0]) row[-1] = across.cells[0][L.index(b - 1, j, k)];
-      if (((b - 1 - i_first) & 1) == 0 && across.cells[1]) {
-        row[b] = across.cells[1][L.index(0, j, k)];
-      }
+      pull_row_x_ghosts(row, L, across, j, k, i_first == 0, ((b - 1 - i_first) & 1) == 0);
       for (int i = i_first; i < b; i += 2) {
         double implicit = 0.0;
         double den = interior;
@@ -289,8 +313,7 @@ inline double residual_constant(double* x, const double* rhs, double* r, const B
       // The neighbouring rows and the row's ghosts along x as in
       // relax_constant (no cell is written meanwhile).
       const auto [y_lo, y_hi, z_lo, z_hi] = neighbour_rows(xr, L, across, j, k);
-      if (across.cells[0]) xr[-1] = across.cells[0][L.index(b - 1, j, k)];
-      if (across.cells[1]) xr[b] = across.cells[1][L.index(0, j, k)];
+      pull_row_x_ghosts(xr, L, across, j, k, true, true);
       for (int i = 0; i < b; ++i) {
         double ax = alpha * xr[i];
         ax -= inv_h2 * (beta * (xr[i + 1] - xr[i]) - beta * (xr[i] - xr[i - 1]));
@@ -754,23 +777,31 @@ void Multigrid::relax_block(int level, int blk, BlockField& x, const BlockField&
       }
   }
   const auto at = static_cast<std::size_t>(blk);
+  const int first = (parity + colour) & 1;
+  const AcrossFaces across = in_place ? same_level_neighbours(forest_, x, blk) : AcrossFaces{};
   if (constant_kernels_ && lv.block_constant[at]) {
-    const AcrossFaces across = in_place ? same_level_neighbours(forest_, x, blk) : AcrossFaces{};
-    relax_constant(xb, rb, L, (parity + colour) & 1, lv.block_alpha[at], lv.block_beta[at], inv_h2,
-                   omega_, faces, across);
+    relax_constant(xb, rb, L, first, lv.block_alpha[at], lv.block_beta[at], inv_h2, omega_, faces,
+                   across);
     return;
   }
+  // The general kernel, by rows, reading same-level neighbours as relax_constant does.
   for (int kk = 0; kk < b; ++kk)
-    for (int j = 0; j < b; ++j)
-      for (int i = ((kk + j + parity + colour) & 1); i < b; i += 2) {
-        const std::ptrdiff_t c = L.index(i, j, kk);
+    for (int j = 0; j < b; ++j) {
+      const std::ptrdiff_t start = L.index(0, j, kk);
+      double* row = xb + start;
+      const int i_first = (kk + j + first) & 1;
+      pull_row_x_ghosts(row, L, across, j, kk, i_first == 0, ((b - 1 - i_first) & 1) == 0);
+      const RowStencil around{row, neighbour_rows(row, L, across, j, kk)};
+      for (int i = i_first; i < b; i += 2) {
+        const std::ptrdiff_t c = start + i;
         const double implicit =
             any ? closure_implicit(
                       {i, j, kk}, b, faces, [&](int d) { return k.beta[D(d)][c]; },
                       [&](int d) { return k.beta[D(d)][c + s[D(d)]]; })
                 : 0.0;
-        xb[c] += omega_ * (relaxed_value(xb, rb[c], k, c, s, inv_h2, implicit) - xb[c]);
+        row[i] += omega_ * (relaxed_value(around, i, rb[c], k, c, s, inv_h2, implicit) - row[i]);
       }
+    }
 }
 
 void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc,
@@ -782,9 +813,10 @@ void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const Sc
   // a pass over all blocks first. It copies the colour the half-sweep reads,
   // which no block changes meanwhile: the same values, in any block order and
   // on any number of threads. The other faces (level jumps, other ranks, and
-  // the matched fluxes) are filled first, as before.
+  // the matched fluxes) are filled first, as before. With
+  // read_neighbours_in_place it reads the same-level neighbours in place
+  // instead of copying them (relax_constant and the general kernel alike).
   const bool fused = b % 2 == 0;
-  const Level& lv = levels_[D(level)];
   for (int sweep = 0; sweep < sweeps; ++sweep) {
     for (int colour = 0; colour < 2; ++colour) {
       if (fused) {
@@ -792,11 +824,8 @@ void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const Sc
       } else {
         fill_ghosts(level, x, bc, true);  // the 7-point stencil reads face ghosts only
       }
-      // A block of the constant-coefficient kernels reads its same-level
-      // neighbours of this process in place instead (relax_constant).
       const auto relax = [&](int blk) {
-        const bool in_place =
-            fused && constant_kernels_ && lv.block_constant[static_cast<std::size_t>(blk)];
+        const bool in_place = fused && in_place_;
         if (fused) fill_block_ghosts(blk, x, bc, 1 - colour, !in_place);
         relax_block(level, blk, x, rhs, bc, colour, in_place);
       };
@@ -826,9 +855,9 @@ void Multigrid::compute_residual(int level, BlockField& x, const BlockField& rhs
   block_squares_.resize(static_cast<std::size_t>(forest_.local_blocks()));
   forest_.for_each_block([&](int blk) {
     const auto at = static_cast<std::size_t>(blk);
-    // The constant-coefficient blocks read their same-level neighbours of
-    // this process in place (residual_constant), unless the ghosts are wanted.
-    const bool in_place = !ghosts_wanted && constant_kernels_ && lv.block_constant[at];
+    // Same-level neighbours of this process are read in place, unless the
+    // ghosts are wanted.
+    const bool in_place = !ghosts_wanted && in_place_;
     fill_block_ghosts(blk, x, bc, -1, !in_place);
     const double h = forest_.block(blk).length / b;
     const double inv_h2 = 1.0 / (h * h);
@@ -838,8 +867,8 @@ void Multigrid::compute_residual(int level, BlockField& x, const BlockField& rhs
     const double* fb = rhs.block(blk);
     const double* ab = lv.active.block(blk);
     double* rb = r.block(blk);
+    const AcrossFaces across = in_place ? same_level_neighbours(forest_, x, blk) : AcrossFaces{};
     if (constant_kernels_ && lv.block_constant[at]) {
-      const AcrossFaces across = in_place ? same_level_neighbours(forest_, x, blk) : AcrossFaces{};
       block_squares_[at] = squares_wanted
                                ? residual_constant<true>(xb, fb, rb, L, lv.block_alpha[at],
                                                          lv.block_beta[at], inv_h2, across)
@@ -849,13 +878,18 @@ void Multigrid::compute_residual(int level, BlockField& x, const BlockField& rhs
     }
     double squares = 0.0;
     for (int kk = 0; kk < b; ++kk)
-      for (int j = 0; j < b; ++j)
+      for (int j = 0; j < b; ++j) {
+        const std::ptrdiff_t start = L.index(0, j, kk);
+        double* row = xb + start;
+        pull_row_x_ghosts(row, L, across, j, kk, true, true);
+        const RowStencil around{row, neighbour_rows(row, L, across, j, kk)};
         for (int i = 0; i < b; ++i) {
-          const std::ptrdiff_t c = L.index(i, j, kk);
-          const double value = (fb[c] - applied(xb, k, c, s, inv_h2)) * ab[c];
+          const std::ptrdiff_t c = start + i;
+          const double value = (fb[c] - applied(around, i, k, c, s, inv_h2)) * ab[c];
           rb[c] = value;
           squares += value * value;
         }
+      }
     block_squares_[at] = squares;
   });
 }
@@ -1025,6 +1059,7 @@ void Multigrid::take_options(const MultigridOptions& options) {
   post_sweeps_ = options.post_sweeps;
   omega_ = options.relaxation;
   constant_kernels_ = options.constant_coefficient_kernels;
+  in_place_ = options.read_neighbours_in_place;
 }
 
 void Multigrid::relax(BlockField& x, const BlockField& rhs, const ScalarBoundary& bc, int sweeps,

@@ -62,11 +62,16 @@ struct MultigridOptions {
   /// and matched coarse-fine faces included; the residual needs no special case. false: always the
   /// general kernels (for tests and comparisons).
   bool constant_coefficient_kernels = true;
+  /// The smoother and the V-cycle's residual read the cells of same-level
+  /// blocks of this process in place instead of copying them into x's ghost
+  /// layer first: the same values, so the same bits, without the copies.
+  /// false: copy (for tests and comparisons).
+  bool read_neighbours_in_place = true;
   /// Fill x's ghosts (neighbours and bc) before returning. false where the
   /// caller refills them anyway (the viscous solves: the velocity's ghosts
   /// are filled again before anything reads them), saving a full exchange;
-  /// x's ghosts are then stale (the constant-coefficient kernels read
-  /// same-level neighbours in place and leave those ghosts as they were).
+  /// x's ghosts are then stale (with read_neighbours_in_place the kernels
+  /// read same-level neighbours in place and leave those ghosts as they were).
   bool fill_ghosts_on_return = true;
 };
 
@@ -217,6 +222,7 @@ class Multigrid {
   int post_sweeps_ = 2;
   double omega_ = 1.0;
   bool constant_kernels_ = true;  ///< MultigridOptions::constant_coefficient_kernels of the solve
+  bool in_place_ = true;          ///< MultigridOptions::read_neighbours_in_place of the solve
 };
 
 }  // namespace sanguis::flow

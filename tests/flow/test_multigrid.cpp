@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <string>
+#include <vector>
 
 #include "adapt_poisson.hpp"
 #include "poisson_problems.hpp"
@@ -151,29 +153,36 @@ TEST(FlowMultigrid, MaskedCellsActAsNeumannWallsAndKeepTheConvergenceRate) {
   EXPECT_GT(std::log2(e16 / e32), 1.8);
 }
 
-/// Solves with the constant-coefficient kernels and with the general ones:
-/// every residual of the report and every cell of the solution must be the
-/// same bits.
+/// Solves with the constant-coefficient kernels and with the general ones,
+/// each reading same-level neighbours in place and through copies in the
+/// ghost layer: every residual of the reports and every cell of the
+/// solutions must be the same bits.
 void expect_kernels_agree(const Forest& forest, Multigrid& mg, const BlockField& rhs,
                           const ScalarBoundary& bc) {
   const int b = forest.block_cells();
   MultigridOptions options;
   options.tolerance = 1e-10;
-  std::array<BlockField, 2> x{BlockField(forest.local_blocks(), b),
-                              BlockField(forest.local_blocks(), b)};
-  std::array<MultigridReport, 2> report;
-  for (int general = 0; general < 2; ++general) {
-    options.constant_coefficient_kernels = general == 0;
-    report[general] = mg.solve(x[general], rhs, bc, options);
+  constexpr int kVariants = 4;  // (constant, in place), (general, in place), then copying
+  std::vector<BlockField> x;
+  std::array<MultigridReport, kVariants> report;
+  for (int variant = 0; variant < kVariants; ++variant) {
+    options.constant_coefficient_kernels = variant % 2 == 0;
+    options.read_neighbours_in_place = variant < 2;
+    x.emplace_back(forest.local_blocks(), b);
+    report[variant] = mg.solve(x.back(), rhs, bc, options);
   }
   EXPECT_TRUE(report[0].converged);
-  EXPECT_EQ(report[0].residuals, report[1].residuals);
-  std::size_t differing = 0;
-  for (int blk = 0; blk < forest.local_blocks(); ++blk)
-    for (int k = 0; k < b; ++k)
-      for (int j = 0; j < b; ++j)
-        for (int i = 0; i < b; ++i) differing += x[0](blk, i, j, k) != x[1](blk, i, j, k) ? 1 : 0;
-  EXPECT_EQ(differing, 0u);
+  for (int variant = 1; variant < kVariants; ++variant) {
+    SCOPED_TRACE("variant " + std::to_string(variant));
+    EXPECT_EQ(report[0].residuals, report[variant].residuals);
+    std::size_t differing = 0;
+    for (int blk = 0; blk < forest.local_blocks(); ++blk)
+      for (int k = 0; k < b; ++k)
+        for (int j = 0; j < b; ++j)
+          for (int i = 0; i < b; ++i)
+            differing += x[0](blk, i, j, k) != x[variant](blk, i, j, k) ? 1 : 0;
+    EXPECT_EQ(differing, 0u);
+  }
 }
 
 TEST(FlowMultigrid, ConstantCoefficientKernelsGiveTheSameBitsAsTheGeneralOnes) {
@@ -242,14 +251,16 @@ TEST(FlowMultigrid, ConstantCoefficientKernelsGiveTheSameBitsAsTheGeneralOnes) {
   }
 }
 
-TEST(FlowMultigrid, ConstantKernelsReadingNeighboursInPlaceGiveTheSameBits) {
-  // The constant-coefficient smoother reads the cells of same-level blocks of
-  // this process in place instead of their copies in its ghost layer (the
-  // general kernels still copy). Across periodic faces that neighbour is
-  // another block (2 per direction) or the block itself (1 per direction),
-  // and with two threads a neighbour may be relaxed at the same time: every
-  // case must give the general kernels' bits. Rectangular forests with an
-  // odd number of trees along y take the other colour parities.
+TEST(FlowMultigrid, KernelsReadingNeighboursInPlaceGiveTheSameBits) {
+  // The smoother and the residual read the cells of same-level blocks of
+  // this process in place instead of their copies in the ghost layer.
+  // Across periodic faces that neighbour is another block (2 per direction)
+  // or the block itself (1 per direction), and with two threads a neighbour
+  // may be relaxed at the same time: every case must give the bits of the
+  // kernels that copy. Rectangular forests with an odd number of trees
+  // along y take the other colour parities. (The solid slab and the refined
+  // forests of the test above take the general kernels in place beside
+  // solid faces and level jumps.)
   for (const int level : {0, 1}) {
     for (const int trees_y : {1, 3}) {
       ForestSpec spec;
