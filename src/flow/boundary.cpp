@@ -130,13 +130,15 @@ void fill_all(const Forest& forest, BlockField& field, const std::array<BcKind, 
 
 void fill_block_boundary_ghosts(const Forest& forest, BlockField& field, int blk,
                                 const std::array<BcKind, 6>& kinds,
-                                const std::array<FaceValue, 6>* values, int width, int colour) {
+                                const std::array<FaceValue, 6>* values, int width, int colour,
+                                bool neumann) {
   width = std::min({width, field.cells(), field.layout().ghost});
   const Block& block = forest.block(blk);
   for (int d = 0; d < 3; ++d) {
     for (int side = 0; side < 2; ++side) {
       if (block.neighbours[face_neighbour_slot(d, side)].link != Link::Boundary) continue;
       const auto f = static_cast<std::size_t>(face_index(d, side));
+      if (!neumann && kinds[f] == BcKind::Neumann) continue;
       fill_face(forest, block, field, blk, d, side, kinds[f], values ? &(*values)[f] : nullptr,
                 width, colour);
     }

@@ -60,9 +60,12 @@ void fill_boundary_ghosts(const Forest& forest, BlockField& field,
 /// With `colour` >= 0 (an even block size, width 1): only the face ghosts of
 /// that red-black colour, as Forest::copy_face_ghosts, and no edge or corner
 /// ghost: what a half-sweep of the smoother reads, at half the cost.
+/// `neumann` false leaves the Neumann faces (for a smoother that reads their
+/// mirror cells in place).
 void fill_block_boundary_ghosts(const Forest& forest, BlockField& field, int blk,
                                 const std::array<BcKind, 6>& kinds,
-                                const std::array<FaceValue, 6>* values, int width, int colour = -1);
+                                const std::array<FaceValue, 6>* values, int width, int colour = -1,
+                                bool neumann = true);
 
 /// Zero-gradient extrapolation of a face field into the ghost cells beyond
 /// domain faces (`width` layers). The faces on the domain boundary itself

@@ -195,14 +195,18 @@ double closure_implicit(const std::array<int, 3>& n, int b, const ClosedFaces& f
   return implicit;
 }
 
-/// Per face (face_index order), the cells of the block across it when that
-/// is a same-level block of this process, else null (the stencil reads the
-/// ghost layer). The fused smoother and the V-cycle's residual read such
-/// neighbours in place instead of copying their face into the ghost layer
-/// first: the same values, so the same bits (Forest::copy_face_ghosts took 15 % of the 64^3 cavity
-/// with 8^3 blocks, docs/performance.md).
+/// Per face (face_index order), the cells the stencil reads beyond it in
+/// place, else null (it reads the ghost layer): a same-level block of this
+/// process across the face, or at a Neumann boundary face the block itself,
+/// whose ghost is the mirror of the cell inside (`shift` moves the
+/// neighbour's row onto the mirrored row). The fused smoother and the
+/// V-cycle's residual read them in place instead of copying them into the
+/// ghost layer first: the same values, so the same bits
+/// (Forest::copy_face_ghosts took 15 % of the 64^3 cavity with 8^3 blocks,
+/// the boundary ghosts 5 %, docs/performance.md).
 struct AcrossFaces {
   std::array<const double*, 6> cells{};
+  std::array<std::ptrdiff_t, 6> shift{};  ///< added to the neighbour's index
 };
 
 /// The rows beside row (j, k) along y and z (y_lo, y_hi, z_lo, z_hi): in
@@ -214,21 +218,33 @@ struct AcrossFaces {
                                                                           int j, int k) {
   const int b = L.cells;
   const std::ptrdiff_t sy = L.stride(1), sz = L.stride(2);
-  return {j > 0 || !across.cells[2] ? row - sy : across.cells[2] + L.index(0, b - 1, k),
-          j < b - 1 || !across.cells[3] ? row + sy : across.cells[3] + L.index(0, 0, k),
-          k > 0 || !across.cells[4] ? row - sz : across.cells[4] + L.index(0, j, b - 1),
-          k < b - 1 || !across.cells[5] ? row + sz : across.cells[5] + L.index(0, j, 0)};
+  const auto& [cells, shift] = across;
+  return {j > 0 || !cells[2] ? row - sy : cells[2] + (L.index(0, b - 1, k) + shift[2]),
+          j < b - 1 || !cells[3] ? row + sy : cells[3] + (L.index(0, 0, k) + shift[3]),
+          k > 0 || !cells[4] ? row - sz : cells[4] + (L.index(0, j, b - 1) + shift[4]),
+          k < b - 1 || !cells[5] ? row + sz : cells[5] + (L.index(0, j, 0) + shift[5])};
 }
 
-/// The AcrossFaces of block `blk` of x.
-AcrossFaces same_level_neighbours(const Forest& forest, const BlockField& x, int blk) {
+/// The AcrossFaces of block `blk` of x, whose domain faces have the
+/// conditions `kinds`.
+AcrossFaces same_level_neighbours(const Forest& forest, const BlockField& x, int blk,
+                                  const std::array<BcKind, 6>& kinds) {
   AcrossFaces across;
   const Block& block = forest.block(blk);
+  const BlockLayout L = x.layout();
+  const int b = L.cells;
   for (int d = 0; d < 3; ++d)
     for (int side = 0; side < 2; ++side) {
       const Neighbour& nb = block.neighbours[D(face_neighbour_slot(d, side))];
+      const auto f = D(face_index(d, side));
       if (nb.link == Link::Local && nb.jump == LevelJump::Same) {
-        across.cells[D(face_index(d, side))] = x.block(nb.index);
+        across.cells[f] = x.block(nb.index);
+      } else if (nb.link == Link::Boundary && kinds[f] == BcKind::Neumann) {
+        // ghost = the cell inside (fill_block_boundary_ghosts): the row
+        // read at the neighbour's far layer (b - 1 or 0) is this block's
+        // layer beside the face (0 or b - 1).
+        across.cells[f] = x.block(blk);
+        across.shift[f] = (side == 0 ? -(b - 1) : b - 1) * L.stride(d);
       }
     }
   return across;
@@ -242,8 +258,9 @@ AcrossFaces same_level_neighbours(const Forest& forest, const BlockField& x, int
                                                      const AcrossFaces& across, int j, int k,
                                                      bool low, bool high) {
   const int b = L.cells;
-  if (low && across.cells[0]) row[-1] = across.cells[0][L.index(b - 1, j, k)];
-  if (high && across.cells[1]) row[b] = across.cells[1][L.index(0, j, k)];
+  const auto& [cells, shift] = across;
+  if (low && cells[0]) row[-1] = cells[0][L.index(b - 1, j, k) + shift[0]];
+  if (high && cells[1]) row[b] = cells[1][L.index(0, j, k) + shift[1]];
 }
 
 /// Red-black Gauss-Seidel on the cells of one colour (i + j + k + first even)
@@ -723,12 +740,12 @@ void Multigrid::fill_ghosts_between_blocks_apart(int level, BlockField& x) {
 }
 
 void Multigrid::fill_block_ghosts(int blk, BlockField& x, const ScalarBoundary* bc, int colour,
-                                  bool same_level) const {
-  if (same_level) forest_.copy_face_ghosts(x, blk, colour);
+                                  bool in_place) const {
+  if (!in_place) forest_.copy_face_ghosts(x, blk, colour);
   if (bc) {
-    fill_block_boundary_ghosts(forest_, x, blk, bc->kind, &bc->value, 1, colour);
+    fill_block_boundary_ghosts(forest_, x, blk, bc->kind, &bc->value, 1, colour, !in_place);
   } else {
-    fill_block_boundary_ghosts(forest_, x, blk, kinds_, nullptr, 1, colour);
+    fill_block_boundary_ghosts(forest_, x, blk, kinds_, nullptr, 1, colour, !in_place);
   }
 }
 
@@ -778,7 +795,7 @@ void Multigrid::relax_block(int level, int blk, BlockField& x, const BlockField&
   }
   const auto at = static_cast<std::size_t>(blk);
   const int first = (parity + colour) & 1;
-  const AcrossFaces across = in_place ? same_level_neighbours(forest_, x, blk) : AcrossFaces{};
+  const AcrossFaces across = in_place ? same_level_neighbours(forest_, x, blk, bc ? bc->kind : kinds_) : AcrossFaces{};
   if (constant_kernels_ && lv.block_constant[at]) {
     relax_constant(xb, rb, L, first, lv.block_alpha[at], lv.block_beta[at], inv_h2, omega_, faces,
                    across);
@@ -826,7 +843,7 @@ void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const Sc
       }
       const auto relax = [&](int blk) {
         const bool in_place = fused && in_place_;
-        if (fused) fill_block_ghosts(blk, x, bc, 1 - colour, !in_place);
+        if (fused) fill_block_ghosts(blk, x, bc, 1 - colour, in_place);
         relax_block(level, blk, x, rhs, bc, colour, in_place);
       };
       // In a half-sweep each block writes only its own cells and ghosts, and
@@ -858,7 +875,7 @@ void Multigrid::compute_residual(int level, BlockField& x, const BlockField& rhs
     // Same-level neighbours of this process are read in place, unless the
     // ghosts are wanted.
     const bool in_place = !ghosts_wanted && in_place_;
-    fill_block_ghosts(blk, x, bc, -1, !in_place);
+    fill_block_ghosts(blk, x, bc, -1, in_place);
     const double h = forest_.block(blk).length / b;
     const double inv_h2 = 1.0 / (h * h);
     const BlockCoefficients k{
@@ -867,7 +884,7 @@ void Multigrid::compute_residual(int level, BlockField& x, const BlockField& rhs
     const double* fb = rhs.block(blk);
     const double* ab = lv.active.block(blk);
     double* rb = r.block(blk);
-    const AcrossFaces across = in_place ? same_level_neighbours(forest_, x, blk) : AcrossFaces{};
+    const AcrossFaces across = in_place ? same_level_neighbours(forest_, x, blk, bc ? bc->kind : kinds_) : AcrossFaces{};
     if (constant_kernels_ && lv.block_constant[at]) {
       block_squares_[at] = squares_wanted
                                ? residual_constant<true>(xb, fb, rb, L, lv.block_alpha[at],

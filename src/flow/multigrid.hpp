@@ -155,16 +155,18 @@ class Multigrid {
   void fill_ghosts_between_blocks_apart(int level, BlockField& x);
   /// The rest of fill_ghosts(.., faces_only) for block `blk` alone: its face
   /// ghosts towards same-level blocks of this rank (`colour` as in
-  /// Forest::copy_face_ghosts; not when !same_level, for a smoother that reads
-  /// those neighbours in place) and its boundary ghosts.
+  /// Forest::copy_face_ghosts) and its boundary ghosts; with `in_place` (for
+  /// kernels that read them in place, same_level_neighbours) neither the
+  /// same-level faces nor the Neumann boundary faces.
   void fill_block_ghosts(int blk, BlockField& x, const ScalarBoundary* bc, int colour,
-                         bool same_level = true) const;
+                         bool in_place = false) const;
   /// `sweeps` red-black sweeps over every block.
   void smooth(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc,
               int sweeps);
   /// One half-sweep (the cells of `colour`) of block `blk`, ghosts filled;
-  /// with `in_place` a constant-coefficient block reads the cells of its
-  /// same-level neighbours of this rank in place (their ghosts not copied).
+  /// with `in_place` the block reads the cells of its same-level neighbours
+  /// of this rank, and its own cells beyond Neumann boundary faces, in place
+  /// (those ghosts not filled).
   void relax_block(int level, int blk, BlockField& x, const BlockField& rhs,
                    const ScalarBoundary* bc, int colour, bool in_place = false) const;
   /// r = rhs - A x on `level`, and each block's sum of r^2 into

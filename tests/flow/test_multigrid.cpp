@@ -258,23 +258,34 @@ TEST(FlowMultigrid, KernelsReadingNeighboursInPlaceGiveTheSameBits) {
   // or the block itself (1 per direction), and with two threads a neighbour
   // may be relaxed at the same time: every case must give the bits of the
   // kernels that copy. Rectangular forests with an odd number of trees
-  // along y take the other colour parities. (The solid slab and the refined
-  // forests of the test above take the general kernels in place beside
-  // solid faces and level jumps.)
-  for (const int level : {0, 1}) {
-    for (const int trees_y : {1, 3}) {
-      ForestSpec spec;
-      spec.level = level;
-      spec.trees = {1, trees_y, 1};
-      spec.periodic = {true, true, true};
-      spec.threads = 2;
-      const Forest forest(spec);
-      ScalarBoundary bc;
-      bc.kind = uniform_kinds(forest, BcKind::Periodic);
-      Multigrid mg(forest, bc.kind);
-      SCOPED_TRACE("level " + std::to_string(level) + ", trees along y " + std::to_string(trees_y));
-      EXPECT_TRUE(mg.constant_coefficients(0));
-      expect_kernels_agree(forest, mg, testing::sample(forest, testing::periodic_source), bc);
+  // along y take the other colour parities. At Neumann walls the block reads
+  // its own cells, the mirrors its ghosts would hold, in place: walls on
+  // every face (a singular problem) and walls along x only, with Dirichlet
+  // walls along y and periodic z. (The solid slab and the refined forests of
+  // the test above take the general kernels in place beside solid faces
+  // and level jumps.)
+  enum class Walls { None, NeumannEverywhere, NeumannAlongX };
+  for (const Walls walls : {Walls::None, Walls::NeumannEverywhere, Walls::NeumannAlongX}) {
+    for (const int level : {0, 1}) {
+      for (const int trees_y : {1, 3}) {
+        ForestSpec spec;
+        spec.level = level;
+        spec.trees = {1, trees_y, 1};
+        spec.periodic = {walls == Walls::None, walls == Walls::None, walls != Walls::NeumannEverywhere};
+        spec.threads = 2;
+        const Forest forest(spec);
+        ScalarBoundary bc;
+        bc.kind = uniform_kinds(forest, walls == Walls::None ? BcKind::Periodic : BcKind::Neumann);
+        if (walls == Walls::NeumannAlongX) {
+          bc.kind[static_cast<std::size_t>(face_index(1, 0))] = BcKind::Dirichlet;
+          bc.kind[static_cast<std::size_t>(face_index(1, 1))] = BcKind::Dirichlet;
+        }
+        Multigrid mg(forest, bc.kind);
+        SCOPED_TRACE("walls " + std::to_string(static_cast<int>(walls)) + ", level " +
+                     std::to_string(level) + ", trees along y " + std::to_string(trees_y));
+        EXPECT_TRUE(mg.constant_coefficients(0));
+        expect_kernels_agree(forest, mg, testing::sample(forest, testing::periodic_source), bc);
+      }
     }
   }
 }
