@@ -361,24 +361,39 @@ double block_squares(const BlockField& f, int blk) {
 // `combine` from 0, and stores `finish` of the result. The one loop behind the
 // coefficient averages, the activity flags and the residual transfer.
 template <typename Combine, typename Finish>
+void restrict_block(const double* fine, const BlockLayout& F, double* coarse, const BlockLayout& C,
+                    int coarse_cells, Combine combine, Finish finish) {
+  for (int k = 0; k < coarse_cells; ++k)
+    for (int j = 0; j < coarse_cells; ++j)
+      for (int i = 0; i < coarse_cells; ++i) {
+        double acc = 0.0;
+        for (int dk = 0; dk < 2; ++dk)
+          for (int dj = 0; dj < 2; ++dj)
+            for (int di = 0; di < 2; ++di)
+              acc = combine(acc, fine[F.index(2 * i + di, 2 * j + dj, 2 * k + dk)]);
+        coarse[C.index(i, j, k)] = finish(acc);
+      }
+}
+
+template <typename Combine, typename Finish>
 void restrict_children(const Forest& forest, const BlockField& fine, BlockField& coarse,
                        int coarse_cells, Combine combine, Finish finish) {
   forest.for_each_block([&](int blk) {
-    for (int k = 0; k < coarse_cells; ++k)
-      for (int j = 0; j < coarse_cells; ++j)
-        for (int i = 0; i < coarse_cells; ++i) {
-          double acc = 0.0;
-          for (int dk = 0; dk < 2; ++dk)
-            for (int dj = 0; dj < 2; ++dj)
-              for (int di = 0; di < 2; ++di)
-                acc = combine(acc, fine(blk, 2 * i + di, 2 * j + dj, 2 * k + dk));
-          coarse(blk, i, j, k) = finish(acc);
-        }
+    restrict_block(fine.block(blk), fine.layout(), coarse.block(blk), coarse.layout(), coarse_cells,
+                   combine, finish);
   });
 }
 
 constexpr auto kAdd = [](double acc, double v) { return acc + v; };
 constexpr auto kMean8 = [](double sum) { return sum / 8.0; };
+
+/// One block of `size` values per thread, for a residual that is not kept:
+/// written and read back while in cache instead of streamed to memory.
+double* thread_scratch(std::ptrdiff_t size) {
+  thread_local std::vector<double> scratch;
+  if (scratch.size() < static_cast<std::size_t>(size)) scratch.resize(static_cast<std::size_t>(size));
+  return scratch.data();
+}
 
 }  // namespace
 
@@ -415,7 +430,6 @@ void Multigrid::rebuild() {
     level.cells = b;
     level.x.reshape(n, b, ghost);
     level.rhs.reshape(n, b, ghost);
-    level.res.reshape(n, b, ghost);
     level.alpha.reshape(n, b, ghost);
     reshape(level.beta, n, b, ghost);
     level.active.reshape(n, b, ghost);
@@ -862,8 +876,8 @@ void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const Sc
 }
 
 void Multigrid::compute_residual(int level, BlockField& x, const BlockField& rhs,
-                                 const ScalarBoundary* bc, BlockField& r, bool squares_wanted,
-                                 bool ghosts_wanted) {
+                                 const ScalarBoundary* bc, BlockField* r, bool squares_wanted,
+                                 bool ghosts_wanted, BlockField* restricted) {
   const Level& lv = levels_[D(level)];
   const BlockLayout L = x.layout();
   const int b = L.cells;
@@ -883,31 +897,36 @@ void Multigrid::compute_residual(int level, BlockField& x, const BlockField& rhs
     double* xb = x.block(blk);
     const double* fb = rhs.block(blk);
     const double* ab = lv.active.block(blk);
-    double* rb = r.block(blk);
-    const AcrossFaces across = in_place ? same_level_neighbours(forest_, x, blk, bc ? bc->kind : kinds_) : AcrossFaces{};
+    // A residual that is not kept lives in a block of scratch, in cache.
+    double* rb = r ? r->block(blk) : thread_scratch(L.size());
+    const AcrossFaces across =
+        in_place ? same_level_neighbours(forest_, x, blk, bc ? bc->kind : kinds_) : AcrossFaces{};
     if (constant_kernels_ && lv.block_constant[at]) {
       block_squares_[at] = squares_wanted
                                ? residual_constant<true>(xb, fb, rb, L, lv.block_alpha[at],
                                                          lv.block_beta[at], inv_h2, across)
                                : residual_constant<false>(xb, fb, rb, L, lv.block_alpha[at],
                                                           lv.block_beta[at], inv_h2, across);
-      return;
-    }
-    double squares = 0.0;
-    for (int kk = 0; kk < b; ++kk)
-      for (int j = 0; j < b; ++j) {
-        const std::ptrdiff_t start = L.index(0, j, kk);
-        double* row = xb + start;
-        pull_row_x_ghosts(row, L, across, j, kk, true, true);
-        const RowStencil around{row, neighbour_rows(row, L, across, j, kk)};
-        for (int i = 0; i < b; ++i) {
-          const std::ptrdiff_t c = start + i;
-          const double value = (fb[c] - applied(around, i, k, c, s, inv_h2)) * ab[c];
-          rb[c] = value;
-          squares += value * value;
+    } else {
+      double squares = 0.0;
+      for (int kk = 0; kk < b; ++kk)
+        for (int j = 0; j < b; ++j) {
+          const std::ptrdiff_t start = L.index(0, j, kk);
+          double* row = xb + start;
+          pull_row_x_ghosts(row, L, across, j, kk, true, true);
+          const RowStencil around{row, neighbour_rows(row, L, across, j, kk)};
+          for (int i = 0; i < b; ++i) {
+            const std::ptrdiff_t c = start + i;
+            const double value = (fb[c] - applied(around, i, k, c, s, inv_h2)) * ab[c];
+            rb[c] = value;
+            squares += value * value;
+          }
         }
-      }
-    block_squares_[at] = squares;
+      block_squares_[at] = squares;
+    }
+    if (restricted) {
+      restrict_block(rb, L, restricted->block(blk), restricted->layout(), b / 2, kAdd, kMean8);
+    }
   });
 }
 
@@ -967,8 +986,8 @@ void Multigrid::vcycle(int level, BlockField& x, const BlockField& rhs, const Sc
   smooth(level, x, rhs, bc, pre_sweeps_);
   Level& fine = levels_[D(level)];
   Level& coarse = levels_[D(level + 1)];
-  compute_residual(level, x, rhs, bc, fine.res, false);  // restricted, no norm
-  restrict_children(forest_, fine.res, coarse.rhs, coarse.cells, kAdd, kMean8);
+  // The residual restricted block by block as it is formed (no norm).
+  compute_residual(level, x, rhs, bc, nullptr, false, false, &coarse.rhs);
   coarse.x.fill(0.0);
   vcycle(level + 1, coarse.x, coarse.rhs, nullptr);
   fill_ghosts(level + 1, coarse.x, nullptr, false, false);  // values, not matched fluxes
@@ -1068,7 +1087,7 @@ void Multigrid::shift_interior(BlockField& f, double by) const {
 
 void Multigrid::residual(BlockField& x, const BlockField& rhs, const ScalarBoundary& bc,
                          BlockField& r) {
-  compute_residual(0, x, rhs, &bc, r, true, true);
+  compute_residual(0, x, rhs, &bc, &r, true, true);
 }
 
 void Multigrid::take_options(const MultigridOptions& options) {
@@ -1099,7 +1118,7 @@ MultigridReport Multigrid::solve(BlockField& x, const BlockField& rhs, const Sca
   MultigridReport report;
   report.rhs_norm = rms(*source);
   Level& fine = levels_.front();
-  compute_residual(0, x, *source, &bc, fine.res);
+  compute_residual(0, x, *source, &bc, nullptr);  // the norm alone
   report.residuals.push_back(root_mean_square(fine.cells));
   const double scale = report.rhs_norm > 0.0 ? report.rhs_norm : report.residuals.front();
   const double target = std::max(options.tolerance * scale, options.absolute_tolerance);
@@ -1107,7 +1126,7 @@ MultigridReport Multigrid::solve(BlockField& x, const BlockField& rhs, const Sca
   while (!report.converged && report.cycles < options.max_cycles) {
     vcycle(0, x, *source, &bc);
     if (singular_) shift_interior(x, mean(x));
-    compute_residual(0, x, *source, &bc, fine.res);
+    compute_residual(0, x, *source, &bc, nullptr);  // the norm alone
     report.residuals.push_back(root_mean_square(fine.cells));
     ++report.cycles;
     report.converged = report.residuals.back() <= target;

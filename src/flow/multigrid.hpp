@@ -132,7 +132,7 @@ class Multigrid {
   void take_options(const MultigridOptions& options);
   struct Level {
     int cells = 0;  ///< cells per block edge at this level
-    BlockField x, rhs, res, alpha;
+    BlockField x, rhs, alpha;
     FaceField beta;
     BlockField active;  ///< 1 where the cell takes part (some open face or alpha > 0), else 0
     /// Composite grids on several ranks: fine-side fluxes by face.
@@ -172,12 +172,16 @@ class Multigrid {
   /// r = rhs - A x on `level`, and each block's sum of r^2 into
   /// block_squares_ (one pass: summed as r is written; root_mean_square()),
   /// unless !squares_wanted (the V-cycle's residual, only restricted): then
-  /// the constant-coefficient blocks' sums are not formed. Unless
-  /// ghosts_wanted, the constant-coefficient blocks read their same-level
-  /// neighbours of this rank in place, and x's ghosts towards them are left
-  /// as they were.
+  /// the constant-coefficient blocks' sums are not formed. r is stored in
+  /// `r` when given, and its restriction to the next level (the mean of the
+  /// 8 children) in `restricted` when given; each block's r is formed in a
+  /// scratch block in cache otherwise (a pass over memory less). Unless
+  /// ghosts_wanted, the kernels read same-level neighbours of this rank
+  /// (read_neighbours_in_place) in place, and x's ghosts towards them are
+  /// left as they were.
   void compute_residual(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc,
-                        BlockField& r, bool squares_wanted = true, bool ghosts_wanted = false);
+                        BlockField* r, bool squares_wanted = true, bool ghosts_wanted = false,
+                        BlockField* restricted = nullptr);
   void vcycle(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc);
   void coarse_solve();
   void build_coarse_operator();
