@@ -391,7 +391,8 @@ constexpr auto kMean8 = [](double sum) { return sum / 8.0; };
 /// written and read back while in cache instead of streamed to memory.
 double* thread_scratch(std::ptrdiff_t size) {
   thread_local std::vector<double> scratch;
-  if (scratch.size() < static_cast<std::size_t>(size)) scratch.resize(static_cast<std::size_t>(size));
+  if (scratch.size() < static_cast<std::size_t>(size))
+    scratch.resize(static_cast<std::size_t>(size));
   return scratch.data();
 }
 
@@ -809,7 +810,8 @@ void Multigrid::relax_block(int level, int blk, BlockField& x, const BlockField&
   }
   const auto at = static_cast<std::size_t>(blk);
   const int first = (parity + colour) & 1;
-  const AcrossFaces across = in_place ? same_level_neighbours(forest_, x, blk, bc ? bc->kind : kinds_) : AcrossFaces{};
+  const AcrossFaces across =
+      in_place ? same_level_neighbours(forest_, x, blk, bc ? bc->kind : kinds_) : AcrossFaces{};
   if (constant_kernels_ && lv.block_constant[at]) {
     relax_constant(xb, rb, L, first, lv.block_alpha[at], lv.block_beta[at], inv_h2, omega_, faces,
                    across);

@@ -271,7 +271,8 @@ TEST(FlowMultigrid, KernelsReadingNeighboursInPlaceGiveTheSameBits) {
         ForestSpec spec;
         spec.level = level;
         spec.trees = {1, trees_y, 1};
-        spec.periodic = {walls == Walls::None, walls == Walls::None, walls != Walls::NeumannEverywhere};
+        spec.periodic = {walls == Walls::None, walls == Walls::None,
+                         walls != Walls::NeumannEverywhere};
         spec.threads = 2;
         const Forest forest(spec);
         ScalarBoundary bc;
