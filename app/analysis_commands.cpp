@@ -53,6 +53,13 @@ struct EnsembleArgs {
   bool plot = false;
 };
 
+struct SliceArgs {
+  std::string run, normal = "z", field = "speed", output;
+  std::vector<int> frame;  // at most one: given or not
+  std::vector<double> time, at;
+  bool blocks = false;
+};
+
 struct CalibrateArgs {
   std::string case_file, output, measure, from;
   std::vector<std::string> parameters;  // each gets the same value
@@ -91,6 +98,34 @@ void plot(const fs::path& dir) {
     std::cerr << "sanguis: warning: plotting failed (" << command
               << "); the CSV files are written\n";
   }
+}
+
+std::string shell_quoted(const std::string& s) {
+  std::string out = "'";
+  for (const char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+// A plane slice of a flow run as PNG and CSV (scripts/flow_slice.py, matplotlib):
+// returns the script's exit status (2: bad input, its message printed).
+int run_slice(const SliceArgs& a) {
+  std::string command = "/usr/bin/python3 " +
+                        shell_quoted(source_dir() + "/scripts/flow_slice.py") + " " +
+                        shell_quoted(a.run) + " --normal " + shell_quoted(a.normal) + " --field " +
+                        shell_quoted(a.field);
+  const auto number = [](double v) {
+    std::ostringstream text;
+    text.precision(17);
+    text << v;
+    return text.str();
+  };
+  if (!a.frame.empty()) command += " --frame " + std::to_string(a.frame.front());
+  if (!a.time.empty()) command += " --time " + number(a.time.front());
+  if (!a.at.empty()) command += " --at " + number(a.at.front());
+  if (a.blocks) command += " --blocks";
+  if (!a.output.empty()) command += " --output " + shell_quoted(a.output);
+  const int status = std::system(command.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 1;
 }
 
 RunAnalysis analyze_one(const fs::path& run, const AnalysisOptions& options, const fs::path& out,
@@ -484,6 +519,7 @@ std::function<bool()> add_analysis_commands(CLI::App& app) {
   auto analyze = std::make_shared<AnalyzeArgs>();
   auto ensemble = std::make_shared<EnsembleArgs>();
   auto calibrate = std::make_shared<CalibrateArgs>();
+  auto slice = std::make_shared<SliceArgs>();
 
   auto* an = app.add_subcommand(
       "analyze", "measure DEM run folders (run-out, heights, velocity, contact network...)");
@@ -552,6 +588,28 @@ std::function<bool()> add_analysis_commands(CLI::App& app) {
                "keep the runs that already finished with the same command line "
                "(VALUE_i/SEED_k/calibration_run.txt) instead of running them again");
 
+  auto* sl = app.add_subcommand(
+      "slice", "a plane slice of a flow run as PNG and CSV (speed, pressure, vorticity...)");
+  sl->add_option("run", slice->run, "flow run folder (its flow.pvd) or one .vtu frame")->required();
+  auto* frame = sl->add_option("--frame", slice->frame,
+                               "frame index (default: the last; negative counts back)")
+                    ->expected(1);
+  sl->add_option("--time", slice->time, "the frame nearest to this time [s]")
+      ->expected(1)
+      ->excludes(frame);
+  sl->add_option("--normal", slice->normal, "normal of the plane")
+      ->check(CLI::IsMember({"x", "y", "z"}))
+      ->capture_default_str();
+  sl->add_option("--at", slice->at, "plane position along the normal [m] (default: mid-domain)")
+      ->expected(1);
+  sl->add_option("--field", slice->field,
+                 "cell array (velocity:x, pressure, vorticity_magnitude, viscosity, level, rank, "
+                 "block) or speed")
+      ->capture_default_str();
+  sl->add_flag("--blocks", slice->blocks, "outline the blocks");
+  sl->add_option("--output,-o", slice->output,
+                 "PNG file, the CSV beside it (default RUN/slice_FIELD_NORMALAT.png)");
+
   // Not the resolved path: /proc/self/exe still starts this executable when its
   // file was replaced (a rebuild) while a long study runs.
   const std::string self_path = "/proc/self/exe";
@@ -559,6 +617,17 @@ std::function<bool()> add_analysis_commands(CLI::App& app) {
     if (*an) return run_analyze(*analyze) == 0;
     if (*en) return run_ensemble(self_path.c_str(), *ensemble) == 0;
     if (*ca) return run_calibrate(self_path.c_str(), *calibrate) == 0;
+    if (*sl) {
+      const int status = run_slice(*slice);
+      if (status == 2) {
+        throw InputError(slice->run, "slice", "the slice script refused its input (message above)");
+      }
+      if (status != 0) {
+        throw std::runtime_error("slice: scripts/flow_slice.py failed (exit status " +
+                                 std::to_string(status) + ")");
+      }
+      return true;
+    }
     return false;
   };
 }
