@@ -505,6 +505,7 @@ void Multigrid::detect_constant_coefficients() {
     const int b = level.cells;
     level.block_constant.assign(static_cast<std::size_t>(n), 0);
     level.block_all_active.assign(static_cast<std::size_t>(n), 0);
+    level.block_ring_active.assign(static_cast<std::size_t>(n), 0);
     level.block_alpha.assign(static_cast<std::size_t>(n), 0.0);
     level.block_beta.assign(static_cast<std::size_t>(n), 0.0);
     forest_.for_each_block([&](int blk) {
@@ -536,6 +537,12 @@ void Multigrid::detect_constant_coefficients() {
                                  b_lo > 0.0 && active_lo == 1.0 &&
                                  std::signbit(a_lo) == std::signbit(a_hi);
       level.block_all_active[at] = active_lo == 1.0;
+      // The ghost ring too (compute_activity filled it: exchange and mirror).
+      bool ring = active_lo == 1.0;
+      for (int k = -1; k <= b && ring; ++k)
+        for (int j = -1; j <= b && ring; ++j)
+          for (int i = -1; i <= b && ring; ++i) ring = level.active(blk, i, j, k) == 1.0;
+      level.block_ring_active[at] = ring;
       level.block_alpha[at] = a_lo;
       level.block_beta[at] = b_lo;
     });
@@ -994,12 +1001,13 @@ void Multigrid::vcycle(int level, BlockField& x, const BlockField& rhs, const Sc
   vcycle(level + 1, coarse.x, coarse.rhs, nullptr);
   fill_ghosts(level + 1, coarse.x, nullptr, false, false);  // values, not matched fluxes
   // Trilinear prolongation of the correction (weights 3/4, 1/4 per direction),
-  // from active coarse cells only. On a constant-coefficient level every cell
-  // and ghost is active (1 exactly), so the factor is skipped: same bits.
+  // from active coarse cells only. Where every coarse cell and ghost the block
+  // reads is active (1 exactly: a constant-coefficient level, or a block away
+  // from solids), the factor is skipped: same bits.
   const int b = fine.cells;
   const bool all_active = coarse.constant_coefficients && constant_kernels_;
   forest_.for_each_block([&](int blk) {
-    if (all_active) {
+    if (all_active || coarse.block_ring_active[static_cast<std::size_t>(blk)]) {
       prolong_all_active(coarse.x, blk, b, x);
       return;
     }

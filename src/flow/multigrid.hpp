@@ -141,6 +141,9 @@ class Multigrid {
     /// on the block's cells and faces 0..b and every cell is active; the values.
     std::vector<unsigned char> block_constant;
     std::vector<unsigned char> block_all_active;  ///< per local block: active is 1 in every cell
+    /// Per local block: active is exactly 1 in every cell and in the ghost
+    /// ring around them (what the trilinear prolongation from this level reads).
+    std::vector<unsigned char> block_ring_active;
     std::vector<double> block_alpha, block_beta;
     /// Every block of every rank constant (then every cell and ghost is active).
     bool constant_coefficients = false;
