@@ -225,6 +225,15 @@ void send_faces(const Forest& forest, std::array<BlockField, 6>& layers, LevelJu
                        [&](std::ptrdiff_t c, std::ptrdiff_t f) { layer[c] = value(blk, d, f); });
       }
   });
+  if (toward == LevelJump::Coarser) {
+    // Only the coarse blocks' ghosts across faces towards finer blocks are
+    // read (for_received_faces from Finer), and the neighbour wrote under
+    // its own face, the opposite one: each layer travels to that face alone,
+    // without the same-level copies and the fine-side interpolations of a
+    // full exchange of six fields (same bits; docs/performance.md).
+    for (int f = 0; f < 6; ++f) forest.exchange_from_finer(layers[D(f)], f ^ 1);
+    return;
+  }
   std::array<BlockField*, 6> fields{};
   for (std::size_t f = 0; f < 6; ++f) fields[f] = &layers[f];
   forest.exchange(fields, 1, true);
