@@ -79,12 +79,18 @@ def read_frame(paths):
             kind, name, comps, data = m.group(1), m.group(2), int(m.group(3)), m.group(4)
             if kind not in kinds:
                 raise SliceError(f"{path}: array {name} of unsupported type {kind}")
-            raw = base64.b64decode(data)[8:]  # an 8-byte length header, then the values
-            values = np.frombuffer(raw, dtype=kinds[kind])
-            piece[name] = values.reshape(-1, comps) if comps > 1 else values
+            try:
+                raw = base64.b64decode(data, validate=True)[8:]  # an 8-byte length header, then the values
+                values = np.frombuffer(raw, dtype=kinds[kind])
+                piece[name] = values.reshape(-1, comps) if comps > 1 else values
+            except ValueError as e:  # binascii.Error is a ValueError
+                raise SliceError(f"{path}: array {name} is corrupt ({e})") from e
         if "Points" not in piece or "connectivity" not in piece:
             raise SliceError(f"{path}: not a flow frame of sanguis (no Points or connectivity)")
-        corners = piece["Points"][piece["connectivity"].reshape(-1, 8)]
+        try:
+            corners = piece["Points"][piece["connectivity"].reshape(-1, 8)]
+        except (ValueError, IndexError) as e:
+            raise SliceError(f"{path}: cells do not match the points ({e})") from e
         lows.append(corners.min(axis=1))
         highs.append(corners.max(axis=1))
         for name, values in piece.items():
