@@ -90,20 +90,22 @@ std::string source_dir() {
   return SANGUIS_SOURCE_DIR;
 }
 
-// Draws the figures of an analysis folder (scripts/plot_analysis.py, matplotlib).
-void plot(const fs::path& dir) {
-  const std::string script = source_dir() + "/scripts/plot_analysis.py";
-  const std::string command = "/usr/bin/python3 '" + script + "' '" + dir.string() + "'";
-  if (std::system(command.c_str()) != 0) {
-    std::cerr << "sanguis: warning: plotting failed (" << command
-              << "); the CSV files are written\n";
-  }
-}
-
+// A shell word holding s exactly (single quotes; a quote inside as '\\'').
 std::string shell_quoted(const std::string& s) {
   std::string out = "'";
   for (const char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
   return out + "'";
+}
+
+// Draws the figures of an analysis folder (scripts/plot_analysis.py, matplotlib).
+void plot(const fs::path& dir) {
+  const std::string command = "/usr/bin/python3 " +
+                              shell_quoted(source_dir() + "/scripts/plot_analysis.py") + " " +
+                              shell_quoted(dir.string());
+  if (std::system(command.c_str()) != 0) {
+    std::cerr << "sanguis: warning: plotting failed (" << command
+              << "); the CSV files are written\n";
+  }
 }
 
 // A plane slice of a flow run as PNG and CSV (scripts/flow_slice.py, matplotlib):

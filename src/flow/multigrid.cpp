@@ -263,6 +263,14 @@ AcrossFaces same_level_neighbours(const Forest& forest, const BlockField& x, int
   if (high && cells[1]) row[b] = cells[1][L.index(0, j, k) + shift[1]];
 }
 
+/// pull_row_x_ghosts in a half-sweep whose colour starts the row at i_first:
+/// the ghost beside each end cell of that colour.
+[[gnu::always_inline]] inline void pull_row_x_ghosts_of_colour(double* row, const BlockLayout& L,
+                                                               const AcrossFaces& across, int j,
+                                                               int k, int i_first) {
+  pull_row_x_ghosts(row, L, across, j, k, i_first == 0, ((L.cells - 1 - i_first) & 1) == 0);
+}
+
 /// Red-black Gauss-Seidel on the cells of one colour (i + j + k + first even)
 /// of a block whose alpha and beta are constants: relaxed_value, the same
 /// operations in the same order, with the implicit part of smooth() (the
@@ -294,7 +302,7 @@ inline void relax_constant(double* x, const double* rhs, const BlockLayout& L, i
       // block writes them in this half-sweep).
       const auto [y_lo, y_hi, z_lo, z_hi] = neighbour_rows(row, L, across, j, k);
       const int i_first = (k + j + first) & 1;
-      pull_row_x_ghosts(row, L, across, j, k, i_first == 0, ((b - 1 - i_first) & 1) == 0);
+      pull_row_x_ghosts_of_colour(row, L, across, j, k, i_first);
       for (int i = i_first; i < b; i += 2) {
         double implicit = 0.0;
         double den = interior;
@@ -361,7 +369,7 @@ double block_squares(const BlockField& f, int blk) {
 // `combine` from 0, and stores `finish` of the result. The one loop behind the
 // coefficient averages, the activity flags and the residual transfer.
 template <typename Combine, typename Finish>
-void restrict_block(const double* fine, const BlockLayout& F, double* coarse, const BlockLayout& C,
+void restrict_cells(const double* fine, const BlockLayout& F, double* coarse, const BlockLayout& C,
                     int coarse_cells, Combine combine, Finish finish) {
   for (int k = 0; k < coarse_cells; ++k)
     for (int j = 0; j < coarse_cells; ++j)
@@ -379,7 +387,7 @@ template <typename Combine, typename Finish>
 void restrict_children(const Forest& forest, const BlockField& fine, BlockField& coarse,
                        int coarse_cells, Combine combine, Finish finish) {
   forest.for_each_block([&](int blk) {
-    restrict_block(fine.block(blk), fine.layout(), coarse.block(blk), coarse.layout(), coarse_cells,
+    restrict_cells(fine.block(blk), fine.layout(), coarse.block(blk), coarse.layout(), coarse_cells,
                    combine, finish);
   });
 }
@@ -830,7 +838,7 @@ void Multigrid::relax_block(int level, int blk, BlockField& x, const BlockField&
       const std::ptrdiff_t start = L.index(0, j, kk);
       double* row = xb + start;
       const int i_first = (kk + j + first) & 1;
-      pull_row_x_ghosts(row, L, across, j, kk, i_first == 0, ((b - 1 - i_first) & 1) == 0);
+      pull_row_x_ghosts_of_colour(row, L, across, j, kk, i_first);
       const RowStencil around{row, neighbour_rows(row, L, across, j, kk)};
       for (int i = i_first; i < b; i += 2) {
         const std::ptrdiff_t c = start + i;
@@ -934,7 +942,7 @@ void Multigrid::compute_residual(int level, BlockField& x, const BlockField& rhs
       block_squares_[at] = squares;
     }
     if (restricted) {
-      restrict_block(rb, L, restricted->block(blk), restricted->layout(), b / 2, kAdd, kMean8);
+      restrict_cells(rb, L, restricted->block(blk), restricted->layout(), b / 2, kAdd, kMean8);
     }
   });
 }
