@@ -41,7 +41,7 @@ struct AnalyzeArgs {
   std::string out;
   double time = -1.0;
   double initial_time = -1.0;
-  double wall = NAN, floor = NAN, pixel = NAN, strong = 5.0, gravity = 9.81;
+  double wall = NAN, floor = NAN, pixel = NAN, strong = 5.0, gravity = 9.81, bulk_margin = NAN;
   std::vector<double> width;
   bool plot = false;
 };
@@ -83,6 +83,7 @@ AnalysisOptions analysis_options(const AnalyzeArgs& a) {
   }
   o.strong_force_ratio = a.strong;
   o.gravity = a.gravity;
+  if (!std::isnan(a.bulk_margin)) o.bulk_margin = a.bulk_margin;
   return o;
 }
 
@@ -152,9 +153,18 @@ void print_summary(const RunAnalysis& a) {
               a.final_height.mean, a.final_height.first_quartile, a.final_height.third_quartile,
               a.repose.angle_deg);
   if (!a.coordination.empty()) {
+    const auto& whole = a.coordination[0].second;
     std::printf("  coordination (t0): pairs %.3f, contact points %.3f; fabric anisotropy %.3f\n",
-                a.coordination[0].second.pair_coordination,
-                a.coordination[0].second.contact_point_coordination, a.fabric.anisotropy);
+                whole.pair_coordination, whole.contact_point_coordination, a.fabric.anisotropy);
+    std::printf("  %zu of %zu particles touch an obstacle; pairs of the others %.3f\n",
+                whole.particles_touching_obstacles, whole.particles,
+                whole.pair_coordination_away_from_obstacles);
+  }
+  if (a.coordination.size() > 3 && a.coordination[3].second.particles > 0) {
+    const auto& bulk = a.coordination[3].second;
+    std::printf(
+        "  bulk (%.3g m in from every side): %zu particles, pairs %.3f, contact points %.3f\n",
+        a.bulk_margin, bulk.particles, bulk.pair_coordination, bulk.contact_point_coordination);
   }
 }
 
@@ -540,6 +550,10 @@ std::function<bool()> add_analysis_commands(CLI::App& app) {
   an->add_option("--strong", analyze->strong, "strong network: Fc / <Fc> above this")
       ->capture_default_str();
   an->add_option("--gravity", analyze->gravity, "|g| [m/s^2]")->capture_default_str();
+  an->add_option("--bulk-margin", analyze->bulk_margin,
+                 "coordination of the bulk: the column less this margin on every side [m] "
+                 "(default: two mean bounding diameters)")
+      ->check(CLI::NonNegativeNumber);
   an->add_flag("--plot", analyze->plot, "draw PNG figures (matplotlib)");
 
   auto* en = app.add_subcommand("ensemble", "run a case over several seeds in parallel, analyze");

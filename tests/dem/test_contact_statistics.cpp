@@ -91,6 +91,9 @@ TEST(Coordination, CountsPairsContactPointsAndWallContacts) {
   EXPECT_DOUBLE_EQ(all.pair_coordination, 4.0 / 3.0);
   EXPECT_DOUBLE_EQ(all.contact_point_coordination, 6.0 / 3.0);
   EXPECT_EQ(all.wall_contact_points.at(0), 2u);
+  // 1 and 2 touch the floor; particle 0 alone touches none, with one neighbour.
+  EXPECT_EQ(all.particles_touching_obstacles, 2u);
+  EXPECT_DOUBLE_EQ(all.pair_coordination_away_from_obstacles, 1.0);
 
   Region right;
   right.min.x = 1.5;
@@ -99,6 +102,8 @@ TEST(Coordination, CountsPairsContactPointsAndWallContacts) {
   EXPECT_DOUBLE_EQ(r.pair_coordination, 1.0);
   EXPECT_DOUBLE_EQ(r.contact_point_coordination, 2.0);
   EXPECT_EQ(r.wall_contact_points.at(0), 1u);
+  EXPECT_EQ(r.particles_touching_obstacles, 1u);
+  EXPECT_DOUBLE_EQ(r.pair_coordination_away_from_obstacles, 0.0);  // none touches no obstacle
 
   const auto loads = wall_loads(p, c, 9.81);
   EXPECT_EQ(loads.at(0).contact_points, 2u);

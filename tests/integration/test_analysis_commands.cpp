@@ -74,6 +74,14 @@ TEST_F(AnalysisCommandTest, AnalyzeMeasuresTheCollapseOfASmallColumn) {
   // A random loose packing of frictional spheres: 3 to 6 neighbours.
   EXPECT_GT(number(s, "pair_coordination"), 3.0);
   EXPECT_LT(number(s, "pair_coordination"), 6.0);
+  // Four beads across: most touch a wall, where they lack neighbours; those
+  // that touch none have more. The default bulk (four mean radii, 8 mm, in
+  // from every side) is empty in a column 16 mm wide.
+  EXPECT_GT(number(s, "particles_touching_obstacles_fraction"), 0.5);
+  EXPECT_LT(number(s, "particles_touching_obstacles_fraction"), 1.0);
+  EXPECT_GT(number(s, "pair_coordination_away_from_obstacles"), number(s, "pair_coordination"));
+  EXPECT_NEAR(number(s, "bulk_margin_m"), 0.008, 0.0005);
+  EXPECT_EQ(number(s, "bulk_particles"), 0.0);
   // The walls carry the column: floor most of it, nothing pulls down.
   const std::string walls = read_text_file(out / "walls.csv");
   EXPECT_NE(walls.find("\"side wall, front\""), std::string::npos);
@@ -85,6 +93,21 @@ TEST_F(AnalysisCommandTest, AnalyzeMeasuresTheCollapseOfASmallColumn) {
   const io::PolyMesh strong = io::read_polymesh_vtp(out / "strong_network.vtp");
   const io::PolyMesh all = io::read_polymesh_vtp(run / "contacts" / "branches_00000010.vtp");
   EXPECT_LT(strong.lines.size(), all.lines.size());
+
+  // A bulk one radius in from every side: the core of the column, better
+  // surrounded than the column as a whole.
+  const fs::path core = dir_ / "core";
+  const CommandResult b = sanguis("analyze " + shell_quoted(run.string()) +
+                                  " --bulk-margin 0.002 --out " + shell_quoted(core.string()));
+  ASSERT_EQ(b.code, 0) << b.err;
+  EXPECT_NE(b.out.find("bulk (0.002 m in from every side)"), std::string::npos) << b.out;
+  const auto c = first_row(core / "summary.csv");
+  EXPECT_GT(number(c, "bulk_particles"), 10.0);
+  EXPECT_LT(number(c, "bulk_particles"), number(c, "particles"));
+  EXPECT_GT(number(c, "bulk_pair_coordination"), number(c, "pair_coordination"));
+  EXPECT_LT(number(c, "bulk_pair_coordination"), 7.0);
+  EXPECT_NE(read_text_file(core / "coordination.csv").find("\"bulk\""), std::string::npos);
+  EXPECT_EQ(sanguis("analyze " + shell_quoted(run.string()) + " --bulk-margin -1").code, 2);
 }
 
 TEST_F(AnalysisCommandTest, AnalyzeRefusesAFolderThatIsNotARun) {

@@ -134,6 +134,15 @@ def main():
         {"quantity": "coordination, touching neighbours per cross", "measured": round(zp, 3),
          "thesis": "8.2 (Table B.1)", "tolerance": "±20 %", "pass": abs(zp / 8.2 - 1) <= 0.2},
     ]
+    # How much of the column is boundary: a cross against a wall, the floor or the gate
+    # has the wall where it would have neighbours (the bulk of `sanguis analyze`, four
+    # mean bounding radii in from every side, is empty in a column 3.9 cm long).
+    wall_share = s0["particles_touching_obstacles_fraction"]
+    zp_away = s0["pair_coordination_away_from_obstacles"]
+    checks.append({"quantity": "crosses touching a wall, the floor or the gate; touching neighbours "
+                   "per cross of the others (gate opening)",
+                   "measured": f"{100 * wall_share:.0f} %; {zp_away:.3f}",
+                   "thesis": "8.2 (Table B.1)", "tolerance": "reported", "pass": None})
     at_opening = diagnostics(pour)[-1]
     checks.append({"quantity": "sanity: mean speed at the opening [m/s]",
                    "measured": f"{at_opening['mean_velocity_m_s']:.2g}", "thesis": "—",

@@ -217,6 +217,20 @@ def main():
     # Glued beads touch neither each other nor the walls (no such contacts are formed
     # since 6988d1b and 124d8c3). The report of 2026-11-23 02:25 analysed runs made
     # before 124d8c3 and counted contacts of glued beads: 4.63; 5.36.
+    # The boundary's share: beads against a wall, the glued floor or the gate lack
+    # neighbours there (glued beads are not obstacles: beads on them count as touching
+    # none); the bulk is the column less four mean radii on every side.
+    n = len(points)
+    wall_share = sum(p["particles_touching_obstacles_fraction"] for p in points) / n
+    z_away = sum(p["pair_coordination_away_from_obstacles"] for p in points) / n
+    bulk = [p for p in points if p["bulk_particles"] > 0]
+    z_bulk = sum(p["bulk_pair_coordination"] for p in bulk) / max(len(bulk), 1)
+    checks.append({"quantity": "beads touching a wall or the gate; pairs per bead of the others; "
+                   f"pairs per bead of the bulk (mean of the {len(bulk)} runs that have one)",
+                   "measured": f"{100 * wall_share:.0f} %; {z_away:.2f}; {z_bulk:.2f}",
+                   "thesis": "5.6 (§3.3.3); frictional spheres compressed at mu = 0.3: about "
+                   "4.5, rattlers left out (Agnolin & Roux 2007)",
+                   "tolerance": "reported", "pass": None})
     checks.append({"quantity": "contacts per bead, contacts with walls and glued floor beads "
                    "included; 2 × (all contacts) / beads",
                    "measured": f"{per_bead / len(counts):.2f}; {thesis_formula / len(counts):.2f}",

@@ -173,10 +173,18 @@ RunAnalysis analyze_run(const RunOutput& run, const AnalysisOptions& o) {
   gate_half.max.x = x_gate;
   gate_top = gate_half;
   gate_top.min.z = z_half;
+  double mean_radius = 0.0;
+  for (const double r : initial.radius) mean_radius += r / static_cast<double>(initial.size());
+  const double margin = o.bulk_margin.value_or(4.0 * mean_radius);
+  Region bulk;
+  bulk.min = {a.wall_x + margin, a.y_min + margin, a.floor_z + margin};
+  bulk.max = {x_gate - margin, a.y_max - margin, a.floor_z + a.initial_height.mean - margin};
+  a.bulk_margin = margin;
   a.coordination = {
       {"whole", coordination(initial, branches, contacts, whole)},
       {"half near the gate", coordination(initial, branches, contacts, gate_half)},
-      {"quarter near the top of the gate", coordination(initial, branches, contacts, gate_top)}};
+      {"quarter near the top of the gate", coordination(initial, branches, contacts, gate_top)},
+      {"bulk", coordination(initial, branches, contacts, bulk)}};
   a.wall_loads = wall_loads(initial, contacts, o.gravity);
   for (std::size_t k = 0; k < std::max<std::size_t>(run.obstacle_count(), 1); ++k) {
     a.obstacle_names.push_back(run.obstacle_name(static_cast<std::int64_t>(k)));
@@ -210,6 +218,7 @@ std::vector<std::pair<std::string, double>> summary_values(const RunAnalysis& a)
     }
   }
   const Coordination whole = a.coordination.empty() ? Coordination{} : a.coordination[0].second;
+  const Coordination bulk = a.coordination.size() < 4 ? Coordination{} : a.coordination[3].second;
   return {
       {"initial_time_s", a.initial_time},
       {"release_time_s", a.release_time},
@@ -238,6 +247,15 @@ std::vector<std::pair<std::string, double>> summary_values(const RunAnalysis& a)
       {"fabric_anisotropy", a.fabric.anisotropy},
       {"repose_angle_deg", a.repose.angle_deg},
       {"fabric_principal_angle_deg", a.fabric.principal_angle_deg},
+      {"particles_touching_obstacles_fraction",
+       whole.particles > 0 ? static_cast<double>(whole.particles_touching_obstacles) /
+                                 static_cast<double>(whole.particles)
+                           : 0.0},
+      {"pair_coordination_away_from_obstacles", whole.pair_coordination_away_from_obstacles},
+      {"bulk_margin_m", a.bulk_margin},
+      {"bulk_particles", static_cast<double>(bulk.particles)},
+      {"bulk_pair_coordination", bulk.pair_coordination},
+      {"bulk_contact_point_coordination", bulk.contact_point_coordination},
   };
 }
 
@@ -288,13 +306,18 @@ void write_analysis(const RunAnalysis& a, const std::filesystem::path& out) {
 
   rows.clear();
   for (const auto& [name, c] : a.coordination) {
-    std::vector<std::string> row = {quoted(name), format(static_cast<double>(c.particles)),
+    std::vector<std::string> row = {quoted(name),
+                                    format(static_cast<double>(c.particles)),
                                     format(c.pair_coordination),
-                                    format(c.contact_point_coordination)};
+                                    format(c.contact_point_coordination),
+                                    format(static_cast<double>(c.particles_touching_obstacles)),
+                                    format(c.pair_coordination_away_from_obstacles)};
     rows.push_back(row);
   }
   write_csv(out / "coordination.csv",
-            {"region", "particles", "pair_coordination", "contact_point_coordination"}, rows);
+            {"region", "particles", "pair_coordination", "contact_point_coordination",
+             "particles_touching_obstacles", "pair_coordination_away_from_obstacles"},
+            rows);
 
   // Contacts per obstacle, by region, and the loads of the whole assembly.
   rows.clear();
@@ -313,11 +336,11 @@ void write_analysis(const RunAnalysis& a, const std::filesystem::path& out) {
     }
     rows.push_back(row);
   }
-  write_csv(
-      out / "walls.csv",
-      {"obstacle", "name", "contacts_whole", "contacts_half_near_gate",
-       "contacts_quarter_near_gate_top", "force_x_N", "force_y_N", "force_z_N", "weight_fraction"},
-      rows);
+  write_csv(out / "walls.csv",
+            {"obstacle", "name", "contacts_whole", "contacts_half_near_gate",
+             "contacts_quarter_near_gate_top", "contacts_bulk", "force_x_N", "force_y_N",
+             "force_z_N", "weight_fraction"},
+            rows);
 
   io::PolyMesh network;
   io::DataArray magnitude{"force_magnitude", 1, {}};

@@ -33,6 +33,12 @@ struct AnalysisOptions {
   double strong_force_ratio = 5.0;  // network of Fc / <Fc> above this (Fig. 3.11b)
   std::size_t fabric_bins = 36;
   RegimeThresholds regime;
+  // The "bulk" coordination region: the column (back wall to the gate, floor
+  // to H0, across the width) less this margin on every side [m]; unset: two
+  // mean bounding diameters of the initial frame's particles (four mean
+  // bounding radii), the layers where walls and the free surface take the
+  // place of neighbours.
+  std::optional<double> bulk_margin;
 };
 
 struct TimeSample {
@@ -42,7 +48,7 @@ struct TimeSample {
 };
 
 struct RunAnalysis {
-  std::string run;  // folder analysed
+  std::string run;                              // folder analysed
   double initial_time = 0.0, final_time = 0.0;  // frames measured [s]
   double release_time = 0.0;  // origin of the time series: the gate's removal, if any [s]
   double wall_x = 0.0, floor_z = 0.0, y_min = 0.0, y_max = 0.0, pixel = 0.0;
@@ -57,7 +63,9 @@ struct RunAnalysis {
   // Contact network of the initial frame (just before the gate opens).
   Histogram force_pdf_linear, force_pdf_log;
   Fabric fabric;
-  std::vector<std::pair<std::string, Coordination>> coordination;  // whole + sub-regions
+  // whole, half near the gate, quarter near the top of the gate (Table B.1), bulk
+  std::vector<std::pair<std::string, Coordination>> coordination;
+  double bulk_margin = 0.0;  // [m] the bulk region's inset (AnalysisOptions::bulk_margin)
   std::map<std::int64_t, WallLoad> wall_loads;
   std::vector<std::string> obstacle_names;  // by index, for the loads and contacts
   BranchFrame strong_network;

@@ -5,6 +5,7 @@
 #include <numbers>
 #include <stdexcept>
 #include <unordered_map>
+#include <unordered_set>
 
 namespace sanguis::dem::analysis {
 
@@ -117,21 +118,38 @@ Coordination coordination(const ParticleFrame& particles, const BranchFrame& bra
     return it != inside.end() && it->second;
   };
   double pair_ends = 0.0, point_ends = 0.0;
+  std::unordered_map<std::int64_t, std::size_t> pairs_of;  // touching neighbours per particle
   for (std::size_t k = 0; k < branches.size(); ++k) {
-    pair_ends +=
-        (in_region(branches.first[k]) ? 1.0 : 0.0) + (in_region(branches.second[k]) ? 1.0 : 0.0);
+    for (const std::int64_t id : {branches.first[k], branches.second[k]}) {
+      if (!in_region(id)) continue;
+      pair_ends += 1.0;
+      ++pairs_of[id];
+    }
   }
+  std::unordered_set<std::int64_t> on_obstacle;
   for (std::size_t k = 0; k < contacts.size(); ++k) {
     if (ContactPointFrame::is_wall(contacts.kind[k])) {
-      if (in_region(contacts.first[k])) ++c.wall_contact_points[contacts.second[k]];
+      if (in_region(contacts.first[k])) {
+        ++c.wall_contact_points[contacts.second[k]];
+        on_obstacle.insert(contacts.first[k]);
+      }
       continue;
     }
     point_ends +=
         (in_region(contacts.first[k]) ? 1.0 : 0.0) + (in_region(contacts.second[k]) ? 1.0 : 0.0);
   }
+  c.particles_touching_obstacles = on_obstacle.size();
   if (c.particles > 0) {
     c.pair_coordination = pair_ends / static_cast<double>(c.particles);
     c.contact_point_coordination = point_ends / static_cast<double>(c.particles);
+  }
+  if (c.particles > c.particles_touching_obstacles) {
+    double away_ends = 0.0;
+    for (const auto& [id, pairs] : pairs_of) {
+      if (!on_obstacle.contains(id)) away_ends += static_cast<double>(pairs);
+    }
+    c.pair_coordination_away_from_obstacles =
+        away_ends / static_cast<double>(c.particles - c.particles_touching_obstacles);
   }
   return c;
 }

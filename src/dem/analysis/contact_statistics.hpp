@@ -54,12 +54,18 @@ struct Region {
 // Coordination of the particles of a region (§3.3.3, Table B.1): mean number
 // of touching neighbours (pairs), mean number of contact points with other
 // particles (an element contact counts once: crosses touch a neighbour at up
-// to several points), and the contact points with each obstacle.
+// to several points), and the contact points with each obstacle. A particle
+// against a wall has a wall where it would have neighbours, so a small column
+// (mostly wall particles) has a lower mean than a large one: the particles
+// that touch an obstacle are counted, and the pair coordination of the others
+// given apart (0 when there are none).
 struct Coordination {
   std::size_t particles = 0;
   double pair_coordination = 0.0;
   double contact_point_coordination = 0.0;
   std::map<std::int64_t, std::size_t> wall_contact_points;  // by obstacle index
+  std::size_t particles_touching_obstacles = 0;        // with at least one obstacle contact point
+  double pair_coordination_away_from_obstacles = 0.0;  // of the particles touching none
 };
 Coordination coordination(const ParticleFrame& particles, const BranchFrame& branches,
                           const ContactPointFrame& contacts, const Region& region);
