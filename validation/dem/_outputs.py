@@ -6,6 +6,7 @@ import csv
 import json
 import os
 import re
+import shutil
 import time
 import tomllib
 import xml.etree.ElementTree as ET
@@ -74,6 +75,34 @@ def calibration_value_folder(calibration_dir, value):
         if name.startswith("value_") and float(name[len("value_"):]) == value:
             return os.path.join(calibration_dir, name)
     raise FileNotFoundError(f"no run folder for the value {value:g} in {calibration_dir}")
+
+
+def reached_time(run):
+    """The latest simulated time [s] a segment of the run finished at (the `done:` lines
+    of its run.log), 0 when none finished."""
+    reached = 0.0
+    path = os.path.join(run, "run.log")
+    if os.path.exists(path):
+        with open(path) as f:
+            for line in f:
+                end = re.search(r"t = (\S+) s", line)
+                if line.startswith("done:") and end:
+                    reached = max(reached, float(end.group(1)))
+    return reached
+
+
+def pour_command(cmd, out, end_s, rerun=False):
+    """The command that brings the pour in `out` to end_s, or None when a run got there.
+    `cmd`: `sanguis run` with its output folder and overrides, without the end time. A pour
+    stopped on the way (a killed run leaves the checkpoint of an earlier time, which is not
+    the opening's) is continued from that checkpoint, the same bits as one run; `rerun`
+    clears the folder and starts afresh."""
+    if rerun:
+        shutil.rmtree(out, ignore_errors=True)
+    checkpoint = os.path.exists(os.path.join(out, "checkpoint.bin"))
+    if checkpoint and reached_time(out) >= end_s - 1e-9:
+        return None
+    return cmd + (["--restart"] if checkpoint else []) + ["--set", f"simulation.end_time_s={end_s}"]
 
 
 def wall_time(run, after=-1.0):

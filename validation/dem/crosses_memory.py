@@ -39,8 +39,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import (gate_removal_time, read_arrays, read_pvd, read_summary,  # noqa: E402
-                      regime_name, wall_time)
+from _outputs import (gate_removal_time, pour_command, read_arrays, read_pvd,  # noqa: E402
+                      read_summary, regime_name, wall_time)
 from crosses_dam_break import diagnostics  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -88,9 +88,10 @@ def main():
     t0 = time.time()
     pour = os.path.join(RUNS, "pour")
     reused_pour_s = 0.0  # a pour kept from an earlier call still counts in the run time
-    if args.rerun_pour or not os.path.exists(os.path.join(pour, "checkpoint.bin")):
-        subprocess.run([exe, "run", CASE, "--output", pour, "--quiet", "--threads", "1",
-                        "--set", f"simulation.end_time_s={GATE_TIME}"], check=True)
+    pour_cmd = pour_command([exe, "run", CASE, "--output", pour, "--quiet", "--threads", "1"],
+                            pour, GATE_TIME, args.rerun_pour)
+    if pour_cmd:
+        subprocess.run(pour_cmd, check=True)
     else:
         reused_pour_s = wall_time(pour)
     runs = {"memory": os.path.join(RUNS, "memory"), "no memory": os.path.join(RUNS, "no_memory")}

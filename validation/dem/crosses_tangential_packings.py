@@ -34,7 +34,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import read_summary, wall_time, write_summary  # noqa: E402
+from _outputs import pour_command, read_summary, wall_time, write_summary  # noqa: E402
 from crosses_tangential_map import (CASE, GATE_TIME, RESULTS, ROOT,  # noqa: E402
                                     TABLE_31, classify, settings)
 
@@ -72,10 +72,10 @@ def main():
     for seed, d in pours.items():
         if args.reuse:
             continue
-        if args.rerun_pours or not os.path.exists(os.path.join(d, "checkpoint.bin")):
-            shutil.rmtree(d, ignore_errors=True)
-            jobs.append(([exe, "run", CASE, "--output", d, "--quiet", "--threads", "1",
-                          "--seed", str(seed), "--set", f"simulation.end_time_s={GATE_TIME}"], d))
+        cmd = pour_command([exe, "run", CASE, "--output", d, "--quiet", "--threads", "1",
+                            "--seed", str(seed)], d, GATE_TIME, args.rerun_pours)
+        if cmd:
+            jobs.append((cmd, d))
         else:
             reused_s += wall_time(d) / 2  # they ran two at a time
     run_two_at_a_time(jobs)
