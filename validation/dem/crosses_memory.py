@@ -201,7 +201,7 @@ def main():
                   "rest, the case's seed gives H0 17.9 cm, 6.31 touching neighbours and 8.03 "
                   "contact points per cross, and the ratio 8.9.",
                   "Coordination: this column of 300 crosses is 3.9 cm long, one and a half "
-                  "cross lengths, so most crosses touch the back wall, the gate, a side wall "
+                  "cross lengths: many crosses touch the back wall, the gate, a side wall "
                   f"or the floor ({100 * wall_share:.0f} % at the opening), and a cross has "
                   "the wall where it would have neighbours; the crosses that touch none "
                   f"have {zp_away:.2f} touching neighbours, against {zp:.2f} for the whole "
