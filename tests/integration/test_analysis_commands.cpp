@@ -124,6 +124,9 @@ TEST_F(AnalysisCommandTest, EnsembleRunsSeedsInParallelAndAggregates) {
   const std::string table = read_text_file(root / "ensemble.csv");
   EXPECT_NE(table.find("Linf_m,"), std::string::npos);
   EXPECT_NE(table.find("fraction_collapsed,"), std::string::npos);
+  // Columns four beads wide have no bulk: its coordination has no runs, not a mean of zeros.
+  EXPECT_NE(table.find("\nbulk_pair_coordination,,,,,0\n"), std::string::npos) << table;
+  EXPECT_NE(table.find("\nbulk_particles,0,0,0,0,2\n"), std::string::npos) << table;
   // Different seeds, different packings.
   EXPECT_NE(read_text_file(root / "seed_1" / "particles" / "particles_00000000.vtu"),
             read_text_file(root / "seed_2" / "particles" / "particles_00000000.vtu"));

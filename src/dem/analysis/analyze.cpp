@@ -364,20 +364,34 @@ void write_ensemble(const std::vector<RunAnalysis>& runs, const std::filesystem:
   std::filesystem::create_directories(out);
   std::vector<std::vector<std::pair<std::string, double>>> all;
   for (const RunAnalysis& r : runs) all.push_back(summary_values(r));
+  // The bulk's coordination counts only in the runs that have a bulk: an empty
+  // one reads 0, which measures nothing.
+  std::size_t bulk_particles = 0;
+  while (all[0][bulk_particles].first != "bulk_particles") ++bulk_particles;
   std::vector<std::vector<std::string>> rows;
   for (std::size_t c = 0; c < all[0].size(); ++c) {
-    double sum = 0.0, sum2 = 0.0, lo = all[0][c].second, hi = lo;
+    const std::string& name = all[0][c].first;
+    const bool bulk_only =
+        name == "bulk_pair_coordination" || name == "bulk_contact_point_coordination";
+    std::vector<double> values;
     for (const auto& s : all) {
-      sum += s[c].second;
-      sum2 += s[c].second * s[c].second;
-      lo = std::min(lo, s[c].second);
-      hi = std::max(hi, s[c].second);
+      if (!bulk_only || s[bulk_particles].second > 0) values.push_back(s[c].second);
     }
-    const double n = static_cast<double>(all.size());
+    if (values.empty()) {
+      rows.push_back({name, "", "", "", "", "0"});
+      continue;
+    }
+    double sum = 0.0, sum2 = 0.0, lo = values[0], hi = lo;
+    for (const double v : values) {
+      sum += v;
+      sum2 += v * v;
+      lo = std::min(lo, v);
+      hi = std::max(hi, v);
+    }
+    const double n = static_cast<double>(values.size());
     const double mean = sum / n;
     const double var = n > 1 ? std::max(0.0, (sum2 - n * mean * mean) / (n - 1)) : 0.0;
-    rows.push_back(
-        {all[0][c].first, format(mean), format(std::sqrt(var)), format(lo), format(hi), format(n)});
+    rows.push_back({name, format(mean), format(std::sqrt(var)), format(lo), format(hi), format(n)});
   }
   std::size_t regimes[3] = {0, 0, 0};
   for (const RunAnalysis& r : runs) ++regimes[static_cast<int>(r.regime)];
