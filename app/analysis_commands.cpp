@@ -160,8 +160,7 @@ void print_summary(const RunAnalysis& a) {
                 whole.particles_touching_obstacles, whole.particles,
                 whole.pair_coordination_away_from_obstacles);
   }
-  if (a.coordination.size() > 3 && a.coordination[3].second.particles > 0) {
-    const auto& bulk = a.coordination[3].second;
+  if (const auto bulk = a.bulk(); bulk.particles > 0) {
     std::printf(
         "  bulk (%.3g m in from every side): %zu particles, pairs %.3f, contact points %.3f\n",
         a.bulk_margin, bulk.particles, bulk.pair_coordination, bulk.contact_point_coordination);

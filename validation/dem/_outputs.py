@@ -77,18 +77,25 @@ def calibration_value_folder(calibration_dir, value):
     raise FileNotFoundError(f"no run folder for the value {value:g} in {calibration_dir}")
 
 
-def reached_time(run):
-    """The latest simulated time [s] a segment of the run finished at (the `done:` lines
-    of its run.log), 0 when none finished."""
-    reached = 0.0
+def finished_segments(run):
+    """(simulated end time [s], wall-clock seconds) of each segment of the run that
+    finished: the `done:` lines of its run.log (a restarted run has one per segment)."""
     path = os.path.join(run, "run.log")
-    if os.path.exists(path):
-        with open(path) as f:
-            for line in f:
-                end = re.search(r"t = (\S+) s", line)
-                if line.startswith("done:") and end:
-                    reached = max(reached, float(end.group(1)))
-    return reached
+    if not os.path.exists(path):
+        return
+    units = {"h": 3600, "m": 60, "s": 1}
+    with open(path) as f:
+        for line in f:
+            m = re.search(r"steps in (\S+) \(", line)
+            end = re.search(r"t = (\S+) s", line)
+            if line.startswith("done:") and m and end:
+                yield (float(end.group(1)),
+                       sum(int(n) * units[u] for n, u in re.findall(r"(\d+)([hms])", m.group(1))))
+
+
+def reached_time(run):
+    """The latest simulated time [s] a segment of the run finished at, 0 when none did."""
+    return max((end for end, _ in finished_segments(run)), default=0.0)
 
 
 def pour_command(cmd, out, end_s, rerun=False):
@@ -106,17 +113,9 @@ def pour_command(cmd, out, end_s, rerun=False):
 
 
 def wall_time(run, after=-1.0):
-    """Wall-clock seconds of the run: the sum of its `done:` lines (a restarted run has
-    one per segment), or of the segments that ended after time `after` [s]."""
-    total = 0.0
-    with open(os.path.join(run, "run.log")) as f:
-        for line in f:
-            m = re.search(r"steps in (\S+) \(", line)
-            end = re.search(r"t = (\S+) s", line)
-            if line.startswith("done:") and m and end and float(end.group(1)) > after + 1e-9:
-                units = {"h": 3600, "m": 60, "s": 1}
-                total += sum(int(n) * units[u] for n, u in re.findall(r"(\d+)([hms])", m.group(1)))
-    return total
+    """Wall-clock seconds of the run: the sum of its finished segments, or of those that
+    ended after time `after` [s]."""
+    return sum(seconds for end, seconds in finished_segments(run) if end > after + 1e-9)
 
 
 def write_summary(summary, results_dir, elapsed, quick, ok):

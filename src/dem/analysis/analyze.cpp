@@ -218,7 +218,7 @@ std::vector<std::pair<std::string, double>> summary_values(const RunAnalysis& a)
     }
   }
   const Coordination whole = a.coordination.empty() ? Coordination{} : a.coordination[0].second;
-  const Coordination bulk = a.coordination.size() < 4 ? Coordination{} : a.coordination[3].second;
+  const Coordination bulk = a.bulk();
   return {
       {"initial_time_s", a.initial_time},
       {"release_time_s", a.release_time},
@@ -366,8 +366,10 @@ void write_ensemble(const std::vector<RunAnalysis>& runs, const std::filesystem:
   for (const RunAnalysis& r : runs) all.push_back(summary_values(r));
   // The bulk's coordination counts only in the runs that have a bulk: an empty
   // one reads 0, which measures nothing.
-  std::size_t bulk_particles = 0;
-  while (all[0][bulk_particles].first != "bulk_particles") ++bulk_particles;
+  const auto bulk_column = std::find_if(all[0].begin(), all[0].end(),
+                                        [](const auto& v) { return v.first == "bulk_particles"; });
+  if (bulk_column == all[0].end()) throw std::logic_error("ensemble: no bulk_particles column");
+  const auto bulk_particles = static_cast<std::size_t>(bulk_column - all[0].begin());
   std::vector<std::vector<std::string>> rows;
   for (std::size_t c = 0; c < all[0].size(); ++c) {
     const std::string& name = all[0][c].first;

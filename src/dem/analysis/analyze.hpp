@@ -73,6 +73,12 @@ struct RunAnalysis {
   double time_scale() const;      // tau_c = sqrt(H0 / g) [s]
   double velocity_scale() const;  // sqrt(g H0) [m/s]
   double gravity = 9.81;
+
+  static constexpr std::size_t kBulkRegion = 3;  // index of "bulk" in `coordination`
+  // The bulk region's coordination (empty when not measured).
+  Coordination bulk() const {
+    return coordination.size() > kBulkRegion ? coordination[kBulkRegion].second : Coordination{};
+  }
 };
 
 RunAnalysis analyze_run(const RunOutput& run, const AnalysisOptions& options);
