@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <iomanip>
 #include <limits>
 #include <optional>
 #include <ostream>
@@ -286,7 +287,9 @@ FlowRunSummary run_flow_case(const FlowCase& c, const FlowRunOptions& options,
   summary.ranks = forest.ranks();
   std::ostringstream done;
   done.precision(4);
-  done << "done: t = " << ns.time() << " s, " << summary.steps << " steps in "
+  // The time to 10 digits: scripts read it to tell a finished run from a stopped one
+  // (validation/dem/_outputs.py), and 4 digits could round an end time down.
+  done << "done: t = " << std::setprecision(10) << ns.time() << std::setprecision(4) << " s, " << summary.steps << " steps in "
        << ProgressReporter::format_duration(summary.wall_seconds) << " ("
        << (summary.wall_seconds > 0 ? cell_updates / summary.wall_seconds : 0.0)
        << " cell-updates/s)";

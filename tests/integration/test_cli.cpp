@@ -399,6 +399,19 @@ TEST_F(CliTest, VtkCanBeSwitchedOff) {
   EXPECT_TRUE(fs::exists(out / "checkpoint.bin"));
 }
 
+TEST_F(CliTest, RunLogGivesTheEndTimeToMoreThanFourDigits) {
+  // Scripts tell a finished run from a stopped one by the time of run.log's done line
+  // (validation/dem/_outputs.py); four digits would print 0.01235 for 0.012346 s.
+  const fs::path file = dir_ / "falling.toml";
+  write_file(file, kFallingCase);
+  const fs::path out = dir_ / "out";
+  const Result r = sanguis("run " + quoted(file.string()) + " -o " + quoted(out.string()) +
+                           " -q --set simulation.end_time_s=0.012346");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string log = read_file(out / "run.log");
+  EXPECT_NE(log.find("done: t = 0.012346 s, 6173 steps"), std::string::npos) << log;
+}
+
 // --- A blow-up -----------------------------------------------------------------------
 
 TEST_F(CliTest, UnstableTimeStepExitsWithCode1AndKeepsASnapshot) {

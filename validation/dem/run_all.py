@@ -34,9 +34,10 @@ REPORT = os.path.join(ROOT, "docs", "validation", "dem.md")
 
 
 def scripts():
-    # Modules shared by the scripts start with '_'.
+    # Modules shared by the scripts start with '_', their unit tests with 'test_'.
     return sorted(p for p in glob.glob(os.path.join(HERE, "*.py"))
-                  if os.path.basename(p) != "run_all.py" and not os.path.basename(p).startswith("_"))
+                  if os.path.basename(p) != "run_all.py"
+                  and not os.path.basename(p).startswith(("_", "test_")))
 
 
 def cpu_model():

@@ -1,0 +1,177 @@
+"""Tests of validation/dem/_outputs.py, the readers and run-folder helpers every DEM
+validation script relies on. Run by ctest (ValidationScripts.DemOutputs) or by hand:
+/usr/bin/python3 -m unittest discover -s validation/dem -p 'test_*.py'"""
+import base64
+import json
+import os
+import struct
+import sys
+import tempfile
+import unittest
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import _outputs  # noqa: E402
+
+
+def data_array(name, kind, values, components=1):
+    """A VTK XML DataArray in sanguis' binary form: base64 of a UInt64 byte count, then
+    the little-endian values."""
+    fmt = {"Float64": "d", "Int64": "q", "UInt8": "B"}[kind]
+    raw = struct.pack(f"<{len(values)}{fmt}", *values)
+    payload = base64.b64encode(struct.pack("<Q", len(raw)) + raw).decode()
+    return (f'<DataArray type="{kind}" Name="{name}" NumberOfComponents="{components}" '
+            f'format="binary">\n  {payload}\n</DataArray>')
+
+
+def write_run_log(folder, lines):
+    os.makedirs(folder, exist_ok=True)
+    with open(os.path.join(folder, "run.log"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+
+
+class ReadArrays(unittest.TestCase):
+    def test_reads_float_and_integer_arrays_and_skips_other_types(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "frame.vtu")
+            with open(path, "w") as f:
+                f.write("<VTKFile><UnstructuredGrid><Piece><PointData>\n"
+                        + data_array("velocity", "Float64", [1.0, 2.0, 3.0, -4.0, 5.5, 6.0], 3)
+                        + "\n" + data_array("id", "Int64", [7, -8]) + "\n"
+                        + data_array("flags", "UInt8", [1, 0]) + "\n"
+                        + "</PointData><Points>\n"
+                        + data_array("Points", "Float64", [0.0] * 6, 3)
+                        + "\n</Points></Piece></UnstructuredGrid></VTKFile>\n")
+            arrays = _outputs.read_arrays(path)
+        self.assertEqual(sorted(arrays), ["Points", "id", "velocity"])
+        self.assertEqual(arrays["velocity"].shape, (2, 3))
+        self.assertEqual(arrays["velocity"][1].tolist(), [-4.0, 5.5, 6.0])
+        self.assertEqual(arrays["id"].tolist(), [7, -8])
+
+
+class ReadPvd(unittest.TestCase):
+    def test_gives_times_and_absolute_paths_in_order(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "particles.pvd")
+            with open(path, "w") as f:
+                f.write('<VTKFile type="Collection"><Collection>'
+                        '<DataSet timestep="0" file="frames/p_0.vtu"/>'
+                        '<DataSet timestep="0.25" file="frames/p_1.vtu"/>'
+                        '</Collection></VTKFile>')
+            frames = _outputs.read_pvd(path)
+            self.assertEqual(frames, [(0.0, os.path.join(tmp, "frames/p_0.vtu")),
+                                      (0.25, os.path.join(tmp, "frames/p_1.vtu"))])
+
+
+class CaseAndSummaries(unittest.TestCase):
+    def test_gate_removal_time_comes_from_the_obstacle_named_gate(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            case = os.path.join(tmp, "case.toml")
+            with open(case, "w") as f:
+                f.write('[[obstacle]]\nname = "floor"\n\n'
+                        '[[obstacle]]\nname = "gate"\nremove_at_s = 2.4\n')
+            self.assertEqual(_outputs.gate_removal_time(case), 2.4)
+            with open(case, "w") as f:
+                f.write('[[obstacle]]\nname = "floor"\n')
+            with self.assertRaisesRegex(ValueError, "no obstacle named 'gate'"):
+                _outputs.gate_removal_time(case)
+
+    def test_summary_row_and_regime(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            os.makedirs(os.path.join(tmp, "analysis"))
+            with open(os.path.join(tmp, "analysis", "summary.csv"), "w") as f:
+                f.write("runout_m,regime\n0.125,1\n")
+            summary = _outputs.read_summary(tmp)
+        self.assertEqual(summary, {"runout_m": 0.125, "regime": 1.0})
+        self.assertEqual(_outputs.regime_name(summary), "fractured")
+        self.assertEqual(_outputs.regime_name({"regime": 0.0}), "stable")
+        self.assertEqual(_outputs.regime_name({"regime": 2.0}), "collapsed")
+
+    def test_calibration_folder_is_found_by_value_not_by_spelling(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            for name in ("value_0.1", "value_1e-05", "value_300"):
+                os.makedirs(os.path.join(tmp, name))
+            self.assertEqual(_outputs.calibration_value_folder(tmp, 1e-5),
+                             os.path.join(tmp, "value_1e-05"))
+            self.assertEqual(_outputs.calibration_value_folder(tmp, 300.0),
+                             os.path.join(tmp, "value_300"))
+            with self.assertRaises(FileNotFoundError):
+                _outputs.calibration_value_folder(tmp, 0.2)
+
+    def test_write_summary_completes_and_writes_the_case_file(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            _outputs.write_summary({"name": "case_x", "checks": []}, tmp, 12.345, False, True)
+            with open(os.path.join(tmp, "case_x.json")) as f:
+                s = json.load(f)
+        self.assertEqual(s["run_time_s"], 12.3)
+        self.assertIs(s["quick"], False)
+        self.assertIs(s["pass"], True)
+        self.assertRegex(s["date"], r"^\d{4}-\d\d-\d\d \d\d:\d\d$")
+
+
+class RunSegments(unittest.TestCase):
+    LOG = ["sanguis 0.1, case.toml",
+           "done: t = 3 s, 880000 steps in 11m25s (2.964e+05 particle-steps/s)",
+           "restart from checkpoint.bin at t = 3 s",
+           "done: t = 3.8 s, 320000 steps in 1h05m (2.779e+05 particle-steps/s), settled",
+           "done: t = 4 s, 10 steps in 7s (1e+05 particle-steps/s)"]
+
+    def test_each_done_line_is_a_segment_with_its_wall_time(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            write_run_log(tmp, self.LOG)
+            self.assertEqual(list(_outputs.finished_segments(tmp)),
+                             [(3.0, 685), (3.8, 3900), (4.0, 7)])
+            self.assertEqual(_outputs.reached_time(tmp), 4.0)
+            self.assertEqual(_outputs.wall_time(tmp), 685 + 3900 + 7)
+            self.assertEqual(_outputs.wall_time(tmp, after=3.0), 3900 + 7)
+
+    def test_a_folder_without_log_has_no_segments(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            self.assertEqual(list(_outputs.finished_segments(tmp)), [])
+            self.assertEqual(_outputs.reached_time(tmp), 0.0)
+            self.assertEqual(_outputs.wall_time(tmp), 0)
+
+
+class PourCommand(unittest.TestCase):
+    CMD = ["sanguis", "run", "case.toml", "-o", "pour"]
+
+    def pour(self, tmp, log, checkpoint=True):
+        out = os.path.join(tmp, "pour")
+        write_run_log(out, log)
+        if checkpoint:
+            open(os.path.join(out, "checkpoint.bin"), "w").close()
+        return out
+
+    def test_a_pour_that_reached_its_end_is_kept(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            out = self.pour(tmp, ["done: t = 2.4 s, 10 steps in 5s (1 particle-steps/s)"])
+            self.assertIsNone(_outputs.pour_command(self.CMD, out, 2.4))
+
+    def test_a_stopped_pour_is_continued_from_its_checkpoint(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            # A killed run: its last segment wrote no done line; its checkpoint is from
+            # an earlier time than the opening.
+            out = self.pour(tmp, ["done: t = 0.8 s, 10 steps in 5s (1 particle-steps/s)"])
+            self.assertEqual(_outputs.pour_command(self.CMD, out, 2.4),
+                             self.CMD + ["--restart", "--set", "simulation.end_time_s=2.4"])
+
+    def test_an_end_time_of_more_than_four_digits_is_recognised(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            out = self.pour(tmp, ["done: t = 2.40625 s, 10 steps in 5s (1 particle-steps/s)"])
+            self.assertIsNone(_outputs.pour_command(self.CMD, out, 2.40625))
+
+    def test_an_empty_folder_gets_a_fresh_run(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            out = os.path.join(tmp, "pour")
+            self.assertEqual(_outputs.pour_command(self.CMD, out, 2.4),
+                             self.CMD + ["--set", "simulation.end_time_s=2.4"])
+
+    def test_rerun_clears_a_finished_pour(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            out = self.pour(tmp, ["done: t = 2.4 s, 10 steps in 5s (1 particle-steps/s)"])
+            self.assertEqual(_outputs.pour_command(self.CMD, out, 2.4, rerun=True),
+                             self.CMD + ["--set", "simulation.end_time_s=2.4"])
+            self.assertFalse(os.path.exists(out))
+
+
+if __name__ == "__main__":
+    unittest.main()

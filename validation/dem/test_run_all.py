@@ -1,0 +1,104 @@
+"""Tests of validation/dem/run_all.py: which scripts it runs, how it stamps a case with
+its machine, and the report it writes. Run by ctest (ValidationScripts.DemOutputs) or
+by hand: /usr/bin/python3 -m unittest discover -s validation/dem -p 'test_*.py'"""
+import json
+import os
+import sys
+import tempfile
+import time
+import unittest
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import run_all  # noqa: E402
+
+
+def summary(name, passed, **extra):
+    s = {"name": name, "title": f"Case {name}", "thesis": "§2.6", "description": "What it does.",
+         "command": f"validation/dem/{name}.py", "date": "2026-12-02 05:00", "run_time_s": 75.0,
+         "pass": passed, "figures": [], "notes": ["a note"],
+         "checks": [{"quantity": "angle | deg", "measured": 35.123456, "thesis": 36,
+                     "tolerance": "±3", "pass": passed},
+                    {"quantity": "reported", "measured": 1, "thesis": None, "tolerance": None,
+                     "pass": None}]}
+    s.update(extra)
+    return s
+
+
+class Scripts(unittest.TestCase):
+    def test_runs_the_case_scripts_only(self):
+        names = [os.path.basename(p) for p in run_all.scripts()]
+        self.assertIn("bouncing_sphere.py", names)
+        for name in names:
+            self.assertFalse(name.startswith(("_", "test_")), name)
+            self.assertNotEqual(name, "run_all.py")
+
+
+class Cells(unittest.TestCase):
+    def test_formats(self):
+        self.assertEqual(run_all.cell(None), "—")
+        self.assertEqual(run_all.cell(35.123456), "35.12")
+        self.assertEqual(run_all.cell("a | b"), "a \\| b")  # a table cell keeps its bar
+        self.assertEqual(run_all.verdict(None), "—")
+        self.assertEqual(run_all.verdict(True), "**PASS**")
+        self.assertEqual(run_all.verdict(False), "**FAIL**")
+        self.assertEqual(run_all.fmt_time(None), "—")
+        self.assertEqual(run_all.fmt_time(2.5), "2.50 s")
+        self.assertEqual(run_all.fmt_time(75), "75 s")
+        self.assertEqual(run_all.fmt_time(1800), "30.0 min")
+
+
+class Report(unittest.TestCase):
+    META = {"date": "2026-12-02 06:00", "cpu": "Test CPU", "nproc": 2, "commit": "abc1234",
+            "build": "build", "quick": False}
+
+    def test_lists_each_case_with_its_graded_checks_and_machine(self):
+        text = run_all.report([("good", summary("good", True, cpu="Xeon", nproc=2,
+                                                commit="f00")),
+                               ("bad", summary("bad", False)),
+                               ("missing", None)], self.META)
+        self.assertIn("Report written 2026-12-02 06:00 on Test CPU (2 cores", text)
+        # Ungraded checks (pass None) do not count: 1 of 1 graded.
+        self.assertIn("| [Case good](#good) | §2.6 | 1/1 | **PASS** | 75 s |", text)
+        self.assertIn("| [Case bad](#bad) | §2.6 | 0/1 | **FAIL** | 75 s |", text)
+        self.assertIn("| missing | — | — | **FAIL** (no summary) | — |", text)
+        self.assertIn("on Xeon (2 cores), commit `f00`", text)
+        self.assertIn("| angle \\| deg | 35.12 | 36 | ±3 | **PASS** |", text)
+        self.assertIn("- a note", text)
+        # A case without a machine stamp says nothing about one.
+        bad = text[text.index('<a id="bad">'):]
+        self.assertIn("Run on 2026-12-02 05:00, run time 75 s. Result: **FAIL**.", bad)
+
+    def test_flags_cases_run_before_the_storage_sort(self):
+        old = summary("old", True, date="2026-11-20 10:00")
+        text = run_all.report([("old", old)], self.META)
+        self.assertIn("1 of these 1 cases were run before the particle storage sort", text)
+
+
+class StampHardware(unittest.TestCase):
+    def test_stamps_only_a_summary_written_by_this_run(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "case.json")
+            with open(path, "w") as f:
+                json.dump({"name": "case"}, f)
+            written = os.path.getmtime(path)
+            run_all.stamp_hardware(path, written + 10, "build")  # written before the run
+            with open(path) as f:
+                self.assertEqual(json.load(f), {"name": "case"})
+            run_all.stamp_hardware(path, written - 10, "build-x")
+            with open(path) as f:
+                s = json.load(f)
+            self.assertEqual(s["name"], "case")
+            self.assertEqual(s["build"], "build-x")
+            self.assertGreaterEqual(s["nproc"], 1)
+            self.assertTrue(s["cpu"] and s["commit"])
+            self.assertEqual(os.listdir(tmp), ["case.json"])  # no temporary left
+
+    def test_a_missing_summary_is_left_missing(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "none.json")
+            run_all.stamp_hardware(path, time.time() - 10, "build")
+            self.assertFalse(os.path.exists(path))
+
+
+if __name__ == "__main__":
+    unittest.main()
