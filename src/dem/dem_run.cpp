@@ -704,9 +704,9 @@ RunSummary run_dem_case(const DemCase& c, const RunOptions& options, std::ostrea
   done.precision(4);
   // The time to 10 digits: scripts read it to tell a finished run from a stopped one
   // (validation/dem/_outputs.py), and 4 digits could round an end time down.
-  done << "done: t = " << std::setprecision(10) << sim.time() << std::setprecision(4) << " s, " << summary.steps << " steps in "
-       << ProgressReporter::format_duration(summary.wall_seconds) << " ("
-       << (summary.wall_seconds > 0 ? particle_steps / summary.wall_seconds : 0.0)
+  done << "done: t = " << std::setprecision(10) << sim.time() << std::setprecision(4) << " s, "
+       << summary.steps << " steps in " << ProgressReporter::format_duration(summary.wall_seconds)
+       << " (" << (summary.wall_seconds > 0 ? particle_steps / summary.wall_seconds : 0.0)
        << " particle-steps/s)" << (summary.settled ? ", settled" : "");
   progress.finish(done.str());
   log << done.str() << "\n";

@@ -288,10 +288,10 @@ FlowRunSummary run_flow_case(const FlowCase& c, const FlowRunOptions& options,
   std::ostringstream done;
   done.precision(4);
   // The time to 10 digits: scripts read it to tell a finished run from a stopped one
-  // (validation/dem/_outputs.py), and 4 digits could round an end time down.
-  done << "done: t = " << std::setprecision(10) << ns.time() << std::setprecision(4) << " s, " << summary.steps << " steps in "
-       << ProgressReporter::format_duration(summary.wall_seconds) << " ("
-       << (summary.wall_seconds > 0 ? cell_updates / summary.wall_seconds : 0.0)
+  // (validation/*/), and 4 digits could round an end time down.
+  done << "done: t = " << std::setprecision(10) << ns.time() << std::setprecision(4) << " s, "
+       << summary.steps << " steps in " << ProgressReporter::format_duration(summary.wall_seconds)
+       << " (" << (summary.wall_seconds > 0 ? cell_updates / summary.wall_seconds : 0.0)
        << " cell-updates/s)";
   if (c.adapt.enabled && summary.wall_seconds > 0) {
     done << "; " << static_cast<long long>(leaf_cells(forest)) << " cells at the end, regridding "
