@@ -42,7 +42,7 @@ class ReadArrays(unittest.TestCase):
         with tempfile.TemporaryDirectory() as tmp:
             path = write_text(tmp, "frame.vtu",
                               "<VTKFile><UnstructuredGrid><Piece><PointData>\n"
-                              + data_array("velocity", "Float64", [1.0, 2.0, 3.0, -4.0, 5.5, 6.0], 3)
+                              + data_array("velocity", "Float64", [1, 2, 3, -4.0, 5.5, 6], 3)
                               + "\n" + data_array("id", "Int64", [7, -8]) + "\n"
                               + data_array("flags", "UInt8", [1, 0]) + "\n"
                               + "</PointData><Points>\n"
