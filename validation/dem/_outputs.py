@@ -118,6 +118,18 @@ def wall_time(run, after=-1.0):
     return sum(seconds for end, seconds in finished_segments(run) if end > after + 1e-9)
 
 
+def two_at_a_time_span(durations):
+    """Wall-clock seconds of jobs of these durations run two at a time in this order, the
+    next one started when the older of the two running finishes (as the scripts' runners
+    wait on them): what a phase of runs reused from an earlier call took."""
+    now, running = 0.0, []
+    for d in durations:
+        if len(running) == 2:
+            now = max(now, running.pop(0))
+        running.append(now + d)
+    return max([now] + running)
+
+
 def write_summary(summary, results_dir, elapsed, quick, ok):
     """Completes a case's summary (run time, date, quick, pass) and writes it as
     RESULTS/<name>.json, the file run_all.py reads for the report."""

@@ -34,7 +34,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import pour_command, read_summary, wall_time, write_summary  # noqa: E402
+from _outputs import (pour_command, read_summary, two_at_a_time_span, wall_time,  # noqa: E402
+                      write_summary)
 from crosses_tangential_map import (CASE, GATE_TIME, RESULTS, ROOT,  # noqa: E402
                                     TABLE_31, classify, settings)
 
@@ -67,7 +68,7 @@ def main():
     exe = os.path.join(ROOT, args.build, "app", "sanguis")
     t0 = time.time()
     pours = {seed: os.path.join(RUNS, f"pour_seed_{seed}") for seed in SEEDS}
-    reused_s = 0.0  # pours kept from an earlier call still count in the run time
+    reused = []  # wall times of pours kept from an earlier call: they count in the run time
     jobs = []
     for seed, d in pours.items():
         if args.reuse:
@@ -77,7 +78,7 @@ def main():
         if cmd:
             jobs.append((cmd, d))
         else:
-            reused_s += wall_time(d) / 2  # they ran two at a time
+            reused.append(wall_time(d))
     run_two_at_a_time(jobs)
     packing = {}
     for seed, d in pours.items():
@@ -102,7 +103,7 @@ def main():
             d = os.path.join(RUNS, f"seed_{seed}_kt_{kt:g}_gamma_{g:g}")
             subprocess.run([exe, "analyze", d], check=True, stdout=subprocess.DEVNULL)
             results[(seed, kt, g)] = classify(d)
-    elapsed = time.time() - t0 + reused_s
+    elapsed = time.time() - t0 + two_at_a_time_span(reused)
     previous = os.path.join(RESULTS, "crosses_tangential_packings.json")
     if args.reuse and os.path.exists(previous):  # keep the time the runs took
         with open(previous) as f:

@@ -137,6 +137,17 @@ class RunSegments(unittest.TestCase):
             self.assertEqual(_outputs.wall_time(tmp), 0)
 
 
+class TwoAtATime(unittest.TestCase):
+    def test_span_of_jobs_run_two_at_a_time_oldest_first(self):
+        self.assertEqual(_outputs.two_at_a_time_span([]), 0.0)
+        self.assertEqual(_outputs.two_at_a_time_span([5.0]), 5.0)
+        # The third starts when the first ends (the runner waits on the older job).
+        self.assertEqual(_outputs.two_at_a_time_span([783, 823, 665]), 783 + 665)
+        # ... even when the second ended sooner.
+        self.assertEqual(_outputs.two_at_a_time_span([10, 2, 1]), 11)
+        self.assertEqual(_outputs.two_at_a_time_span([1, 1, 1, 1]), 2)
+
+
 class PourCommand(unittest.TestCase):
     CMD = ["sanguis", "run", "case.toml", "-o", "pour"]
 
