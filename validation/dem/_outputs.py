@@ -7,6 +7,7 @@ import json
 import os
 import re
 import shutil
+import subprocess
 import time
 import tomllib
 import xml.etree.ElementTree as ET
@@ -110,6 +111,15 @@ def pour_command(cmd, out, end_s, rerun=False):
     if checkpoint and reached_time(out) >= end_s - 1e-9:
         return None
     return cmd + (["--restart"] if checkpoint else []) + ["--set", f"simulation.end_time_s={end_s}"]
+
+
+def run_pour(cmd, out, end_s, rerun=False):
+    """Runs pour_command's command, if any, so that the pour in `out` stands at end_s;
+    False when an earlier run had got there (nothing ran)."""
+    command = pour_command(cmd, out, end_s, rerun)
+    if command:
+        subprocess.run(command, check=True)
+    return bool(command)
 
 
 def wall_time(run, after=-1.0):

@@ -39,8 +39,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import (gate_removal_time, pour_command, read_arrays, read_pvd,  # noqa: E402
-                      read_summary, regime_name, wall_time)
+from _outputs import (gate_removal_time, read_arrays, read_pvd, read_summary,  # noqa: E402
+                      regime_name, run_pour, wall_time)
 from crosses_dam_break import diagnostics  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -88,11 +88,8 @@ def main():
     t0 = time.time()
     pour = os.path.join(RUNS, "pour")
     reused_pour_s = 0.0  # a pour kept from an earlier call still counts in the run time
-    pour_cmd = pour_command([exe, "run", CASE, "--output", pour, "--quiet", "--threads", "1"],
-                            pour, GATE_TIME, args.rerun_pour)
-    if pour_cmd:
-        subprocess.run(pour_cmd, check=True)
-    else:
+    if not run_pour([exe, "run", CASE, "--output", pour, "--quiet", "--threads", "1"], pour,
+                    GATE_TIME, args.rerun_pour):
         reused_pour_s = wall_time(pour)
     runs = {"memory": os.path.join(RUNS, "memory"), "no memory": os.path.join(RUNS, "no_memory")}
     procs = []

@@ -40,8 +40,8 @@ import time
 import matplotlib
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import (calibration_value_folder, pour_command, read_summary,  # noqa: E402
-                      regime_name, wall_time, write_summary)
+from _outputs import (calibration_value_folder, read_summary, regime_name,  # noqa: E402
+                      run_pour, wall_time, write_summary)
 from crosses_dam_break import (CASE, RESULTS, ROOT, diagnostics,  # noqa: E402
                                draw_velocity_bands, lajeunesse, opening_time, velocity_curve)
 from crosses_tangential_map import tangential_settings  # noqa: E402
@@ -122,10 +122,8 @@ def run_calibrated(exe, gamma):
 
 def run_all(exe, threads):
     pour = os.path.join(RUNS, "pour")
-    pour_cmd = pour_command([exe, "run", CASE, "--output", pour, "--quiet", "--threads",
-                             str(threads)], pour, OPENING_S)
-    if pour_cmd:
-        subprocess.run(pour_cmd, check=True)
+    run_pour([exe, "run", CASE, "--output", pour, "--quiet", "--threads", str(threads)], pour,
+             OPENING_S)
     running = []
     for name, (_, kt, gamma) in RUNS_OF.items():
         out = os.path.join(RUNS, name)

@@ -35,8 +35,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import (gate_removal_time, pour_command, read_arrays, read_pvd,  # noqa: E402
-                      read_summary, regime_name, write_summary)
+from _outputs import (gate_removal_time, read_arrays, read_pvd, read_summary,  # noqa: E402
+                      regime_name, run_pour, write_summary)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 CASE = os.path.join(ROOT, "cases", "dem", "dam-break-crosses-memory.toml")
@@ -106,10 +106,7 @@ def main():
     ap.add_argument("--reuse", action="store_true", help="classify the runs on disk")
     args = ap.parse_args()
     exe = os.path.join(ROOT, args.build, "app", "sanguis")
-    pour_cmd = pour_command([exe, "run", CASE, "--output", POUR, "--quiet", "--threads", "1"],
-                            POUR, GATE_TIME)
-    if pour_cmd:
-        subprocess.run(pour_cmd, check=True)
+    run_pour([exe, "run", CASE, "--output", POUR, "--quiet", "--threads", "1"], POUR, GATE_TIME)
     grid = QUICK if args.quick else [(kt, g) for kt in KT for g in GAMMA]
     if not args.quick:
         grid += [(kt, g) for kt in LOCAL_KT for g in LOCAL_GAMMA if (kt, g) not in grid]

@@ -1,5 +1,5 @@
 """Tests of validation/dem/_outputs.py, the readers and run-folder helpers every DEM
-validation script relies on. Run by ctest (ValidationScripts.DemOutputs) or by hand:
+validation script relies on. Run by ctest (ValidationScripts.DemHelpers) or by hand:
 /usr/bin/python3 -m unittest discover -s validation/dem -p 'test_*.py'"""
 import base64
 import json
@@ -33,8 +33,7 @@ def write_text(folder, name, text):
 
 def write_run_log(folder, lines):
     os.makedirs(folder, exist_ok=True)
-    with open(os.path.join(folder, "run.log"), "w") as f:
-        f.write("\n".join(lines) + "\n")
+    write_text(folder, "run.log", "\n".join(lines) + "\n")
 
 
 class ReadArrays(unittest.TestCase):
@@ -71,21 +70,17 @@ class ReadPvd(unittest.TestCase):
 class CaseAndSummaries(unittest.TestCase):
     def test_gate_removal_time_comes_from_the_obstacle_named_gate(self):
         with tempfile.TemporaryDirectory() as tmp:
-            case = os.path.join(tmp, "case.toml")
-            with open(case, "w") as f:
-                f.write('[[obstacle]]\nname = "floor"\n\n'
-                        '[[obstacle]]\nname = "gate"\nremove_at_s = 2.4\n')
+            case = write_text(tmp, "case.toml", '[[obstacle]]\nname = "floor"\n\n'
+                              '[[obstacle]]\nname = "gate"\nremove_at_s = 2.4\n')
             self.assertEqual(_outputs.gate_removal_time(case), 2.4)
-            with open(case, "w") as f:
-                f.write('[[obstacle]]\nname = "floor"\n')
+            write_text(tmp, "case.toml", '[[obstacle]]\nname = "floor"\n')
             with self.assertRaisesRegex(ValueError, "no obstacle named 'gate'"):
                 _outputs.gate_removal_time(case)
 
     def test_summary_row_and_regime(self):
         with tempfile.TemporaryDirectory() as tmp:
             os.makedirs(os.path.join(tmp, "analysis"))
-            with open(os.path.join(tmp, "analysis", "summary.csv"), "w") as f:
-                f.write("runout_m,regime\n0.125,1\n")
+            write_text(os.path.join(tmp, "analysis"), "summary.csv", "runout_m,regime\n0.125,1\n")
             summary = _outputs.read_summary(tmp)
         self.assertEqual(summary, {"runout_m": 0.125, "regime": 1.0})
         self.assertEqual(_outputs.regime_name(summary), "fractured")
@@ -178,6 +173,12 @@ class PourCommand(unittest.TestCase):
             out = os.path.join(tmp, "pour")
             self.assertEqual(_outputs.pour_command(self.CMD, out, 2.4),
                              self.CMD + ["--set", "simulation.end_time_s=2.4"])
+
+    def test_run_pour_runs_the_command_only_when_one_is_needed(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            out = self.pour(tmp, ["done: t = 2.4 s, 10 steps in 5s (1 particle-steps/s)"])
+            self.assertFalse(_outputs.run_pour(["false"], out, 2.4))  # `false` would raise
+            self.assertTrue(_outputs.run_pour(["true"], out, 3.0))
 
     def test_rerun_clears_a_finished_pour(self):
         with tempfile.TemporaryDirectory() as tmp:

@@ -1,5 +1,5 @@
 """Tests of validation/dem/run_all.py: which scripts it runs, how it stamps a case with
-its machine, and the report it writes. Run by ctest (ValidationScripts.DemOutputs) or
+its machine, and the report it writes. Run by ctest (ValidationScripts.DemHelpers) or
 by hand: /usr/bin/python3 -m unittest discover -s validation/dem -p 'test_*.py'"""
 import json
 import os

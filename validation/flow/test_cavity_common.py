@@ -7,7 +7,6 @@ import base64
 import os
 import pathlib
 import struct
-import subprocess
 import sys
 import tempfile
 import unittest

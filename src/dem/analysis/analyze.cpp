@@ -173,9 +173,7 @@ RunAnalysis analyze_run(const RunOutput& run, const AnalysisOptions& o) {
   gate_half.max.x = x_gate;
   gate_top = gate_half;
   gate_top.min.z = z_half;
-  double mean_radius = 0.0;
-  for (const double r : initial.radius) mean_radius += r / static_cast<double>(initial.size());
-  const double margin = o.bulk_margin.value_or(4.0 * mean_radius);
+  const double margin = o.bulk_margin.value_or(4.0 * e0.mean_radius);
   Region bulk;
   bulk.min = {a.wall_x + margin, a.y_min + margin, a.floor_z + margin};
   bulk.max = {x_gate - margin, a.y_max - margin, a.floor_z + a.initial_height.mean - margin};
