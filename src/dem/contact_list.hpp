@@ -51,6 +51,39 @@ inline void carry_history(const ContactList& previous, ContactList& fresh) {
   }
 }
 
+// The same, the fresh list cut into `threads` ranges merged in parallel (each finds where
+// its first key falls in `previous` by bisection): the same copies, so the same lists.
+inline void carry_history(const ContactList& previous, ContactList& fresh, int threads) {
+  const std::size_t n = fresh.size(), np = previous.size();
+  if (threads <= 1 || n < 4096) {
+    carry_history(previous, fresh);
+    return;
+  }
+  const auto ranges = static_cast<std::size_t>(threads);
+#pragma omp parallel for schedule(static) num_threads(threads)
+  for (std::size_t r = 0; r < ranges; ++r) {
+    const std::size_t begin = n * r / ranges, end = n * (r + 1) / ranges;
+    if (begin == end) continue;
+    // First entry of `previous` whose key is not below the range's first key.
+    std::size_t lo = 0, hi = np;
+    const std::uint64_t first_key = fresh.key(begin);
+    while (lo < hi) {
+      const std::size_t mid = lo + (hi - lo) / 2;
+      if (previous.key(mid) < first_key) {
+        lo = mid + 1;
+      } else {
+        hi = mid;
+      }
+    }
+    std::size_t p = lo;
+    for (std::size_t k = begin; k < end && p < np; ++k) {
+      const std::uint64_t key = fresh.key(k);
+      while (p < np && previous.key(p) < key) ++p;
+      if (p < np && previous.key(p) == key) fresh.history[k] = previous.history[p];
+    }
+  }
+}
+
 // Candidate contacts involving non-spherical bodies, one entry per pair of convex
 // elements (two crosses touch at up to four points, each with its own memory),
 // sorted by (first, second, element_first, element_second). For obstacle contacts

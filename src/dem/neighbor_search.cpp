@@ -135,78 +135,120 @@ void NeighborSearch::bin(const ParticleStore& particles) {
   }
 }
 
+void NeighborSearch::pairs_of(const ParticleStore& particles, std::size_t i,
+                              const std::uint8_t* ghost, std::vector<std::uint32_t>& out) const {
+  const Vec3 xi = particles.position[i];
+  const double ri = particles.radius[i];
+  const bool fixed_i = particles.is_fixed(i);  // two glued particles never interact
+  std::int64_t ci[3];
+  for (int k = 0; k < 3; ++k) {
+    const auto ku = static_cast<std::size_t>(k);
+    ci[k] = std::clamp<std::int64_t>(
+        static_cast<std::int64_t>(std::floor((xi[k] - domain_.min[k]) / cell_size_[k])), 0,
+        cells_[ku] - 1);
+  }
+  const std::size_t begin = out.size();
+  for (int dz = -1; dz <= 1; ++dz) {
+    std::int64_t cz = ci[2] + dz;
+    if (cz < 0 || cz >= cells_[2]) {
+      if (!domain_.periodic[2]) continue;
+      cz = (cz + cells_[2]) % cells_[2];
+    }
+    for (int dy = -1; dy <= 1; ++dy) {
+      std::int64_t cy = ci[1] + dy;
+      if (cy < 0 || cy >= cells_[1]) {
+        if (!domain_.periodic[1]) continue;
+        cy = (cy + cells_[1]) % cells_[1];
+      }
+      for (int dx = -1; dx <= 1; ++dx) {
+        std::int64_t cx = ci[0] + dx;
+        if (cx < 0 || cx >= cells_[0]) {
+          if (!domain_.periodic[0]) continue;
+          cx = (cx + cells_[0]) % cells_[0];
+        }
+        const auto c = static_cast<std::size_t>((cz * cells_[1] + cy) * cells_[0] + cx);
+        for (std::uint32_t m = cell_start_[c]; m < cell_start_[c + 1]; ++m) {
+          const std::uint32_t j = cell_members_[m];
+          if (j <= i || (ghost != nullptr && ghost[i] && ghost[j])) continue;
+          if (fixed_i && particles.is_fixed(j)) continue;
+          const double cut = ri + particles.radius[j] + skin_;
+          const Vec3 d = domain_.minimum_image(particles.position[j] - xi);
+          if (norm2(d) < cut * cut) out.push_back(j);
+        }
+      }
+    }
+  }
+  std::sort(out.begin() + static_cast<std::ptrdiff_t>(begin), out.end());
+}
+
+template <typename Find>
+void NeighborSearch::collect(std::size_t n, int threads, ContactList& list, Find&& find) {
+  // Contiguous ranges of particles, several per thread (their costs differ), each filling
+  // its own buffers; joined in range order, the list is the one a single loop builds.
+  const std::size_t ranges =
+      threads > 1 ? std::min<std::size_t>(n, 4 * static_cast<std::size_t>(threads)) : 1;
+  if (range_first_.size() < ranges) {
+    range_first_.resize(ranges);
+    range_second_.resize(ranges);
+  }
+  const auto range_begin = [n, ranges](std::size_t r) { return n * r / ranges; };
+  const auto fill = [&](std::size_t r) {
+    std::vector<std::uint32_t>& first = range_first_[r];
+    std::vector<std::uint32_t>& second = range_second_[r];
+    first.clear();
+    second.clear();
+    for (std::size_t i = range_begin(r); i < range_begin(r + 1); ++i) {
+      find(i, second);
+      first.resize(second.size(), static_cast<std::uint32_t>(i));
+    }
+  };
+  std::vector<std::size_t>& offset = range_offset_;
+  offset.assign(ranges + 1, 0);
+  if (threads > 1) {
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    for (std::size_t r = 0; r < ranges; ++r) fill(r);
+  } else {
+    for (std::size_t r = 0; r < ranges; ++r) fill(r);
+  }
+  for (std::size_t r = 0; r < ranges; ++r) offset[r + 1] = offset[r] + range_second_[r].size();
+  list.first.resize(offset[ranges]);
+  list.second.resize(offset[ranges]);
+  list.history.assign(offset[ranges], ContactHistory{});
+  parallel_for(ranges, threads, [&](std::size_t r) {
+    std::copy(range_first_[r].begin(), range_first_[r].end(),
+              list.first.begin() + static_cast<std::ptrdiff_t>(offset[r]));
+    std::copy(range_second_[r].begin(), range_second_[r].end(),
+              list.second.begin() + static_cast<std::ptrdiff_t>(offset[r]));
+  });
+}
+
 void NeighborSearch::rebuild(ParticleStore& particles, const std::vector<Obstacle>& obstacles,
                              double time, ContactList& pairs, ContactList& walls,
-                             const std::uint8_t* ghost) {
+                             const std::uint8_t* ghost, int threads) {
   const std::size_t n = particles.size();
-  for (auto& x : particles.position) domain_.wrap(x);
+  threads = std::max(threads, 1);
+  parallel_for(n, threads, [&](std::size_t i) { domain_.wrap(particles.position[i]); });
   bin(particles);
 
   // Particle pairs: each particle looks at the 27 surrounding cells and keeps j > i,
   // so each pair appears once, and the list comes out sorted by (i, j).
-  scratch_.clear();
-  for (std::size_t i = 0; i < n; ++i) {
-    const Vec3 xi = particles.position[i];
-    const double ri = particles.radius[i];
-    const bool fixed_i = particles.is_fixed(i);  // two glued particles never interact
-    std::int64_t ci[3];
-    for (int k = 0; k < 3; ++k) {
-      const auto ku = static_cast<std::size_t>(k);
-      ci[k] = std::clamp<std::int64_t>(
-          static_cast<std::int64_t>(std::floor((xi[k] - domain_.min[k]) / cell_size_[k])), 0,
-          cells_[ku] - 1);
-    }
-    candidates_.clear();
-    for (int dz = -1; dz <= 1; ++dz) {
-      std::int64_t cz = ci[2] + dz;
-      if (cz < 0 || cz >= cells_[2]) {
-        if (!domain_.periodic[2]) continue;
-        cz = (cz + cells_[2]) % cells_[2];
-      }
-      for (int dy = -1; dy <= 1; ++dy) {
-        std::int64_t cy = ci[1] + dy;
-        if (cy < 0 || cy >= cells_[1]) {
-          if (!domain_.periodic[1]) continue;
-          cy = (cy + cells_[1]) % cells_[1];
-        }
-        for (int dx = -1; dx <= 1; ++dx) {
-          std::int64_t cx = ci[0] + dx;
-          if (cx < 0 || cx >= cells_[0]) {
-            if (!domain_.periodic[0]) continue;
-            cx = (cx + cells_[0]) % cells_[0];
-          }
-          const auto c = static_cast<std::size_t>((cz * cells_[1] + cy) * cells_[0] + cx);
-          for (std::uint32_t m = cell_start_[c]; m < cell_start_[c + 1]; ++m) {
-            const std::uint32_t j = cell_members_[m];
-            if (j <= i || (ghost != nullptr && ghost[i] && ghost[j])) continue;
-            if (fixed_i && particles.is_fixed(j)) continue;
-            const double cut = ri + particles.radius[j] + skin_;
-            const Vec3 d = domain_.minimum_image(particles.position[j] - xi);
-            if (norm2(d) < cut * cut) candidates_.push_back(j);
-          }
-        }
-      }
-    }
-    std::sort(candidates_.begin(), candidates_.end());
-    for (std::uint32_t j : candidates_) scratch_.push(static_cast<std::uint32_t>(i), j, {});
-  }
-  carry_history(pairs, scratch_);
+  collect(n, threads, scratch_, [&](std::size_t i, std::vector<std::uint32_t>& out) {
+    pairs_of(particles, i, ghost, out);
+  });
+  carry_history(pairs, scratch_, threads);
   std::swap(pairs, scratch_);
 
   // Particle-obstacle pairs, sorted by (particle, obstacle).
-  scratch_.clear();
-  for (std::size_t i = 0; i < n; ++i) {
-    if ((ghost != nullptr && ghost[i]) || particles.is_fixed(i)) continue;  // glued: no force
+  collect(n, threads, scratch_, [&](std::size_t i, std::vector<std::uint32_t>& out) {
+    if ((ghost != nullptr && ghost[i]) || particles.is_fixed(i)) return;  // glued: no force
     for (std::size_t o = 0; o < obstacles.size(); ++o) {
       if (!obstacles[o].active(time)) continue;
       const SphereObstacleGap gap =
           sphere_gap(obstacles[o], time, particles.position[i], particles.radius[i]);
-      if (gap.overlap > -skin_) {
-        scratch_.push(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(o), {});
-      }
+      if (gap.overlap > -skin_) out.push_back(static_cast<std::uint32_t>(o));
     }
-  }
-  carry_history(walls, scratch_);
+  });
+  carry_history(walls, scratch_, threads);
   std::swap(walls, scratch_);
 
   reference_ = particles.position;

@@ -30,8 +30,11 @@ class NeighborSearch {
   // Wraps periodic positions, bins particles and rebuilds both lists, carrying the
   // contact histories over. Obstacles inactive at `time` get no entries. With `ghost`
   // (one flag per particle), pairs of two ghosts and ghost-obstacle pairs are left out.
+  // The search runs on `threads` OpenMP threads, each on ranges of particles with lists
+  // of their own, joined in particle order: the lists are the same for any thread count.
   void rebuild(ParticleStore& particles, const std::vector<Obstacle>& obstacles, double time,
-               ContactList& pairs, ContactList& walls, const std::uint8_t* ghost = nullptr);
+               ContactList& pairs, ContactList& walls, const std::uint8_t* ghost = nullptr,
+               int threads = 1);
 
   // Each particle's place along a space-filling curve through the linked cells: the
   // layers of cells along `axis` one after the other, a Z-order (Morton) curve within
@@ -56,6 +59,13 @@ class NeighborSearch {
   // The cell of x along each axis, clamped into the grid (a NaN coordinate gives 0).
   std::array<std::int64_t, 3> cell_coordinates(const Vec3& x) const;
   double obstacle_travel(const Obstacle& o, double t0, double t1) const;
+  // Appends the particles j > i within cut-off + skin of particle i, in increasing order.
+  void pairs_of(const ParticleStore& particles, std::size_t i, const std::uint8_t* ghost,
+                std::vector<std::uint32_t>& out) const;
+  // Fills `list` (fresh memories) with the entries find(i, out) appends for i = 0 .. n - 1,
+  // in that order, the particles cut into ranges searched in parallel.
+  template <typename Find>
+  void collect(std::size_t n, int threads, ContactList& list, Find&& find);
 
   Domain domain_;
   double skin_ = 0.0;
@@ -69,7 +79,9 @@ class NeighborSearch {
   std::int64_t rebuilds_ = 0;
   double reference_time_ = 0.0;  // time of the last rebuild [s]
   ContactList scratch_;
-  std::vector<std::uint32_t> candidates_;
+  // One pair of buffers per range of particles (kept: no allocation once they have grown).
+  std::vector<std::vector<std::uint32_t>> range_first_, range_second_;
+  std::vector<std::size_t> range_offset_;
 };
 
 }  // namespace sanguis::dem

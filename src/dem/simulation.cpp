@@ -630,7 +630,7 @@ void DemSimulation::choose_threads() {
 void DemSimulation::rebuild_lists() {
   choose_threads();
   search_.rebuild(setup_.particles, setup_.obstacles, time(), pairs_, walls_,
-                  ghost_.empty() ? nullptr : ghost_.data());
+                  ghost_.empty() ? nullptr : ghost_.data(), threads_);
   if (has_bodies_) split_body_contacts();
   build_incidence();
 }

@@ -108,5 +108,60 @@ TEST(NeighborSearch, ListsObstaclesWithinTheSkinAndSkipsRemovedOnes) {
   EXPECT_EQ(walls.second[0], 0u);
 }
 
+// Every field of two lists equal (histories compared component by component).
+void expect_same_list(const ContactList& a, const ContactList& b, const char* what) {
+  ASSERT_EQ(a.size(), b.size()) << what;
+  EXPECT_EQ(a.first, b.first) << what;
+  EXPECT_EQ(a.second, b.second) << what;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    ASSERT_EQ(a.history[k].tangential_displacement, b.history[k].tangential_displacement)
+        << what << " entry " << k;
+    ASSERT_EQ(a.history[k].normal, b.history[k].normal) << what << " entry " << k;
+  }
+}
+
+TEST(NeighborSearch, ListsAndCarriedHistoriesAreTheSameOnOneTwoAndThreeThreads) {
+  // Enough particles for several ranges per thread; glued particles (no pair between two of
+  // them, no wall entry), ghosts (no pair of two ghosts), a periodic axis, two obstacles.
+  Domain d{{0.0, 0.0, 0.0}, {0.03, 0.02, 0.02}, {true, false, false}};
+  std::vector<Obstacle> obstacles(2);
+  obstacles[0].shape = PlaneShape{{0, 0, 0}, {0, 0, 1}};
+  obstacles[1].shape = PlaneShape{{0, 0.02, 0}, {0, -1, 0}};
+  const double skin = 0.3e-3;
+  std::vector<std::uint8_t> ghost(6000);
+  for (std::size_t i = 0; i < ghost.size(); i += 7) ghost[i] = 1;
+  ContactList reference_pairs, reference_walls;
+  for (const int threads : {1, 2, 3}) {
+    ParticleStore p = random_particles(ghost.size(), d, 21);
+    for (std::size_t i = 0; i < p.size(); i += 5) p.fix(i);
+    NeighborSearch search(d, skin, 1.2e-3);
+    ContactList pairs, walls;
+    search.rebuild(p, obstacles, 0.0, pairs, walls, ghost.data(), threads);
+    ASSERT_GT(pairs.size(), 5000u);
+    ASSERT_GT(walls.size(), 100u);
+    // Memories named after their pair, then a move that keeps most pairs and changes some.
+    for (ContactList* list : {&pairs, &walls}) {
+      for (std::size_t k = 0; k < list->size(); ++k) {
+        list->history[k].tangential_displacement = {double(list->first[k]),
+                                                    double(list->second[k]), 1.0};
+        list->history[k].normal = {0.0, 0.0, 1.0};
+      }
+    }
+    for (std::size_t i = 0; i < p.size(); i += 3) p.position[i].x += 0.8 * skin;
+    search.rebuild(p, obstacles, 0.0, pairs, walls, ghost.data(), threads);
+    if (threads == 1) {
+      reference_pairs = pairs;
+      reference_walls = walls;
+      std::size_t carried = 0;
+      for (std::size_t k = 0; k < pairs.size(); ++k) carried += pairs.history[k].normal.z == 1.0;
+      EXPECT_GT(carried, pairs.size() / 2);
+      EXPECT_LT(carried, pairs.size());
+      continue;
+    }
+    expect_same_list(pairs, reference_pairs, "pairs");
+    expect_same_list(walls, reference_walls, "walls");
+  }
+}
+
 }  // namespace
 }  // namespace sanguis::dem
