@@ -152,6 +152,11 @@ void fill_face_field_ghosts(const Forest& forest, FaceField& uf, int width) {
   forest.for_each_block([&](int blk) {
     const Block& block = forest.block(blk);
     for (int d = 0; d < 3; ++d) {
+      // The plane's cells by (t1, t2) along the other two directions, the inner loop along
+      // the one with the smaller stride.
+      const int e1 = (d + 1) % 3, e2 = (d + 2) % 3;
+      const std::ptrdiff_t s_in = std::min(L.stride(e1), L.stride(e2));
+      const std::ptrdiff_t s_out = std::max(L.stride(e1), L.stride(e2));
       for (int side = 0; side < 2; ++side) {
         std::array<int, 3> o{0, 0, 0};
         o[static_cast<std::size_t>(d)] = side == 0 ? -1 : 1;
@@ -169,13 +174,15 @@ void fill_face_field_ghosts(const Forest& forest, FaceField& uf, int width) {
               if (side == 1) ++ghost;
               mirror = side == 0 ? 0 : b;
             }
-            for (int t2 = -width; t2 < b + width; ++t2)
-              for (int t1 = -width; t1 < b + width; ++t1) {
-                const auto g = along(d, ghost, t1, t2);
-                const auto src = along(d, mirror, t1, t2);
-                if (g[static_cast<std::size_t>(d)] >= b + L.ghost) continue;
-                data[L.index(g[0], g[1], g[2])] = data[L.index(src[0], src[1], src[2])];
-              }
+            if (ghost >= b + L.ghost) continue;  // beyond the stored layers
+            const auto g0 = along(d, ghost, 0, 0), m0 = along(d, mirror, 0, 0);
+            double* to = data + L.index(g0[0], g0[1], g0[2]);
+            const double* from = data + L.index(m0[0], m0[1], m0[2]);
+            for (int t_out = -width; t_out < b + width; ++t_out) {
+              double* row_to = to + t_out * s_out;
+              const double* row_from = from + t_out * s_out;
+              for (int t = -width; t < b + width; ++t) row_to[t * s_in] = row_from[t * s_in];
+            }
           }
         }
       }
