@@ -16,6 +16,7 @@
 #include "core/config.hpp"
 #include "dem/dem_case.hpp"
 #include "falling_crosses.hpp"
+#include "thrown_pile.hpp"
 
 namespace {
 std::atomic<long> g_allocations{0};
@@ -35,77 +36,46 @@ void* counted_aligned(std::size_t size, std::align_val_t align) {
 }
 }  // namespace
 
-void* operator new(std::size_t size) { return counted(size); }
-void* operator new[](std::size_t size) { return counted(size); }
+void* operator new(std::size_t size) {
+  return counted(size);
+}
+void* operator new[](std::size_t size) {
+  return counted(size);
+}
 void* operator new(std::size_t size, std::align_val_t align) {
   return counted_aligned(size, align);
 }
 void* operator new[](std::size_t size, std::align_val_t align) {
   return counted_aligned(size, align);
 }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
-void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+void operator delete(void* p) noexcept {
+  std::free(p);
+}
+void operator delete[](void* p) noexcept {
+  std::free(p);
+}
+void operator delete(void* p, std::size_t) noexcept {
+  std::free(p);
+}
+void operator delete[](void* p, std::size_t) noexcept {
+  std::free(p);
+}
+void operator delete(void* p, std::align_val_t) noexcept {
+  std::free(p);
+}
+void operator delete[](void* p, std::align_val_t) noexcept {
+  std::free(p);
+}
+void operator delete(void* p, std::size_t, std::align_val_t) noexcept {
+  std::free(p);
+}
+void operator delete[](void* p, std::size_t, std::align_val_t) noexcept {
+  std::free(p);
+}
 
 namespace {
 
 using sanguis::dem::DemSimulation;
-
-// A pile of 500 beads thrown about in a box with walls, a periodic axis and rolling
-// resistance: contacts open and close, and lists are rebuilt every few dozen steps.
-const char* kPile = R"(
-[simulation]
-end_time_s = 1.0
-seed = 9
-threads = 1
-[domain]
-min_m = [0.0, 0.0, 0.0]
-max_m = [0.012, 0.012, 0.03]
-periodic = [true, false, false]
-[[material]]
-name = "glass"
-density_kg_m3 = 2500.0
-[[material]]
-name = "wall"
-[[interaction]]
-materials = ["glass", "glass"]
-normal_restitution = 0.4
-tangential_restitution = 0.3
-max_overlap_ratio = 0.01
-max_impact_velocity_m_s = 0.5
-rolling_friction = 0.1
-[[interaction]]
-materials = ["glass", "wall"]
-normal_restitution = 0.4
-tangential_restitution = 0.3
-max_overlap_ratio = 0.01
-max_impact_velocity_m_s = 0.5
-rolling_friction = 0.1
-[[obstacle]]
-type = "plane"
-material = "wall"
-point_m = [0.0, 0.0, 0.0]
-normal = [0.0, 0.0, 1.0]
-[[obstacle]]
-type = "box"
-material = "wall"
-min_m = [0.0, 0.011, 0.0]
-max_m = [0.012, 0.02, 0.03]
-[[particles]]
-material = "glass"
-radius_min_m = 0.4e-3
-radius_max_m = 0.6e-3
-arrangement = "random"
-count = 500
-region_min_m = [0.0, 0.0, 0.0]
-region_max_m = [0.012, 0.011, 0.01]
-velocity_noise_m_s = 0.4
-)";
 
 // Steps `sim` `steps` times; returns the number of steps that rebuilt no list yet
 // allocated, and prints what it saw.
@@ -149,21 +119,22 @@ int main() {
   for (const int threads : {1, 2}) {
     {
       sanguis::dem::DemCase c = sanguis::dem::load_dem_case(
-          sanguis::ConfigTable::parse_string(kPile, "pile.toml"), "pile.toml");
+          sanguis::ConfigTable::parse_string(sanguis::dem::testing::kThrownPile, "pile.toml"),
+          "pile.toml");
       c.setup.threads = threads;
       c.setup.particles_per_thread = 1;  // threads on this small system
       c.setup.storage_sort_interval = 500;
       DemSimulation sim(c.setup);
       for (int n = 0; n < 20; ++n) sim.step();  // first lists and buffers
-      failures += allocating_steps(sim, 2000, "sphere pile, " + std::to_string(threads) +
-                                                  " thread(s)") > 0;
+      failures +=
+          allocating_steps(sim, 2000, "sphere pile, " + std::to_string(threads) + " thread(s)") > 0;
     }
     {
       DemSimulation sim(sanguis::dem::testing::falling_crosses(
           threads, [](int n) { return static_cast<std::int64_t>(n); }));
       for (int n = 0; n < 20; ++n) sim.step();
-      failures += allocating_steps(sim, 2000, "falling crosses, " + std::to_string(threads) +
-                                                  " thread(s)") > 0;
+      failures += allocating_steps(
+                      sim, 2000, "falling crosses, " + std::to_string(threads) + " thread(s)") > 0;
     }
   }
   std::printf(failures == 0 ? "no allocation between list rebuilds\n"

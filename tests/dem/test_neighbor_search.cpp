@@ -142,8 +142,8 @@ TEST(NeighborSearch, ListsAndCarriedHistoriesAreTheSameOnOneTwoAndThreeThreads) 
     // Memories named after their pair, then a move that keeps most pairs and changes some.
     for (ContactList* list : {&pairs, &walls}) {
       for (std::size_t k = 0; k < list->size(); ++k) {
-        list->history[k].tangential_displacement = {double(list->first[k]),
-                                                    double(list->second[k]), 1.0};
+        list->history[k].tangential_displacement = {double(list->first[k]), double(list->second[k]),
+                                                    1.0};
         list->history[k].normal = {0.0, 0.0, 1.0};
       }
     }

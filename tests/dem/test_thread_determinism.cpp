@@ -11,63 +11,12 @@
 
 #include "core/config.hpp"
 #include "dem/dem_case.hpp"
+#include "thrown_pile.hpp"
 
 namespace sanguis::dem {
 namespace {
 
-const char* kPile = R"(
-[simulation]
-end_time_s = 1.0
-seed = 9
-threads = 1
-[domain]
-min_m = [0.0, 0.0, 0.0]
-max_m = [0.012, 0.012, 0.03]
-periodic = [true, false, false]
-[[material]]
-name = "glass"
-density_kg_m3 = 2500.0
-[[material]]
-name = "wall"
-[[interaction]]
-materials = ["glass", "glass"]
-normal_restitution = 0.4
-tangential_restitution = 0.3
-max_overlap_ratio = 0.01
-max_impact_velocity_m_s = 0.5
-rolling_friction = 0.1
-[[interaction]]
-materials = ["glass", "wall"]
-normal_restitution = 0.4
-tangential_restitution = 0.3
-max_overlap_ratio = 0.01
-max_impact_velocity_m_s = 0.5
-rolling_friction = 0.1
-[[obstacle]]
-type = "plane"
-material = "wall"
-point_m = [0.0, 0.0, 0.0]
-normal = [0.0, 0.0, 1.0]
-[[obstacle]]
-type = "plane"
-material = "wall"
-point_m = [0.0, 0.0, 0.0]
-normal = [0.0, 1.0, 0.0]
-[[obstacle]]
-type = "box"
-material = "wall"
-min_m = [0.0, 0.011, 0.0]
-max_m = [0.012, 0.02, 0.03]
-[[particles]]
-material = "glass"
-radius_min_m = 0.4e-3
-radius_max_m = 0.6e-3
-arrangement = "random"
-count = 500
-region_min_m = [0.0, 0.0, 0.0]
-region_max_m = [0.012, 0.011, 0.01]
-velocity_noise_m_s = 0.4
-)";
+const char* const kPile = testing::kThrownPile;
 
 struct Snapshot {
   std::vector<Vec3> x, v, w, f;
