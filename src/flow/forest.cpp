@@ -563,6 +563,90 @@ void Forest::exchange_face_ghosts_but_local_same_level(BlockField& field,
   exchange_scoped(one, 1, true, -1, true, coarse_ghosts);
 }
 
+void Forest::fill_block_ghosts(std::span<BlockField* const> fields, int blk, int width,
+                               bool faces_only, int finer_face, bool skip_local_same_level,
+                               CoarseGhosts coarse_ghosts, const double* remote) const {
+  const BlockLayout layout = fields[0]->layout();
+  const int b = layout.cells;
+  const std::size_t nf = fields.size();
+  const std::size_t packed = static_cast<std::size_t>(b) * b * b;  // one field of one block
+  const std::size_t per_block = nf * packed;
+  const Block& block = blocks_[static_cast<std::size_t>(blk)];
+  for (int oz = -1; oz <= 1; ++oz) {
+    for (int oy = -1; oy <= 1; ++oy) {
+      for (int ox = -1; ox <= 1; ++ox) {
+        const int nonzero = (ox != 0) + (oy != 0) + (oz != 0);
+        if (nonzero == 0 || (faces_only && nonzero > 1)) continue;
+        if (finer_face >= 0 && (nonzero != 1 || offset_face(ox, oy, oz) != finer_face)) continue;
+        const Neighbour& nb =
+            block.neighbours[static_cast<std::size_t>(neighbour_slot(ox, oy, oz))];
+        if (nb.link == Link::Boundary) continue;
+        if (finer_face >= 0 && nb.jump != LevelJump::Finer) continue;
+        if (skip_local_same_level && nb.jump == LevelJump::Same && nb.link == Link::Local) {
+          continue;
+        }
+        const Range rx = ghost_range(ox, b, width), ry = ghost_range(oy, b, width),
+                    rz = ghost_range(oz, b, width);
+        if (nb.jump != LevelJump::Same) {
+          const std::array<Range, 3> r{rx, ry, rz};
+          const std::array<int, 3> o{ox, oy, oz};
+          for (std::size_t f = 0; f < nf; ++f) {
+            auto reader = [&](const BlockRef& ref) {
+              if (ref.link == Link::Local) {
+                return CellReader{fields[f]->block(ref.index) + layout.index(0, 0, 0),
+                                  {1, layout.stride(1), layout.stride(2)}};
+              }
+              return CellReader{
+                  remote + static_cast<std::size_t>(ref.index) * per_block + f * packed,
+                  {1, b, std::ptrdiff_t{b} * b}};
+            };
+            if (nb.jump == LevelJump::Coarser) {
+              if (coarse_ghosts == CoarseGhosts::Composite && nonzero == 1 &&
+                  composite_ghost_fits(b)) {
+                fill_composite_face_ghosts(block, o, r, reader({nb.link, nb.index}), *fields[f],
+                                           blk);
+              } else {
+                fill_from_coarser(block, o, r, reader({nb.link, nb.index}), *fields[f], blk);
+              }
+            } else {
+              std::array<CellReader, 8> children{};
+              for (std::size_t c = 0; c < 8; ++c) {
+                if (nb.children[c].link != Link::Boundary) children[c] = reader(nb.children[c]);
+              }
+              fill_from_finer(o, r, children, *fields[f], blk);
+            }
+          }
+          continue;
+        }
+        for (std::size_t f = 0; f < nf; ++f) {
+          double* dst = fields[f]->block(blk);
+          if (nb.link == Link::Local) {
+            const double* src = fields[f]->block(nb.index);
+            const int row = rx.end - rx.begin;  // short rows: a plain loop, no memmove call
+            for (int k = rz.begin; k < rz.end; ++k)
+              for (int j = ry.begin; j < ry.end; ++j) {
+                const double* from =
+                    src + layout.index(rx.begin + rx.shift, j + ry.shift, k + rz.shift);
+                double* to = dst + layout.index(rx.begin, j, k);
+                for (int i = 0; i < row; ++i) to[i] = from[i];
+              }
+          } else {
+            const double* src =
+                remote + static_cast<std::size_t>(nb.index) * per_block + f * packed;
+            for (int k = rz.begin; k < rz.end; ++k)
+              for (int j = ry.begin; j < ry.end; ++j)
+                for (int i = rx.begin; i < rx.end; ++i)
+                  dst[layout.index(i, j, k)] = src[(static_cast<std::size_t>(k + rz.shift) * b +
+                                                    static_cast<std::size_t>(j + ry.shift)) *
+                                                       b +
+                                                   static_cast<std::size_t>(i + rx.shift)];
+          }
+        }
+      }
+    }
+  }
+}
+
 void Forest::exchange_scoped(std::span<BlockField* const> fields, int width, bool faces_only,
                              int finer_face, bool skip_local_same_level,
                              CoarseGhosts coarse_ghosts) const {
@@ -596,80 +680,8 @@ void Forest::exchange_scoped(std::span<BlockField* const> fields, int width, boo
   }
 
   const auto fill = [&](int blk) {
-    const Block& block = blocks_[static_cast<std::size_t>(blk)];
-    for (int oz = -1; oz <= 1; ++oz) {
-      for (int oy = -1; oy <= 1; ++oy) {
-        for (int ox = -1; ox <= 1; ++ox) {
-          const int nonzero = (ox != 0) + (oy != 0) + (oz != 0);
-          if (nonzero == 0 || (faces_only && nonzero > 1)) continue;
-          if (finer_face >= 0 && (nonzero != 1 || offset_face(ox, oy, oz) != finer_face)) continue;
-          const Neighbour& nb =
-              block.neighbours[static_cast<std::size_t>(neighbour_slot(ox, oy, oz))];
-          if (nb.link == Link::Boundary) continue;
-          if (finer_face >= 0 && nb.jump != LevelJump::Finer) continue;
-          if (skip_local_same_level && nb.jump == LevelJump::Same && nb.link == Link::Local) {
-            continue;
-          }
-          const Range rx = ghost_range(ox, b, width), ry = ghost_range(oy, b, width),
-                      rz = ghost_range(oz, b, width);
-          if (nb.jump != LevelJump::Same) {
-            const std::array<Range, 3> r{rx, ry, rz};
-            const std::array<int, 3> o{ox, oy, oz};
-            for (std::size_t f = 0; f < nf; ++f) {
-              auto reader = [&](const BlockRef& ref) {
-                if (ref.link == Link::Local) {
-                  return CellReader{fields[f]->block(ref.index) + layout.index(0, 0, 0),
-                                    {1, layout.stride(1), layout.stride(2)}};
-                }
-                return CellReader{
-                    remote.data() + static_cast<std::size_t>(ref.index) * per_block + f * packed,
-                    {1, b, std::ptrdiff_t{b} * b}};
-              };
-              if (nb.jump == LevelJump::Coarser) {
-                if (coarse_ghosts == CoarseGhosts::Composite && nonzero == 1 &&
-                    composite_ghost_fits(b)) {
-                  fill_composite_face_ghosts(block, o, r, reader({nb.link, nb.index}), *fields[f],
-                                             blk);
-                } else {
-                  fill_from_coarser(block, o, r, reader({nb.link, nb.index}), *fields[f], blk);
-                }
-              } else {
-                std::array<CellReader, 8> children{};
-                for (std::size_t c = 0; c < 8; ++c) {
-                  if (nb.children[c].link != Link::Boundary) children[c] = reader(nb.children[c]);
-                }
-                fill_from_finer(o, r, children, *fields[f], blk);
-              }
-            }
-            continue;
-          }
-          for (std::size_t f = 0; f < nf; ++f) {
-            double* dst = fields[f]->block(blk);
-            if (nb.link == Link::Local) {
-              const double* src = fields[f]->block(nb.index);
-              const int row = rx.end - rx.begin;  // short rows: a plain loop, no memmove call
-              for (int k = rz.begin; k < rz.end; ++k)
-                for (int j = ry.begin; j < ry.end; ++j) {
-                  const double* from =
-                      src + layout.index(rx.begin + rx.shift, j + ry.shift, k + rz.shift);
-                  double* to = dst + layout.index(rx.begin, j, k);
-                  for (int i = 0; i < row; ++i) to[i] = from[i];
-                }
-            } else {
-              const double* src =
-                  remote.data() + static_cast<std::size_t>(nb.index) * per_block + f * packed;
-              for (int k = rz.begin; k < rz.end; ++k)
-                for (int j = ry.begin; j < ry.end; ++j)
-                  for (int i = rx.begin; i < rx.end; ++i)
-                    dst[layout.index(i, j, k)] = src[(static_cast<std::size_t>(k + rz.shift) * b +
-                                                      static_cast<std::size_t>(j + ry.shift)) *
-                                                         b +
-                                                     static_cast<std::size_t>(i + rx.shift)];
-            }
-          }
-        }
-      }
-    }
+    fill_block_ghosts(fields, blk, width, faces_only, finer_face, skip_local_same_level,
+                      coarse_ghosts, remote.data());
   };
   // Only the blocks with something to fill when the exchange is narrowed.
   if (finer_face >= 0) {
@@ -679,6 +691,17 @@ void Forest::exchange_scoped(std::span<BlockField* const> fields, int width, boo
   } else {
     for_each_block(fill);
   }
+}
+
+bool Forest::uniform_local() const {
+  return ranks_ == 1 && min_level_ == max_level_;
+}
+
+void Forest::fill_same_level_ghosts(std::span<BlockField* const> fields, int blk, int width) const {
+  if (fields.empty()) return;
+  const BlockLayout layout = fields[0]->layout();
+  width = std::min({width, layout.cells, layout.ghost});
+  fill_block_ghosts(fields, blk, width, false, -1, false, CoarseGhosts::Interpolated, nullptr);
 }
 
 double Forest::sum(double local) const {

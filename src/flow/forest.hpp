@@ -165,6 +165,16 @@ class Forest {
   /// stencils read face ghosts only).
   void exchange(std::span<BlockField* const> fields, int width, bool faces_only = false,
                 CoarseGhosts coarse_ghosts = CoarseGhosts::Interpolated) const;
+  /// Whether every block is at one level and on this process. A block's ghosts are then
+  /// copies of its neighbours' interior cells alone, so a loop over the blocks may fill
+  /// each block's ghosts right before it reads them (fill_same_level_ghosts) instead of
+  /// exchanging them all first: the same values, read while they are in cache.
+  [[nodiscard]] bool uniform_local() const;
+  /// exchange(fields, width) for block blk alone (uniform_local() forests only). Reads
+  /// only the neighbours' interior cells and writes only blk's ghosts, so blocks may be
+  /// filled in any order and on any thread, as long as no interior of these fields
+  /// changes meanwhile.
+  void fill_same_level_ghosts(std::span<BlockField* const> fields, int blk, int width) const;
   void exchange(BlockField& field, int width, bool faces_only = false,
                 CoarseGhosts coarse_ghosts = CoarseGhosts::Interpolated) const {
     BlockField* one[] = {&field};
@@ -267,6 +277,11 @@ class Forest {
   void exchange_scoped(std::span<BlockField* const> fields, int width, bool faces_only,
                        int finer_face, bool skip_local_same_level = false,
                        CoarseGhosts coarse_ghosts = CoarseGhosts::Interpolated) const;
+  /// What exchange_scoped() writes into block blk (its ghost cells, from the neighbours'
+  /// interior cells; `remote`: the interiors of the ghost layer's blocks, packed).
+  void fill_block_ghosts(std::span<BlockField* const> fields, int blk, int width, bool faces_only,
+                         int finer_face, bool skip_local_same_level, CoarseGhosts coarse_ghosts,
+                         const double* remote) const;
   void build_blocks();
   void build_ghost_tables();
   void build_neighbours();

@@ -628,6 +628,39 @@ Vec3 NavierStokes::solid_force() const {
   return {forest_.sum(force.x), forest_.sum(force.y), forest_.sum(force.z)};
 }
 
+template <class Kernel>
+void NavierStokes::for_each_block_with_velocity_ghosts(VectorField& u, int width,
+                                                       VectorField* neumann, Kernel&& kernel) {
+  if (!forest_.uniform_local()) {
+    fill_velocity_ghosts(u, width);
+    if (neumann) fill_neumann_ghosts(*neumann, 1);
+    forest_.for_each_block(kernel);
+    return;
+  }
+  // Each block's ghosts (copies of its neighbours' cells, then its boundary closures,
+  // which read its own cells and ghosts) right before the kernel reads them: the values
+  // fill_velocity_ghosts and fill_neumann_ghosts give, and the block's lines are in cache
+  // when the kernel runs.
+  BlockField* fields[] = {&u[0], &u[1], &u[2]};
+  BlockField* others[] = {neumann ? &(*neumann)[0] : nullptr, neumann ? &(*neumann)[1] : nullptr,
+                          neumann ? &(*neumann)[2] : nullptr};
+  const auto neumann_kinds = uniform_kinds(forest_, BcKind::Neumann);
+  forest_.for_each_block([&](int blk) {
+    forest_.fill_same_level_ghosts(fields, blk, width);
+    for (int c = 0; c < 3; ++c) {
+      fill_block_boundary_ghosts(forest_, u[D(c)], blk, velocity_bc_[D(c)].kind,
+                                 &velocity_bc_[D(c)].value, width);
+    }
+    if (neumann) {
+      forest_.fill_same_level_ghosts(others, blk, 1);
+      for (BlockField* f : others) {
+        fill_block_boundary_ghosts(forest_, *f, blk, neumann_kinds, nullptr, 1);
+      }
+    }
+    kernel(blk);
+  });
+}
+
 void NavierStokes::fill_velocity_ghosts(VectorField& u, int width) {
   BlockField* fields[] = {&u[0], &u[1], &u[2]};
   forest_.exchange(fields, width);
@@ -757,7 +790,7 @@ void NavierStokes::predict_face_velocity(double dt) {
   const int b = forest_.block_cells();
   const BlockLayout L = u_[0].layout();
   const Strides s{L.stride(0), L.stride(1), L.stride(2)};
-  forest_.for_each_block([&](int blk) {
+  for_each_block_with_velocity_ghosts(u_, kGhost, &g_, [&](int blk) {
     const StepScales scales{dt, forest_.block(blk).length / b};
     const std::array<const double*, 3> u{u_[0].block(blk), u_[1].block(blk), u_[2].block(blk)};
     for (int d = 0; d < 3; ++d) {
@@ -1177,10 +1210,9 @@ void NavierStokes::viscous_step(double dt, StepReport& report) {
 
 void NavierStokes::face_average_plus_acceleration(double dt) {
   const int b = forest_.block_cells();
-  fill_velocity_ghosts(u_, 2);
   const BlockLayout L = u_[0].layout();
   const Strides s{L.stride(0), L.stride(1), L.stride(2)};
-  forest_.for_each_block([&](int blk) {
+  for_each_block_with_velocity_ghosts(u_, 2, nullptr, [&](int blk) {
     const std::array<bool, 6> prescribed = prescribed_faces(forest_.block(blk));
     const double* solid = solid_.block(blk);
     for (int d = 0; d < 3; ++d) {
@@ -1318,9 +1350,8 @@ StepReport NavierStokes::step(double dt) {
   const double rho = fluid_.density;
   bc_time_ = time_ + dt;
 
-  // 1. prediction of the face velocity at t + dt/2, MAC projection with dt/2.
-  fill_velocity_ghosts(u_);
-  fill_neumann_ghosts(g_, 1);
+  // 1. prediction of the face velocity at t + dt/2 (it fills the ghosts of u and g, which
+  // the advection below reads too), MAC projection with dt/2.
   predict_face_velocity(dt);
   // The predicted uf already holds -grad p through g (eq. 4.2 at t + dt/2),
   // so this projection finds only a correction: the previous step's

@@ -219,10 +219,20 @@ class NavierStokes {
   void advect_scalar(BlockField& c, double dt);
   /// Fills the ghost cells of the velocity (width 2) with the boundary conditions.
   void fill_velocity_ghosts(VectorField& u, int width = kGhost);
+
   /// The last multigrid report of the final projection.
   [[nodiscard]] const MultigridReport& last_pressure_report() const { return pressure_report_; }
 
  private:
+  /// kernel(blk) for every block, each block's velocity ghosts (width; and the ghosts of
+  /// `neumann`, width 1, Neumann at the domain's boundary, when given) filled first: block
+  /// by block inside the loop on a uniform one-process forest (Forest::uniform_local), else
+  /// by fill_velocity_ghosts and fill_neumann_ghosts before it. The kernel must not write u
+  /// or `neumann`.
+  template <class Kernel>
+  void for_each_block_with_velocity_ghosts(VectorField& u, int width, VectorField* neumann,
+                                           Kernel&& kernel);
+  /// The face velocity at t + dt/2 (BCG) from u and g; fills their ghosts first.
   void predict_face_velocity(double dt);
   void advect(double dt);
   /// out = f - dt div(uf f_{n+1/2}), BCG face values with the cell source
