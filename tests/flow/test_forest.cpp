@@ -96,6 +96,50 @@ TEST(FlowForest, GhostExchangeCopiesNeighbourCellsWithPeriodicWrap) {
   EXPECT_GT(checked, 0);
 }
 
+// The Navier-Stokes loops fill each block's ghosts right before they read them on a
+// uniform one-process forest: fill_same_level_ghosts must write, block by block and in any
+// order, every ghost exchange() writes (faces, edges, corners, both layers, periodic wrap)
+// with the same value, and nothing else; a refined forest is not uniform_local().
+TEST(FlowForest, OneBlocksGhostsFilledAloneMatchTheExchange) {
+  ForestSpec spec;
+  spec.trees = {2, 1, 1};
+  spec.periodic = {true, false, true};
+  spec.level = 1;
+  spec.block_cells = 4;
+  Forest forest(spec);
+  if (forest.ranks() > 1) GTEST_SKIP() << "needs one rank";
+  ASSERT_TRUE(forest.uniform_local());
+  BlockField exchanged = tagged_cells(forest), second = tagged_cells(forest);
+  BlockField alone = exchanged, alone_second = second;
+  BlockField* both[] = {&exchanged, &second};
+  forest.exchange(both, kGhost);
+  BlockField* both_alone[] = {&alone, &alone_second};
+  for (int blk = forest.local_blocks() - 1; blk >= 0; --blk) {  // backwards: order is free
+    forest.fill_same_level_ghosts(both_alone, blk, kGhost);
+  }
+  std::size_t filled = 0;
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    const int b = spec.block_cells;
+    for (int k = -kGhost; k < b + kGhost; ++k)
+      for (int j = -kGhost; j < b + kGhost; ++j)
+        for (int i = -kGhost; i < b + kGhost; ++i) {
+          ASSERT_EQ(alone(blk, i, j, k), exchanged(blk, i, j, k)) << blk << ' ' << i << j << k;
+          ASSERT_EQ(alone_second(blk, i, j, k), second(blk, i, j, k)) << blk << ' ' << i << j << k;
+          const bool ghost = i < 0 || i >= b || j < 0 || j >= b || k < 0 || k >= b;
+          filled += ghost && exchanged(blk, i, j, k) != -1.0;
+        }
+  }
+  EXPECT_GT(filled, 0u);
+  // One block refined: two levels, so ghosts may come from interpolation.
+  forest.adapt(
+      [](const Block& block) {
+        return block.coord == std::array<std::int64_t, 3>{0, 0, 0} ? AdaptFlag::Refine
+                                                                   : AdaptFlag::Keep;
+      },
+      {});
+  EXPECT_FALSE(forest.uniform_local());
+}
+
 // The fused smoother fills one block's face ghosts at a time: copy_face_ghosts
 // must put there what exchange(field, 1, faces only) does (periodic wrap and
 // boundary faces included), and a colour must copy that colour and no other.
