@@ -411,10 +411,22 @@ void DemSimulation::compute_forces() {
       worst = std::max(worst, o.overlap_ratio);
     };
     SpherePairLanes lanes;
+    // Sphere pairs without a branch on contact: a pair apart has an outcome of +0 forces and
+    // torques and a zero overlap ratio, which leave the sums as they are (they start at +0
+    // and so are never -0, the one value +0 would change).
     evaluate_sphere_pairs(
         sphere_pairs, [](std::size_t e) { return e; }, n_pairs, lanes,
         [&](std::size_t k, const ContactOutcome& o) {
-          add_pair(o, pairs_.first[k], pairs_.second[k]);
+          const std::uint32_t i = pairs_.first[k], j = pairs_.second[k];
+          const std::int32_t on = o.touching ? 1 : 0;
+          f[i] += o.force;
+          f[j] -= o.force;
+          tq[i] += o.torque_first;
+          tq[j] += o.torque_second;
+          coord[i] += on;
+          coord[j] += on;
+          touching_pairs += on;
+          worst = std::max(worst, o.overlap_ratio);
         });
     for (std::size_t k = 0; k < n_body_pairs; ++k) {
       add_pair(body_pair_outcome(k), body_pairs_.first[k], body_pairs_.second[k]);
@@ -493,11 +505,20 @@ void DemSimulation::compute_forces() {
           const std::size_t count = run.end - run.begin;
           if (run.direct) {  // consecutive contacts of unshared particles: as the serial loop
             const std::size_t k0 = block[run.begin];
+            // Without a branch on contact, as the serial loop's sphere pairs.
             evaluate_sphere_pairs(
                 sphere_pairs, [k0](std::size_t e) { return k0 + e; }, count, lanes,
                 [&](std::size_t k, const ContactOutcome& o) {
-                  tally(o, slab_pairs);
-                  if (o.touching) add_to_both(o, pairs_.first[k], pairs_.second[k]);
+                  const std::uint32_t i = pairs_.first[k], j = pairs_.second[k];
+                  const std::int32_t on = o.touching ? 1 : 0;
+                  f[i] += o.force;
+                  f[j] -= o.force;
+                  tq[i] += o.torque_first;
+                  tq[j] += o.torque_second;
+                  coord[i] += on;
+                  coord[j] += on;
+                  slab_pairs += on;
+                  slab_worst = std::max(slab_worst, o.overlap_ratio);
                 });
           } else {
             const std::uint32_t* ks = block.data() + run.begin;

@@ -206,17 +206,31 @@ void evaluate_sphere_lanes(SpherePairLanes& b, int n, double dt) {
     h.tangential_displacement = lane(b.tx, b.ty, b.tz, l);
     h.rolling_spring_torque = lane(b.mx, b.my, b.mz, l);
     h.normal = lane(b.nx, b.ny, b.nz, l);
+    const ContactHistory before = h;
     const ContactResponse r = evaluate_contact(p, c, h, dt);
     const Vec3 moment = cross(normal, r.force);
     const Vec3 t1 = a_i * moment + r.rolling_torque;
     const Vec3 t2 = a_j * moment - r.rolling_torque;
-    put_lane(b.fx, b.fy, b.fz, l, r.force);
-    put_lane(b.t1x, b.t1y, b.t1z, l, t1);
-    put_lane(b.t2x, b.t2y, b.t2z, l, t2);
-    b.ratio[l] = c.overlap / std::min(ri, rj);
-    put_lane(b.tx, b.ty, b.tz, l, h.tangential_displacement);
-    put_lane(b.mx, b.my, b.mz, l, h.rolling_spring_torque);
-    put_lane(b.nx, b.ny, b.nz, l, h.normal);
+    // A lane apart gives +0 forces and torques (a select, not a product: 0 x a negative
+    // value would be -0), so its outcome adds nothing; its memory is forgotten (zeroed) if it
+    // had one, else left as it was (a memory turned round by a renumbering holds -0s).
+    const bool on = b.touching[l] != 0.0;
+    const bool had = before.normal.x != 0.0 || before.normal.y != 0.0 || before.normal.z != 0.0;
+    const auto keep = [on](const Vec3& v) __attribute__((always_inline)) {
+      return on ? v : Vec3{};
+    };
+    const auto memory =
+        [ on, had ](const Vec3& now, const Vec3& was) __attribute__((always_inline)) {
+      return on ? now : (had ? Vec3{} : was);
+    };
+    put_lane(b.fx, b.fy, b.fz, l, keep(r.force));
+    put_lane(b.t1x, b.t1y, b.t1z, l, keep(t1));
+    put_lane(b.t2x, b.t2y, b.t2z, l, keep(t2));
+    b.ratio[l] = on ? c.overlap / std::min(ri, rj) : 0.0;
+    put_lane(b.tx, b.ty, b.tz, l,
+             memory(h.tangential_displacement, before.tangential_displacement));
+    put_lane(b.mx, b.my, b.mz, l, memory(h.rolling_spring_torque, before.rolling_spring_torque));
+    put_lane(b.nx, b.ny, b.nz, l, memory(h.normal, before.normal));
   }
 }
 
@@ -224,13 +238,11 @@ void evaluate_sphere_lanes(SpherePairLanes& b, int n, double dt) {
 // history; it is already zero unless it touched before).
 [[gnu::always_inline]] inline void store_sphere_history(const SpherePairLanes& b, int l,
                                                         ContactHistory& h) {
-  if (b.touching[l] != 0.0) {
-    h.tangential_displacement = lane(b.tx, b.ty, b.tz, l);
-    h.rolling_spring_torque = lane(b.mx, b.my, b.mz, l);
-    h.normal = lane(b.nx, b.ny, b.nz, l);
-  } else if (h.normal.x != 0.0 || h.normal.y != 0.0 || h.normal.z != 0.0) {
-    h = ContactHistory{};
-  }
+  // The lanes hold what the memory must become, touching or apart (evaluate_sphere_lanes):
+  // no branch here.
+  h.tangential_displacement = lane(b.tx, b.ty, b.tz, l);
+  h.rolling_spring_torque = lane(b.mx, b.my, b.mz, l);
+  h.normal = lane(b.nx, b.ny, b.nz, l);
 }
 
 // One contact at a time: the same operations as the three passes, with the branches
@@ -269,13 +281,13 @@ void evaluate_sphere_lanes(SpherePairLanes& b, int n, double dt) {
 
 // Lane l of a batch as a contact outcome.
 [[gnu::always_inline]] inline ContactOutcome lane_outcome(const SpherePairLanes& b, int l) {
+  // No branch: a lane apart holds zeros (evaluate_sphere_lanes), the empty outcome's values.
   ContactOutcome out;
-  if (b.touching[l] == 0.0) return out;
   out.force = lane(b.fx, b.fy, b.fz, l);
   out.torque_first = lane(b.t1x, b.t1y, b.t1z, l);
   out.torque_second = lane(b.t2x, b.t2y, b.t2z, l);
   out.overlap_ratio = b.ratio[l];
-  out.touching = true;
+  out.touching = b.touching[l] != 0.0;
   return out;
 }
 
