@@ -53,9 +53,11 @@ if ((quick)); then
   spheres=(--particles 4000 --steps 200); crosses=(--particles 300 --steps 50)
   big=(--particles 100000 --steps 2); repeat=1; flow_n=16; flow_steps=2; wake_steps=5
   membrane=(--triangles 320 --capsules 4 --steps 2); lammps=(--particles 4000 --steps 200)
+  pour=(--end-time 0.002)
 else
   spheres=(); crosses=(); big=(--particles 1000000 --steps 3); repeat=3; flow_n=64
   flow_steps=20; wake_steps=100; membrane=(--triangles 5120 --capsules 100); lammps=()
+  pour=()
 fi
 
 # Granular solver (issues #3, #5).
@@ -69,6 +71,8 @@ fi
 # One and two threads alternated, the median of the pairs' speed-ups (issue #5: 1.8x).
 run dem-spheres-thread-speedup "$root/bench/dem_thread_speedup.sh" --repeat "$repeat" -- \
   "${spheres[@]}"
+# A pour, where lists are rebuilt every few dozen steps (the broad phase on the threads).
+run dem-pour-thread-speedup "$root/bench/dem_pour_threads.sh" --repeat "$repeat" "${pour[@]}"
 run dem-spheres-2proc "${mpirun_cmd[@]}" -np 2 "$sanguis" bench dem-spheres "${spheres[@]}"
 # The storage sort (docs/performance.md): ids scattered in space, sorted and never sorted.
 for sort in 2000 0; do
