@@ -389,6 +389,25 @@ void DemSimulation::compute_forces() {
     ++coord[j];
   };
 
+  // Sphere pair k's outcome added to both spheres and to the tallies without a branch on
+  // contact: a pair apart has +0 forces and torques and a zero overlap ratio
+  // (evaluate_sphere_lanes), which leave the sums as they are, since they start at +0 and so
+  // never hold the -0 that adding +0 would change. (Which listed pairs touch follows no
+  // pattern the branch predictor learns: docs/performance.md.)
+  const auto add_sphere_pair = [&](const ContactOutcome& o, std::size_t k, std::int64_t& touching,
+                                   double& worst_ratio) {
+    const std::uint32_t i = pairs_.first[k], j = pairs_.second[k];
+    const std::int32_t on = o.touching ? 1 : 0;
+    f[i] += o.force;
+    f[j] -= o.force;
+    tq[i] += o.torque_first;
+    tq[j] += o.torque_second;
+    coord[i] += on;
+    coord[j] += on;
+    touching += on;
+    worst_ratio = std::max(worst_ratio, o.overlap_ratio);
+  };
+
   if (threads_ <= 1) {
     // Serial: accumulate directly, contacts in list order.
     std::fill(p.force.begin(), p.force.end(), Vec3{});
@@ -411,22 +430,10 @@ void DemSimulation::compute_forces() {
       worst = std::max(worst, o.overlap_ratio);
     };
     SpherePairLanes lanes;
-    // Sphere pairs without a branch on contact: a pair apart has an outcome of +0 forces and
-    // torques and a zero overlap ratio, which leave the sums as they are (they start at +0
-    // and so are never -0, the one value +0 would change).
     evaluate_sphere_pairs(
         sphere_pairs, [](std::size_t e) { return e; }, n_pairs, lanes,
         [&](std::size_t k, const ContactOutcome& o) {
-          const std::uint32_t i = pairs_.first[k], j = pairs_.second[k];
-          const std::int32_t on = o.touching ? 1 : 0;
-          f[i] += o.force;
-          f[j] -= o.force;
-          tq[i] += o.torque_first;
-          tq[j] += o.torque_second;
-          coord[i] += on;
-          coord[j] += on;
-          touching_pairs += on;
-          worst = std::max(worst, o.overlap_ratio);
+          add_sphere_pair(o, k, touching_pairs, worst);
         });
     for (std::size_t k = 0; k < n_body_pairs; ++k) {
       add_pair(body_pair_outcome(k), body_pairs_.first[k], body_pairs_.second[k]);
@@ -505,20 +512,10 @@ void DemSimulation::compute_forces() {
           const std::size_t count = run.end - run.begin;
           if (run.direct) {  // consecutive contacts of unshared particles: as the serial loop
             const std::size_t k0 = block[run.begin];
-            // Without a branch on contact, as the serial loop's sphere pairs.
             evaluate_sphere_pairs(
                 sphere_pairs, [k0](std::size_t e) { return k0 + e; }, count, lanes,
                 [&](std::size_t k, const ContactOutcome& o) {
-                  const std::uint32_t i = pairs_.first[k], j = pairs_.second[k];
-                  const std::int32_t on = o.touching ? 1 : 0;
-                  f[i] += o.force;
-                  f[j] -= o.force;
-                  tq[i] += o.torque_first;
-                  tq[j] += o.torque_second;
-                  coord[i] += on;
-                  coord[j] += on;
-                  slab_pairs += on;
-                  slab_worst = std::max(slab_worst, o.overlap_ratio);
+                  add_sphere_pair(o, k, slab_pairs, slab_worst);
                 });
           } else {
             const std::uint32_t* ks = block.data() + run.begin;

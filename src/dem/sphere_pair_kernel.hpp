@@ -234,8 +234,8 @@ void evaluate_sphere_lanes(SpherePairLanes& b, int n, double dt) {
   }
 }
 
-// Pass (3), for lane l: the memory back. A contact that does not touch forgets (a zero
-// history; it is already zero unless it touched before).
+// Pass (3), for lane l: the memory back. A contact that does not touch forgets the memory it
+// had (zeroed); one that had none is left as it was.
 [[gnu::always_inline]] inline void store_sphere_history(const SpherePairLanes& b, int l,
                                                         ContactHistory& h) {
   // The lanes hold what the memory must become, touching or apart (evaluate_sphere_lanes):
