@@ -219,7 +219,6 @@ class NavierStokes {
   void advect_scalar(BlockField& c, double dt);
   /// Fills the ghost cells of the velocity (width 2) with the boundary conditions.
   void fill_velocity_ghosts(VectorField& u, int width = kGhost);
-
   /// The last multigrid report of the final projection.
   [[nodiscard]] const MultigridReport& last_pressure_report() const { return pressure_report_; }
 
