@@ -72,7 +72,7 @@ for ((r = 1; r <= repeat; r++)); do
   b="$seconds"
   one+=("$a")
   many+=("$b")
-  ratios+=("$(awk -v a="$a" -v b="$b" 'BEGIN { printf "%.4g", a / b }')")
+  ratios+=("$(ratio "$a" "$b")")
 done
 m1=$(printf '%s\n' "${one[@]}" | median)
 mT=$(printf '%s\n' "${many[@]}" | median)

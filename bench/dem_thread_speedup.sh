@@ -53,7 +53,7 @@ for ((r = 1; r <= repeat; r++)); do
   b=$(echo "$lineT" | rate)
   one+=("$a")
   many+=("$b")
-  ratios+=("$(awk -v a="$a" -v b="$b" 'BEGIN { printf "%.4g", b / a }')")
+  ratios+=("$(ratio "$b" "$a")")
 done
 m1=$(printf '%s\n' "${one[@]}" | median)
 mT=$(printf '%s\n' "${many[@]}" | median)

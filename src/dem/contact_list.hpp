@@ -39,16 +39,22 @@ struct ContactList {
   std::uint64_t key(std::size_t k) const { return (std::uint64_t{first[k]} << 32) | second[k]; }
 };
 
-// Copies the histories of `previous` into `fresh` for the keys present in both.
-// Both lists must be sorted by (first, second).
-inline void carry_history(const ContactList& previous, ContactList& fresh) {
-  std::size_t p = 0;
+// Copies the histories of `previous` into `fresh` for the keys present in both, for the
+// entries begin .. end - 1 of `fresh`, walking `previous` from entry p on. Both lists must
+// be sorted by (first, second).
+inline void carry_history_range(const ContactList& previous, ContactList& fresh, std::size_t begin,
+                                std::size_t end, std::size_t p) {
   const std::size_t np = previous.size();
-  for (std::size_t k = 0; k < fresh.size() && p < np; ++k) {
+  for (std::size_t k = begin; k < end && p < np; ++k) {
     const std::uint64_t key = fresh.key(k);
     while (p < np && previous.key(p) < key) ++p;
     if (p < np && previous.key(p) == key) fresh.history[k] = previous.history[p];
   }
+}
+
+// The same for the whole of `fresh`.
+inline void carry_history(const ContactList& previous, ContactList& fresh) {
+  carry_history_range(previous, fresh, 0, fresh.size(), 0);
 }
 
 // The same, the fresh list cut into `threads` ranges merged in parallel (each finds where
@@ -75,12 +81,7 @@ inline void carry_history(const ContactList& previous, ContactList& fresh, int t
         hi = mid;
       }
     }
-    std::size_t p = lo;
-    for (std::size_t k = begin; k < end && p < np; ++k) {
-      const std::uint64_t key = fresh.key(k);
-      while (p < np && previous.key(p) < key) ++p;
-      if (p < np && previous.key(p) == key) fresh.history[k] = previous.history[p];
-    }
+    carry_history_range(previous, fresh, begin, end, lo);
   }
 }
 
