@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
+#include <type_traits>
 
 #include "flow/coarse_fine.hpp"
 #include "flow/conjugate_gradients.hpp"
@@ -271,6 +274,177 @@ AcrossFaces same_level_neighbours(const Forest& forest, const BlockField& x, int
   pull_row_x_ghosts(row, L, across, j, k, i_first == 0, ((L.cells - 1 - i_first) & 1) == 0);
 }
 
+/// One row of a block's half-sweep away from closed faces (implicit 0),
+/// kB cells: the new value of every cell of the row is formed from the old
+/// values into a buffer, a loop of unit strides and fixed length that
+/// vectorises whole, and the row is stored back with the cells of the
+/// half-sweep's colour (from i_first, every second one) replaced. A cell's
+/// new value reads only cells of the other colour, which the half-sweep does
+/// not write, so each stored value is the one the strided scalar loop of
+/// relax_constant forms: the same operations in the same order, the same
+/// bits. The other colour's values are formed and dropped (they may read a
+/// stale ghost at a row end): twice the arithmetic in a fraction of the
+/// instructions. The row goes back whole (the other colour rewritten with
+/// its own values) so that the next row's wide loads of this one forward
+/// from stores of their own width; single-cell stores stalled them.
+/// Where pull_row_x_ghosts_of_colour would read the row's two ghosts along
+/// x (null: the ghost layer holds them).
+[[gnu::always_inline]] inline std::array<const double*, 2> row_x_ghosts_of_colour(
+    const BlockLayout& L, const AcrossFaces& across, int j, int k, int i_first) {
+  const int b = L.cells;
+  const auto& [cells, shift] = across;
+  const bool low = i_first == 0, high = ((b - 1 - i_first) & 1) == 0;
+  return {low && cells[0] ? cells[0] + (L.index(b - 1, j, k) + shift[0]) : nullptr,
+          high && cells[1] ? cells[1] + (L.index(0, j, k) + shift[1]) : nullptr};
+}
+
+// GCC/Clang vector types of 4 and 8 doubles, and their lane masks.
+typedef double Doubles4 __attribute__((vector_size(32)));
+typedef std::int64_t Lanes4 __attribute__((vector_size(32)));
+typedef double Doubles8 __attribute__((vector_size(64)));
+typedef std::int64_t Lanes8 __attribute__((vector_size(64)));
+
+/// The diagonal part of a row's cells in relax_constant: none (implicit 0,
+/// the interior diagonal, one value for the row), or per cell (a row beside
+/// a closed face: closure_implicit and its diagonal, kB values each).
+struct RowDiagonal {
+  double interior = 0.0;
+  const double* implicit = nullptr;  ///< per cell, or null: 0 and `interior` everywhere
+  const double* den = nullptr;
+};
+
+/// relax_row_whole on kLanes cells of a row from cell `at`: whole loads,
+/// the scalar loop's operations in its order lane by lane, one blended store.
+/// `x_ghosts`: the row's ghosts along x read in place in a same-level
+/// neighbour (pull_row_x_ghosts_of_colour), else null: they go into the
+/// lanes in registers instead of through the ghost layer, whose
+/// single-value store the wide load right after could not forward from.
+template <typename Doubles, typename Lanes, int kLanes, bool kClosure>
+[[gnu::always_inline]] inline void relax_row_lanes(double* row, const double* f,
+                                                   const std::array<const double*, 4>& beside,
+                                                   const std::array<const double*, 2>& x_ghosts,
+                                                   int at, bool last, int i_first, double beta,
+                                                   double inv_h2, const RowDiagonal& diagonal,
+                                                   double omega) {
+  const auto load = [at](const double* p) {
+    Doubles v;
+    std::memcpy(&v, p + at, sizeof v);
+    return v;
+  };
+  Lanes lane{};
+  for (int i = 0; i < kLanes; ++i) lane[i] = at + i;
+  const Doubles centre = load(row);
+  Doubles num;
+  if constexpr (kClosure) {
+    num = load(f) + load(diagonal.implicit) * inv_h2 * centre;
+  } else {
+    const double implicit = 0.0;
+    num = load(f) + implicit * inv_h2 * centre;
+  }
+  Doubles left = load(row - 1), right = load(row + 1);
+  if (at == 0 && x_ghosts[0]) left[0] = *x_ghosts[0];
+  if (last && x_ghosts[1]) right[kLanes - 1] = *x_ghosts[1];
+  num += inv_h2 * (beta * left + beta * right);
+  num += inv_h2 * (beta * load(beside[0]) + beta * load(beside[1]));
+  num += inv_h2 * (beta * load(beside[2]) + beta * load(beside[3]));
+  Doubles relaxed;
+  if constexpr (kClosure) {
+    relaxed = centre + omega * (num / load(diagonal.den) - centre);
+  } else {
+    relaxed = centre + omega * (num / diagonal.interior - centre);
+  }
+  const Doubles out = (lane & 1) == i_first ? relaxed : centre;
+  std::memcpy(row + at, &out, sizeof out);
+}
+
+template <int kB, bool kClosure>
+[[gnu::always_inline]] inline void relax_row_whole(double* row, const double* f,
+                                                   const std::array<const double*, 4>& beside,
+                                                   const std::array<const double*, 2>& x_ghosts,
+                                                   int i_first, double beta, double inv_h2,
+                                                   const RowDiagonal& diagonal, double omega) {
+  constexpr int kLanes = kB % 8 == 0 ? 8 : 4;
+  static_assert(kB % kLanes == 0);
+  using Doubles = std::conditional_t<kLanes == 8, Doubles8, Doubles4>;
+  using Lanes = std::conditional_t<kLanes == 8, Lanes8, Lanes4>;
+  for (int at = 0; at < kB; at += kLanes)
+    relax_row_lanes<Doubles, Lanes, kLanes, kClosure>(
+        row, f, beside, x_ghosts, at, at + kLanes == kB, i_first, beta, inv_h2, diagonal, omega);
+}
+
+/// A row of relax_constant_rows beside a closed face: every cell's implicit
+/// part and diagonal (the other colour's are formed and dropped with its
+/// values). Out of line: the open rows' loop stays small.
+template <int kB, typename DiagonalOf>
+[[gnu::noinline]] void relax_closure_row(double* row, const double* f,
+                                         const std::array<const double*, 4>& beside,
+                                         const std::array<const double*, 2>& x_ghosts, int j, int k,
+                                         int i_first, double beta, double inv_h2, double omega,
+                                         const ClosedFaces& faces, DiagonalOf diagonal_of) {
+  alignas(64) std::array<double, kB> implicit, den;
+  const auto constant = [beta](int) { return beta; };
+  const auto set = [&](int i, double value) {
+    implicit[D(i)] = value;
+    den[D(i)] = diagonal_of(value);
+  };
+  // Without matched faces a cell's implicit part depends on i only at the
+  // row's ends (the faces along x): the cells between share one value.
+  if (std::none_of(faces.matched.begin(), faces.matched.end(), [](bool m) { return m; })) {
+    const double between = closure_implicit({1, j, k}, kB, faces, constant, constant);
+    const double between_den = diagonal_of(between);
+    for (int i = 1; i < kB - 1; ++i) {
+      implicit[D(i)] = between;
+      den[D(i)] = between_den;
+    }
+    set(0, closure_implicit({0, j, k}, kB, faces, constant, constant));
+    set(kB - 1, closure_implicit({kB - 1, j, k}, kB, faces, constant, constant));
+  } else {
+    for (int i = 0; i < kB; ++i) set(i, closure_implicit({i, j, k}, kB, faces, constant, constant));
+  }
+  const RowDiagonal near{0.0, implicit.data(), den.data()};
+  relax_row_whole<kB, true>(row, f, beside, x_ghosts, i_first, beta, inv_h2, near, omega);
+}
+
+/// relax_constant with kB cells per edge, every row through relax_row_whole
+/// (docs/performance.md, "Whole rows in the smoother"). `closed`: the faces
+/// of `faces` that close on the cells beside them; `diagonal_of(implicit)`:
+/// the diagonal with that implicit part.
+template <int kB, bool kAnyClosed, typename DiagonalOf>
+void relax_constant_rows(double* x, const double* rhs, const BlockLayout& L, int first, double beta,
+                         double inv_h2, double omega, const ClosedFaces& faces,
+                         const std::array<bool, 6>& closed, DiagonalOf diagonal_of,
+                         const AcrossFaces& across) {
+  const bool x_faces = closed[D(face_index(0, 0))] || closed[D(face_index(0, 1))];
+  RowDiagonal open;
+  open.interior = diagonal_of(0.0);
+  // Rows with j + k even first, then the others: a row reads the four rows
+  // beside it along y and z, all of the other kind, so no row reads one that
+  // was just stored. In row order each row's loads waited on the previous
+  // row's store (whole, its unchanged lanes too), a chain through the
+  // division's latency from row to row. Any order gives the same bits: in a
+  // half-sweep no cell reads one of its own colour.
+  for (int kind = 0; kind < 2; ++kind)
+    for (int k = 0; k < kB; ++k)
+      for (int j = (k + kind) & 1; j < kB; j += 2) {
+        double* row = x + L.index(0, j, k);
+        const double* f = rhs + L.index(0, j, k);
+        const int i_first = (k + j + first) & 1;
+        const auto beside = neighbour_rows(row, L, across, j, k);
+        const auto x_ghosts = row_x_ghosts_of_colour(L, across, j, k, i_first);
+        const bool closure_row =
+            kAnyClosed && (x_faces || (j == 0 && closed[D(face_index(1, 0))]) ||
+                           (j == kB - 1 && closed[D(face_index(1, 1))]) ||
+                           (k == 0 && closed[D(face_index(2, 0))]) ||
+                           (k == kB - 1 && closed[D(face_index(2, 1))]));
+        if (!closure_row) {
+          relax_row_whole<kB, false>(row, f, beside, x_ghosts, i_first, beta, inv_h2, open, omega);
+          continue;
+        }
+        relax_closure_row<kB>(row, f, beside, x_ghosts, j, k, i_first, beta, inv_h2, omega, faces,
+                              diagonal_of);
+      }
+}
+
 /// Red-black Gauss-Seidel on the cells of one colour (i + j + k + first even)
 /// of a block whose alpha and beta are constants: relaxed_value, the same
 /// operations in the same order, with the implicit part of smooth() (the
@@ -288,6 +462,31 @@ inline void relax_constant(double* x, const double* rhs, const BlockLayout& L, i
   std::array<bool, 6> closed{};
   for (std::size_t f = 0; f < 6; ++f)
     closed[f] = faces.dirichlet[f] || faces.matched[f] || faces.coarser[f];
+  const bool any_closed = std::any_of(closed.begin(), closed.end(), [](bool c) { return c; });
+  // By block size, and with or without closed faces (most blocks: none, and
+  // their loop tests no row for them).
+  const auto rows = [&]<int kB>() {
+    if (any_closed) {
+      relax_constant_rows<kB, true>(x, rhs, L, first, beta, inv_h2, omega, faces, closed, diagonal,
+                                    across);
+    } else {
+      relax_constant_rows<kB, false>(x, rhs, L, first, beta, inv_h2, omega, faces, closed, diagonal,
+                                     across);
+    }
+  };
+  switch (b) {
+    case 4:
+      return rows.template operator()<4>();
+    case 8:
+      return rows.template operator()<8>();
+    case 16:
+      return rows.template operator()<16>();
+    case 32:
+      return rows.template operator()<32>();
+    default:
+      break;
+  }
+  // Other block sizes (the in-block level of 2 cells): cell by cell.
   const double interior = diagonal(0.0);
   const bool x_faces = closed[D(face_index(0, 0))] || closed[D(face_index(0, 1))];
   for (int k = 0; k < b; ++k)
