@@ -372,37 +372,37 @@ template <int kB, bool kClosure>
         row, f, beside, x_ghosts, at, at + kLanes == kB, i_first, beta, inv_h2, diagonal, omega);
 }
 
-/// A row of relax_constant_rows beside a closed face: every cell's implicit
-/// part and diagonal (the other colour's are formed and dropped with its
-/// values). Out of line: the open rows' loop stays small.
-template <int kB, typename DiagonalOf>
-[[gnu::noinline]] void relax_closure_row(double* row, const double* f,
-                                         const std::array<const double*, 4>& beside,
-                                         const std::array<const double*, 2>& x_ghosts, int j, int k,
-                                         int i_first, double beta, double inv_h2, double omega,
-                                         const ClosedFaces& faces, DiagonalOf diagonal_of) {
+/// The implicit parts and diagonals of the kB cells of row (j, k) beside a
+/// closed face (the other colour's are formed and dropped with its values).
+/// Out of line: the open rows' loop stays small.
+template <int kB>
+struct ClosureRow {
   alignas(64) std::array<double, kB> implicit, den;
+  [[nodiscard]] RowDiagonal diagonal() const { return {0.0, implicit.data(), den.data()}; }
+};
+
+template <int kB, typename DiagonalOf>
+[[gnu::noinline]] void form_closure_row(int j, int k, double beta, const ClosedFaces& faces,
+                                        bool matched, DiagonalOf diagonal_of, ClosureRow<kB>& out) {
   const auto constant = [beta](int) { return beta; };
   const auto set = [&](int i, double value) {
-    implicit[D(i)] = value;
-    den[D(i)] = diagonal_of(value);
+    out.implicit[D(i)] = value;
+    out.den[D(i)] = diagonal_of(value);
   };
+  if (matched) {
+    for (int i = 0; i < kB; ++i) set(i, closure_implicit({i, j, k}, kB, faces, constant, constant));
+    return;
+  }
   // Without matched faces a cell's implicit part depends on i only at the
   // row's ends (the faces along x): the cells between share one value.
-  if (std::none_of(faces.matched.begin(), faces.matched.end(), [](bool m) { return m; })) {
-    const double between = closure_implicit({1, j, k}, kB, faces, constant, constant);
-    const double between_den = diagonal_of(between);
-    for (int i = 1; i < kB - 1; ++i) {
-      implicit[D(i)] = between;
-      den[D(i)] = between_den;
-    }
-    set(0, closure_implicit({0, j, k}, kB, faces, constant, constant));
-    set(kB - 1, closure_implicit({kB - 1, j, k}, kB, faces, constant, constant));
-  } else {
-    for (int i = 0; i < kB; ++i) set(i, closure_implicit({i, j, k}, kB, faces, constant, constant));
+  const double between = closure_implicit({1, j, k}, kB, faces, constant, constant);
+  const double between_den = diagonal_of(between);
+  for (int i = 1; i < kB - 1; ++i) {
+    out.implicit[D(i)] = between;
+    out.den[D(i)] = between_den;
   }
-  const RowDiagonal near{0.0, implicit.data(), den.data()};
-  relax_row_whole<kB, true>(row, f, beside, x_ghosts, i_first, beta, inv_h2, near, omega);
+  set(0, closure_implicit({0, j, k}, kB, faces, constant, constant));
+  set(kB - 1, closure_implicit({kB - 1, j, k}, kB, faces, constant, constant));
 }
 
 /// relax_constant with kB cells per edge, every row through relax_row_whole
@@ -417,6 +417,10 @@ void relax_constant_rows(double* x, const double* rhs, const BlockLayout& L, int
   const bool x_faces = closed[D(face_index(0, 0))] || closed[D(face_index(0, 1))];
   RowDiagonal open;
   open.interior = diagonal_of(0.0);
+  const bool matched =
+      std::any_of(faces.matched.begin(), faces.matched.end(), [](bool m) { return m; });
+  ClosureRow<kB> own, inner_rows;
+  bool inner_formed = false;
   // Rows with j + k even first, then the others: a row reads the four rows
   // beside it along y and z, all of the other kind, so no row reads one that
   // was just stored. In row order each row's loads waited on the previous
@@ -440,8 +444,17 @@ void relax_constant_rows(double* x, const double* rhs, const BlockLayout& L, int
           relax_row_whole<kB, false>(row, f, beside, x_ghosts, i_first, beta, inv_h2, open, omega);
           continue;
         }
-        relax_closure_row<kB>(row, f, beside, x_ghosts, j, k, i_first, beta, inv_h2, omega, faces,
-                              diagonal_of);
+        // Without matched faces the rows away from the y and z faces (closed
+        // by the x faces alone) share one closure row, formed once.
+        const bool inner = !matched && j > 0 && j < kB - 1 && k > 0 && k < kB - 1;
+        if (!inner) {
+          form_closure_row<kB>(j, k, beta, faces, matched, diagonal_of, own);
+        } else if (!inner_formed) {
+          form_closure_row<kB>(j, k, beta, faces, matched, diagonal_of, inner_rows);
+          inner_formed = true;
+        }
+        relax_row_whole<kB, true>(row, f, beside, x_ghosts, i_first, beta, inv_h2,
+                                  (inner ? inner_rows : own).diagonal(), omega);
       }
 }
 
