@@ -419,8 +419,14 @@ void relax_constant_rows(double* x, const double* rhs, const BlockLayout& L, int
   open.interior = diagonal_of(0.0);
   const bool matched =
       std::any_of(faces.matched.begin(), faces.matched.end(), [](bool m) { return m; });
-  ClosureRow<kB> own, inner_rows;
-  bool inner_formed = false;
+  // Without matched faces a row's closure depends on (j, k) only through
+  // whether each lies on the block's first, last or a middle layer: nine
+  // kinds of row, each formed once, when first met. With matched faces
+  // (their weights vary along the face) every row is formed.
+  ClosureRow<kB> own;
+  std::array<ClosureRow<kB>, 9> by_kind;
+  std::array<bool, 9> formed{};
+  const auto layer = [](int n) { return n == 0 ? 0 : (n == kB - 1 ? 2 : 1); };
   // Rows with j + k even first, then the others: a row reads the four rows
   // beside it along y and z, all of the other kind, so no row reads one that
   // was just stored. In row order each row's loads waited on the previous
@@ -444,17 +450,19 @@ void relax_constant_rows(double* x, const double* rhs, const BlockLayout& L, int
           relax_row_whole<kB, false>(row, f, beside, x_ghosts, i_first, beta, inv_h2, open, omega);
           continue;
         }
-        // Without matched faces the rows away from the y and z faces (closed
-        // by the x faces alone) share one closure row, formed once.
-        const bool inner = !matched && j > 0 && j < kB - 1 && k > 0 && k < kB - 1;
-        if (!inner) {
+        const ClosureRow<kB>* closure = &own;
+        if (matched) {
           form_closure_row<kB>(j, k, beta, faces, matched, diagonal_of, own);
-        } else if (!inner_formed) {
-          form_closure_row<kB>(j, k, beta, faces, matched, diagonal_of, inner_rows);
-          inner_formed = true;
+        } else {
+          const auto kind_of_row = D(3 * layer(k) + layer(j));
+          closure = &by_kind[kind_of_row];
+          if (!formed[kind_of_row]) {
+            form_closure_row<kB>(j, k, beta, faces, matched, diagonal_of, by_kind[kind_of_row]);
+            formed[kind_of_row] = true;
+          }
         }
         relax_row_whole<kB, true>(row, f, beside, x_ghosts, i_first, beta, inv_h2,
-                                  (inner ? inner_rows : own).diagonal(), omega);
+                                  closure->diagonal(), omega);
       }
 }
 
