@@ -274,19 +274,6 @@ AcrossFaces same_level_neighbours(const Forest& forest, const BlockField& x, int
   pull_row_x_ghosts(row, L, across, j, k, i_first == 0, ((L.cells - 1 - i_first) & 1) == 0);
 }
 
-/// One row of a block's half-sweep away from closed faces (implicit 0),
-/// kB cells: the new value of every cell of the row is formed from the old
-/// values into a buffer, a loop of unit strides and fixed length that
-/// vectorises whole, and the row is stored back with the cells of the
-/// half-sweep's colour (from i_first, every second one) replaced. A cell's
-/// new value reads only cells of the other colour, which the half-sweep does
-/// not write, so each stored value is the one the strided scalar loop of
-/// relax_constant forms: the same operations in the same order, the same
-/// bits. The other colour's values are formed and dropped (they may read a
-/// stale ghost at a row end): twice the arithmetic in a fraction of the
-/// instructions. The row goes back whole (the other colour rewritten with
-/// its own values) so that the next row's wide loads of this one forward
-/// from stores of their own width; single-cell stores stalled them.
 /// Where pull_row_x_ghosts_of_colour would read the row's two ghosts along
 /// x (null: the ghost layer holds them).
 [[gnu::always_inline]] inline std::array<const double*, 2> row_x_ghosts_of_colour(
@@ -357,6 +344,28 @@ template <typename Doubles, typename Lanes, int kLanes, bool kClosure>
   std::memcpy(row + at, &out, sizeof out);
 }
 
+/// One row of a block's half-sweep, kB cells: the new value of every cell
+/// of the row is formed from the old values, in vectors of 4 or 8 lanes
+/// with fixed trip counts, and the row is stored back with the cells of the
+/// half-sweep's colour (from i_first, every second one) replaced. A cell's
+/// new value reads only cells of the other colour, which the half-sweep does
+/// not write, so each stored value is the one the strided scalar loop of
+/// relax_constant forms: the same operations in the same order, the same
+/// bits. The other colour's values are formed and dropped (they may read a
+/// stale ghost at a row end): twice the arithmetic in a fraction of the
+/// instructions. The row goes back whole (the other colour rewritten with
+/// its own values) so that the next row's wide loads of this one forward
+/// from stores of their own width; single-cell stores stalled them. On
+/// several threads a block's first and last layers are read in place by the
+/// blocks beside it, which may be relaxed at the same time: their wide loads
+/// meet this row's whole store. The lanes they use are the other colour's,
+/// which the store rewrites with the values they already hold, and the
+/// lanes this store changes are the ones they drop: each value used is the
+/// same whichever access comes first (aligned 8-byte lanes, never torn), so
+/// the bits do not depend on the threads (KernelsReadingNeighboursInPlace-
+/// GiveTheSameBits runs on two). Formally a race on memory; kClosure:
+/// the row lies beside a closed face, its implicit parts and diagonals per
+/// cell (RowDiagonal); else implicit 0 and the interior diagonal.
 template <int kB, bool kClosure>
 [[gnu::always_inline]] inline void relax_row_whole(double* row, const double* f,
                                                    const std::array<const double*, 4>& beside,
