@@ -70,6 +70,11 @@ FlowCase load_flow_case(const ConfigTable& cfg, const std::filesystem::path& sou
 /// The viscosity at x: the last region holding x, else the fluid's.
 double viscosity_at(const FlowCase& c, const Vec3& x);
 
+/// A line suggesting 16^3 blocks where the grid does not adapt, its cell
+/// counts allow them and the blocks are smaller (they run a uniform grid
+/// 1.5-2x faster per cell); empty otherwise. describe() includes it.
+std::string block_size_hint(const FlowCase& c);
+
 /// The resolved parameters, one per line (for run.log).
 std::string describe(const FlowCase& c);
 

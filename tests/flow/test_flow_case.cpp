@@ -102,6 +102,23 @@ TEST(FlowCase, ValidCaseResolvesGridBoundariesAndFluid) {
   EXPECT_DOUBLE_EQ(c.options.dt_max, 0.005);
 }
 
+TEST(FlowCase, TheLogSuggestsSixteenCellBlocksWhereTheGridDoesNotAdapt) {
+  // The channel (8 x 16 x 8 cells) cannot take 16^3 blocks: no hint.
+  EXPECT_EQ(block_size_hint(parse(kChannel)), "");
+  // 16 x 16 x 16 cells of the default 8^3 blocks, no adaptivity: the hint, in the log's text.
+  std::string text = replaced(kChannel, "size_m = [0.5, 1.0, 0.5]", "size_m = [1.0, 1.0, 1.0]");
+  text = replaced(text, "cells = [8, 16, 8]", "cells = [16, 16, 16]");
+  const FlowCase uniform = parse(text);
+  const std::string hint = block_size_hint(uniform);
+  EXPECT_NE(hint.find("block_cells = 16"), std::string::npos) << hint;
+  EXPECT_NE(describe(uniform).find(hint), std::string::npos);
+  // Already 16^3 blocks, or an adaptive grid (8^3 keeps refined regions tight): none.
+  EXPECT_EQ(block_size_hint(parse(
+                replaced(text, "cells = [16, 16, 16]", "cells = [16, 16, 16]\nblock_cells = 16"))),
+            "");
+  EXPECT_EQ(block_size_hint(parse(text + "\n[flow.adapt]\nvelocity_threshold_m_s = 1e-3\n")), "");
+}
+
 TEST(FlowCase, ParabolicInflowVariesOnlyAcrossTheWalls) {
   // Inflow at x_min, walls at y, periodic in z (read after x): the profile is
   // 6 s (1 - s) U in y and uniform in z (a bug once made it parabolic in z too,
