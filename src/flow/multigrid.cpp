@@ -390,16 +390,27 @@ struct ClosureRow {
   [[nodiscard]] RowDiagonal diagonal() const { return {0.0, implicit.data(), den.data()}; }
 };
 
+/// With matched faces only the cells of the colour starting at i_first are
+/// formed (the others' lanes are dropped; they get the open diagonal).
 template <int kB, typename DiagonalOf>
 [[gnu::noinline]] void form_closure_row(int j, int k, double beta, const ClosedFaces& faces,
-                                        bool matched, DiagonalOf diagonal_of, ClosureRow<kB>& out) {
+                                        bool matched, int i_first, DiagonalOf diagonal_of,
+                                        ClosureRow<kB>& out) {
   const auto constant = [beta](int) { return beta; };
   const auto set = [&](int i, double value) {
     out.implicit[D(i)] = value;
     out.den[D(i)] = diagonal_of(value);
   };
   if (matched) {
-    for (int i = 0; i < kB; ++i) set(i, closure_implicit({i, j, k}, kB, faces, constant, constant));
+    const double open = diagonal_of(0.0);
+    for (int i = 0; i < kB; ++i) {
+      if ((i & 1) == i_first) {
+        set(i, closure_implicit({i, j, k}, kB, faces, constant, constant));
+      } else {
+        out.implicit[D(i)] = 0.0;
+        out.den[D(i)] = open;
+      }
+    }
     return;
   }
   // Without matched faces a cell's implicit part depends on i only at the
@@ -461,12 +472,13 @@ void relax_constant_rows(double* x, const double* rhs, const BlockLayout& L, int
         }
         const ClosureRow<kB>* closure = &own;
         if (matched) {
-          form_closure_row<kB>(j, k, beta, faces, matched, diagonal_of, own);
+          form_closure_row<kB>(j, k, beta, faces, matched, i_first, diagonal_of, own);
         } else {
           const auto kind_of_row = D(3 * layer(k) + layer(j));
           closure = &by_kind[kind_of_row];
           if (!formed[kind_of_row]) {
-            form_closure_row<kB>(j, k, beta, faces, matched, diagonal_of, by_kind[kind_of_row]);
+            form_closure_row<kB>(j, k, beta, faces, matched, i_first, diagonal_of,
+                                 by_kind[kind_of_row]);
             formed[kind_of_row] = true;
           }
         }
