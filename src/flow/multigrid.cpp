@@ -285,7 +285,13 @@ AcrossFaces same_level_neighbours(const Forest& forest, const BlockField& x, int
           high && cells[1] ? cells[1] + (L.index(0, j, k) + shift[1]) : nullptr};
 }
 
-// GCC/Clang vector types of 4 and 8 doubles, and their lane masks.
+// GCC/Clang vector types of 4 and 8 doubles, and their lane masks. The
+// helpers below pass them by value between inlined functions of this file
+// only; on a build without AVX (SANGUIS_NATIVE off) GCC notes that such a
+// return changes the ABI (-Wpsabi), which concerns no interface here.
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wpsabi"
+#endif
 typedef double Doubles4 __attribute__((vector_size(32)));
 typedef std::int64_t Lanes4 __attribute__((vector_size(32)));
 typedef double Doubles8 __attribute__((vector_size(64)));
