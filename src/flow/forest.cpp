@@ -565,7 +565,8 @@ void Forest::exchange_face_ghosts_but_local_same_level(BlockField& field,
 
 void Forest::fill_block_ghosts(std::span<BlockField* const> fields, int blk, int width,
                                bool faces_only, int finer_face, bool skip_local_same_level,
-                               CoarseGhosts coarse_ghosts, const double* remote) const {
+                               CoarseGhosts coarse_ghosts, const double* remote,
+                               bool stencil_only) const {
   const BlockLayout layout = fields[0]->layout();
   const int b = layout.cells;
   const std::size_t nf = fields.size();
@@ -577,6 +578,7 @@ void Forest::fill_block_ghosts(std::span<BlockField* const> fields, int blk, int
       for (int ox = -1; ox <= 1; ++ox) {
         const int nonzero = (ox != 0) + (oy != 0) + (oz != 0);
         if (nonzero == 0 || (faces_only && nonzero > 1)) continue;
+        if (stencil_only && nonzero == 3) continue;
         if (finer_face >= 0 && (nonzero != 1 || offset_face(ox, oy, oz) != finer_face)) continue;
         const Neighbour& nb =
             block.neighbours[static_cast<std::size_t>(neighbour_slot(ox, oy, oz))];
@@ -585,8 +587,11 @@ void Forest::fill_block_ghosts(std::span<BlockField* const> fields, int blk, int
         if (skip_local_same_level && nb.jump == LevelJump::Same && nb.link == Link::Local) {
           continue;
         }
-        const Range rx = ghost_range(ox, b, width), ry = ghost_range(oy, b, width),
-                    rz = ghost_range(oz, b, width);
+        // stencil_only: the edges one layer deep (what a stencil reading one
+        // transverse neighbour of a face ghost needs).
+        const int deep = stencil_only && nonzero == 2 ? 1 : width;
+        const Range rx = ghost_range(ox, b, deep), ry = ghost_range(oy, b, deep),
+                    rz = ghost_range(oz, b, deep);
         if (nb.jump != LevelJump::Same) {
           const std::array<Range, 3> r{rx, ry, rz};
           const std::array<int, 3> o{ox, oy, oz};
@@ -697,11 +702,13 @@ bool Forest::uniform_local() const {
   return ranks_ == 1 && min_level_ == max_level_;
 }
 
-void Forest::fill_same_level_ghosts(std::span<BlockField* const> fields, int blk, int width) const {
+void Forest::fill_same_level_ghosts(std::span<BlockField* const> fields, int blk, int width,
+                                    bool stencil_only) const {
   if (fields.empty()) return;
   const BlockLayout layout = fields[0]->layout();
   width = std::min({width, layout.cells, layout.ghost});
-  fill_block_ghosts(fields, blk, width, false, -1, false, CoarseGhosts::Interpolated, nullptr);
+  fill_block_ghosts(fields, blk, width, false, -1, false, CoarseGhosts::Interpolated, nullptr,
+                    stencil_only);
 }
 
 double Forest::sum(double local) const {

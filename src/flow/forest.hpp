@@ -173,8 +173,11 @@ class Forest {
   /// exchange(fields, width) for block blk alone (uniform_local() forests only). Reads
   /// only the neighbours' interior cells and writes only blk's ghosts, so blocks may be
   /// filled in any order and on any thread, as long as no interior of these fields
-  /// changes meanwhile.
-  void fill_same_level_ghosts(std::span<BlockField* const> fields, int blk, int width) const;
+  /// changes meanwhile. stencil_only: the face ghosts `width` deep, the edge ghosts one
+  /// layer deep, no corner ghosts (what the face prediction and the face average read);
+  /// the others keep their values.
+  void fill_same_level_ghosts(std::span<BlockField* const> fields, int blk, int width,
+                              bool stencil_only = false) const;
   void exchange(BlockField& field, int width, bool faces_only = false,
                 CoarseGhosts coarse_ghosts = CoarseGhosts::Interpolated) const {
     BlockField* one[] = {&field};
@@ -281,7 +284,7 @@ class Forest {
   /// interior cells; `remote`: the interiors of the ghost layer's blocks, packed).
   void fill_block_ghosts(std::span<BlockField* const> fields, int blk, int width, bool faces_only,
                          int finer_face, bool skip_local_same_level, CoarseGhosts coarse_ghosts,
-                         const double* remote) const;
+                         const double* remote, bool stencil_only = false) const;
   void build_blocks();
   void build_ghost_tables();
   void build_neighbours();

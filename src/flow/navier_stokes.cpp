@@ -646,7 +646,7 @@ void NavierStokes::for_each_block_with_velocity_ghosts(VectorField& u, int width
                           neumann ? &(*neumann)[2] : nullptr};
   const auto neumann_kinds = uniform_kinds(forest_, BcKind::Neumann);
   forest_.for_each_block([&](int blk) {
-    forest_.fill_same_level_ghosts(fields, blk, width);
+    forest_.fill_same_level_ghosts(fields, blk, width, /*stencil_only=*/true);
     for (int c = 0; c < 3; ++c) {
       fill_block_boundary_ghosts(forest_, u[D(c)], blk, velocity_bc_[D(c)].kind,
                                  &velocity_bc_[D(c)].value, width);
