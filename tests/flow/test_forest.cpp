@@ -140,6 +140,51 @@ TEST(FlowForest, OneBlocksGhostsFilledAloneMatchTheExchange) {
   EXPECT_FALSE(forest.uniform_local());
 }
 
+TEST(FlowForest, StencilGhostsAreTheFacesTwoDeepAndTheEdgesOneDeep) {
+  // fill_same_level_ghosts(..., stencil_only) for the face prediction and the
+  // face average: the face ghosts (both layers) and the first layer of the
+  // edge ghosts as the exchange fills them; the second edge layer and the
+  // corners untouched (still -1, as tagged_cells leaves every ghost).
+  ForestSpec spec;
+  spec.trees = {2, 1, 1};
+  spec.periodic = {true, false, true};
+  spec.level = 1;
+  spec.block_cells = 4;
+  const Forest forest(spec);
+  if (forest.ranks() > 1) GTEST_SKIP() << "needs one rank";
+  ASSERT_TRUE(forest.uniform_local());
+  BlockField exchanged = tagged_cells(forest);
+  BlockField stencil = exchanged;
+  forest.exchange(exchanged, kGhost);
+  BlockField* one[] = {&stencil};
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    forest.fill_same_level_ghosts(one, blk, kGhost, /*stencil_only=*/true);
+  }
+  const int b = spec.block_cells;
+  const auto beyond = [b](int n) { return n < 0 ? -n : (n >= b ? n - b + 1 : 0); };
+  std::size_t edges = 0, untouched = 0;
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    for (int k = -kGhost; k < b + kGhost; ++k)
+      for (int j = -kGhost; j < b + kGhost; ++j)
+        for (int i = -kGhost; i < b + kGhost; ++i) {
+          const int out[] = {beyond(i), beyond(j), beyond(k)};
+          const int across = (out[0] > 0) + (out[1] > 0) + (out[2] > 0);
+          const int deepest = std::max({out[0], out[1], out[2]});
+          // Beyond a domain wall (y here) nothing is exchanged: -1 in both.
+          const bool wanted = across <= 1 || (across == 2 && deepest == 1);
+          if (wanted) {
+            ASSERT_EQ(stencil(blk, i, j, k), exchanged(blk, i, j, k)) << blk << ' ' << i << j << k;
+            edges += across == 2 && exchanged(blk, i, j, k) != -1.0;
+          } else {
+            ASSERT_EQ(stencil(blk, i, j, k), -1.0) << blk << ' ' << i << j << k;
+            untouched += exchanged(blk, i, j, k) != -1.0;
+          }
+        }
+  }
+  EXPECT_GT(edges, 0u);      // some first-layer edge ghosts were copied
+  EXPECT_GT(untouched, 0u);  // and some that the exchange fills were left alone
+}
+
 // The fused smoother fills one block's face ghosts at a time: copy_face_ghosts
 // must put there what exchange(field, 1, faces only) does (periodic wrap and
 // boundary faces included), and a colour must copy that colour and no other.
