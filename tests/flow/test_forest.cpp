@@ -55,6 +55,17 @@ TEST(FlowForest, BrickOfAnyAspectRatioHasTheRightBlocksAndExtent) {
   }
 }
 
+/// Two trees along x, level 1, blocks of 4^3 cells, periodic in x and z with
+/// walls along y: the forest of the single-block ghost tests below.
+ForestSpec two_trees_walls_along_y() {
+  ForestSpec spec;
+  spec.trees = {2, 1, 1};
+  spec.periodic = {true, false, true};
+  spec.level = 1;
+  spec.block_cells = 4;
+  return spec;
+}
+
 TEST(FlowForest, GhostExchangeCopiesNeighbourCellsWithPeriodicWrap) {
   ForestSpec spec;
   spec.trees = {2, 1, 1};
@@ -101,11 +112,7 @@ TEST(FlowForest, GhostExchangeCopiesNeighbourCellsWithPeriodicWrap) {
 // order, every ghost exchange() writes (faces, edges, corners, both layers, periodic wrap)
 // with the same value, and nothing else; a refined forest is not uniform_local().
 TEST(FlowForest, OneBlocksGhostsFilledAloneMatchTheExchange) {
-  ForestSpec spec;
-  spec.trees = {2, 1, 1};
-  spec.periodic = {true, false, true};
-  spec.level = 1;
-  spec.block_cells = 4;
+  const ForestSpec spec = two_trees_walls_along_y();
   Forest forest(spec);
   if (forest.ranks() > 1) GTEST_SKIP() << "needs one rank";
   ASSERT_TRUE(forest.uniform_local());
@@ -145,11 +152,7 @@ TEST(FlowForest, StencilGhostsAreTheFacesTwoDeepAndTheEdgesOneDeep) {
   // face average: the face ghosts (both layers) and the first layer of the
   // edge ghosts as the exchange fills them; the second edge layer and the
   // corners untouched (still -1, as tagged_cells leaves every ghost).
-  ForestSpec spec;
-  spec.trees = {2, 1, 1};
-  spec.periodic = {true, false, true};
-  spec.level = 1;
-  spec.block_cells = 4;
+  const ForestSpec spec = two_trees_walls_along_y();
   const Forest forest(spec);
   if (forest.ranks() > 1) GTEST_SKIP() << "needs one rank";
   ASSERT_TRUE(forest.uniform_local());
@@ -189,11 +192,7 @@ TEST(FlowForest, StencilGhostsAreTheFacesTwoDeepAndTheEdgesOneDeep) {
 // must put there what exchange(field, 1, faces only) does (periodic wrap and
 // boundary faces included), and a colour must copy that colour and no other.
 TEST(FlowForest, OneBlocksFaceGhostsMatchTheExchangeColourByColour) {
-  ForestSpec spec;
-  spec.trees = {2, 1, 1};
-  spec.periodic = {true, false, true};
-  spec.level = 1;
-  spec.block_cells = 4;
+  const ForestSpec spec = two_trees_walls_along_y();
   const Forest forest(spec);
   ASSERT_TRUE(forest.faces_local_same_level() || forest.ranks() > 1);
   if (!forest.faces_local_same_level()) GTEST_SKIP() << "needs one rank";
