@@ -564,9 +564,8 @@ void Forest::exchange_face_ghosts_but_local_same_level(BlockField& field,
 }
 
 void Forest::fill_block_ghosts(std::span<BlockField* const> fields, int blk, int width,
-                               bool faces_only, int finer_face, bool skip_local_same_level,
-                               CoarseGhosts coarse_ghosts, const double* remote,
-                               bool stencil_only) const {
+                               GhostExtent extent, int finer_face, bool skip_local_same_level,
+                               CoarseGhosts coarse_ghosts, const double* remote) const {
   const BlockLayout layout = fields[0]->layout();
   const int b = layout.cells;
   const std::size_t nf = fields.size();
@@ -577,8 +576,8 @@ void Forest::fill_block_ghosts(std::span<BlockField* const> fields, int blk, int
     for (int oy = -1; oy <= 1; ++oy) {
       for (int ox = -1; ox <= 1; ++ox) {
         const int nonzero = (ox != 0) + (oy != 0) + (oz != 0);
-        if (nonzero == 0 || (faces_only && nonzero > 1)) continue;
-        if (stencil_only && nonzero == 3) continue;
+        if (nonzero == 0 || (extent == GhostExtent::Faces && nonzero > 1)) continue;
+        if (extent == GhostExtent::Stencil && nonzero == 3) continue;
         if (finer_face >= 0 && (nonzero != 1 || offset_face(ox, oy, oz) != finer_face)) continue;
         const Neighbour& nb =
             block.neighbours[static_cast<std::size_t>(neighbour_slot(ox, oy, oz))];
@@ -587,9 +586,9 @@ void Forest::fill_block_ghosts(std::span<BlockField* const> fields, int blk, int
         if (skip_local_same_level && nb.jump == LevelJump::Same && nb.link == Link::Local) {
           continue;
         }
-        // stencil_only: the edges one layer deep (what a stencil reading one
+        // The stencil's edges one layer deep (what a stencil reading one
         // transverse neighbour of a face ghost needs).
-        const int deep = stencil_only && nonzero == 2 ? 1 : width;
+        const int deep = extent == GhostExtent::Stencil && nonzero == 2 ? 1 : width;
         const Range rx = ghost_range(ox, b, deep), ry = ghost_range(oy, b, deep),
                     rz = ghost_range(oz, b, deep);
         if (nb.jump != LevelJump::Same) {
@@ -685,8 +684,8 @@ void Forest::exchange_scoped(std::span<BlockField* const> fields, int width, boo
   }
 
   const auto fill = [&](int blk) {
-    fill_block_ghosts(fields, blk, width, faces_only, finer_face, skip_local_same_level,
-                      coarse_ghosts, remote.data());
+    fill_block_ghosts(fields, blk, width, faces_only ? GhostExtent::Faces : GhostExtent::All,
+                      finer_face, skip_local_same_level, coarse_ghosts, remote.data());
   };
   // Only the blocks with something to fill when the exchange is narrowed.
   if (finer_face >= 0) {
@@ -707,8 +706,8 @@ void Forest::fill_same_level_ghosts(std::span<BlockField* const> fields, int blk
   if (fields.empty()) return;
   const BlockLayout layout = fields[0]->layout();
   width = std::min({width, layout.cells, layout.ghost});
-  fill_block_ghosts(fields, blk, width, false, -1, false, CoarseGhosts::Interpolated, nullptr,
-                    stencil_only);
+  fill_block_ghosts(fields, blk, width, stencil_only ? GhostExtent::Stencil : GhostExtent::All, -1,
+                    false, CoarseGhosts::Interpolated, nullptr);
 }
 
 double Forest::sum(double local) const {

@@ -282,9 +282,12 @@ class Forest {
                        CoarseGhosts coarse_ghosts = CoarseGhosts::Interpolated) const;
   /// What exchange_scoped() writes into block blk (its ghost cells, from the neighbours'
   /// interior cells; `remote`: the interiors of the ghost layer's blocks, packed).
-  void fill_block_ghosts(std::span<BlockField* const> fields, int blk, int width, bool faces_only,
-                         int finer_face, bool skip_local_same_level, CoarseGhosts coarse_ghosts,
-                         const double* remote, bool stencil_only = false) const;
+  /// Which of a block's ghosts a fill writes: all (faces, edges and corners, `width`
+  /// deep), the faces only, or the stencil's (faces `width` deep, edges one deep).
+  enum class GhostExtent { All, Faces, Stencil };
+  void fill_block_ghosts(std::span<BlockField* const> fields, int blk, int width,
+                         GhostExtent extent, int finer_face, bool skip_local_same_level,
+                         CoarseGhosts coarse_ghosts, const double* remote) const;
   void build_blocks();
   void build_ghost_tables();
   void build_neighbours();

@@ -257,32 +257,55 @@ AcrossFaces same_level_neighbours(const Forest& forest, const BlockField& x, int
 /// in place (one value each, in a cache line the row reads anyway). In a
 /// half-sweep only where this colour has the end cell beside the ghost: the
 /// other colour's end cells are being written by the neighbour's thread.
+/// Where those two ghosts are read (null: not asked for, or the ghost layer
+/// holds them).
+[[gnu::always_inline]] inline std::array<const double*, 2> row_x_ghosts(const BlockLayout& L,
+                                                                        const AcrossFaces& across,
+                                                                        int j, int k, bool low,
+                                                                        bool high) {
+  const int b = L.cells;
+  const auto& [cells, shift] = across;
+  return {low && cells[0] ? cells[0] + (L.index(b - 1, j, k) + shift[0]) : nullptr,
+          high && cells[1] ? cells[1] + (L.index(0, j, k) + shift[1]) : nullptr};
+}
+
 [[gnu::always_inline]] inline void pull_row_x_ghosts(double* row, const BlockLayout& L,
                                                      const AcrossFaces& across, int j, int k,
                                                      bool low, bool high) {
-  const int b = L.cells;
-  const auto& [cells, shift] = across;
-  if (low && cells[0]) row[-1] = cells[0][L.index(b - 1, j, k) + shift[0]];
-  if (high && cells[1]) row[b] = cells[1][L.index(0, j, k) + shift[1]];
+  const auto [from_low, from_high] = row_x_ghosts(L, across, j, k, low, high);
+  if (from_low) row[-1] = *from_low;
+  if (from_high) row[L.cells] = *from_high;
 }
 
-/// pull_row_x_ghosts in a half-sweep whose colour starts the row at i_first:
-/// the ghost beside each end cell of that colour.
+/// The ends of the row that a half-sweep whose colour starts the row at
+/// i_first relaxes: the ghost beside each end cell of that colour.
+[[gnu::always_inline]] inline std::array<bool, 2> colour_ends(const BlockLayout& L, int i_first) {
+  return {i_first == 0, ((L.cells - 1 - i_first) & 1) == 0};
+}
+
+/// pull_row_x_ghosts in a half-sweep whose colour starts the row at i_first.
 [[gnu::always_inline]] inline void pull_row_x_ghosts_of_colour(double* row, const BlockLayout& L,
                                                                const AcrossFaces& across, int j,
                                                                int k, int i_first) {
-  pull_row_x_ghosts(row, L, across, j, k, i_first == 0, ((L.cells - 1 - i_first) & 1) == 0);
+  const auto [low, high] = colour_ends(L, i_first);
+  pull_row_x_ghosts(row, L, across, j, k, low, high);
 }
 
 /// Where pull_row_x_ghosts_of_colour would read the row's two ghosts along
 /// x (null: the ghost layer holds them).
 [[gnu::always_inline]] inline std::array<const double*, 2> row_x_ghosts_of_colour(
     const BlockLayout& L, const AcrossFaces& across, int j, int k, int i_first) {
-  const int b = L.cells;
-  const auto& [cells, shift] = across;
-  const bool low = i_first == 0, high = ((b - 1 - i_first) & 1) == 0;
-  return {low && cells[0] ? cells[0] + (L.index(b - 1, j, k) + shift[0]) : nullptr,
-          high && cells[1] ? cells[1] + (L.index(0, j, k) + shift[1]) : nullptr};
+  const auto [low, high] = colour_ends(L, i_first);
+  return row_x_ghosts(L, across, j, k, low, high);
+}
+
+/// Whether row (j, k) of a block of b cells lies beside one of its `closed`
+/// faces (by face_index): every row when a face along x is closed.
+[[gnu::always_inline]] inline bool row_beside_closed_face(const std::array<bool, 6>& closed, int b,
+                                                          int j, int k) {
+  return closed[D(face_index(0, 0))] || closed[D(face_index(0, 1))] ||
+         (j == 0 && closed[D(face_index(1, 0))]) || (j == b - 1 && closed[D(face_index(1, 1))]) ||
+         (k == 0 && closed[D(face_index(2, 0))]) || (k == b - 1 && closed[D(face_index(2, 1))]);
 }
 
 // GCC/Clang vector types of 4 and 8 doubles, and their lane masks. The
@@ -440,7 +463,6 @@ void relax_constant_rows(double* x, const double* rhs, const BlockLayout& L, int
                          double inv_h2, double omega, const ClosedFaces& faces,
                          const std::array<bool, 6>& closed, DiagonalOf diagonal_of,
                          const AcrossFaces& across) {
-  const bool x_faces = closed[D(face_index(0, 0))] || closed[D(face_index(0, 1))];
   RowDiagonal open;
   open.interior = diagonal_of(0.0);
   const bool matched =
@@ -467,12 +489,7 @@ void relax_constant_rows(double* x, const double* rhs, const BlockLayout& L, int
         const int i_first = (k + j + first) & 1;
         const auto beside = neighbour_rows(row, L, across, j, k);
         const auto x_ghosts = row_x_ghosts_of_colour(L, across, j, k, i_first);
-        const bool closure_row =
-            kAnyClosed && (x_faces || (j == 0 && closed[D(face_index(1, 0))]) ||
-                           (j == kB - 1 && closed[D(face_index(1, 1))]) ||
-                           (k == 0 && closed[D(face_index(2, 0))]) ||
-                           (k == kB - 1 && closed[D(face_index(2, 1))]));
-        if (!closure_row) {
+        if (!kAnyClosed || !row_beside_closed_face(closed, kB, j, k)) {
           relax_row_whole<kB, false>(row, f, beside, x_ghosts, i_first, beta, inv_h2, open, omega);
           continue;
         }
@@ -536,15 +553,11 @@ inline void relax_constant(double* x, const double* rhs, const BlockLayout& L, i
   }
   // Other block sizes (the in-block level of 2 cells): cell by cell.
   const double interior = diagonal(0.0);
-  const bool x_faces = closed[D(face_index(0, 0))] || closed[D(face_index(0, 1))];
   for (int k = 0; k < b; ++k)
     for (int j = 0; j < b; ++j) {
       double* row = x + L.index(0, j, k);
       const double* f = rhs + L.index(0, j, k);
-      const bool closure_row = x_faces || (j == 0 && closed[D(face_index(1, 0))]) ||
-                               (j == b - 1 && closed[D(face_index(1, 1))]) ||
-                               (k == 0 && closed[D(face_index(2, 0))]) ||
-                               (k == b - 1 && closed[D(face_index(2, 1))]);
+      const bool closure_row = row_beside_closed_face(closed, b, j, k);
       // The neighbouring rows (a neighbour's cells of the other colour: no
       // block writes them in this half-sweep).
       const auto [y_lo, y_hi, z_lo, z_hi] = neighbour_rows(row, L, across, j, k);
