@@ -6,12 +6,21 @@
 // two crust surfaces (Fig. A.5). If the cores themselves intersect (overlap
 // larger than the crusts), EPA gives the penetration depth and normal.
 // Planes use the support function directly (exact, no iteration).
+//
+// Flat-faced cores (boxes, polyhedra, obstacle facets) also get a contact patch
+// (geometry/contact_patch.hpp): the part of the facing faces within the crusts'
+// reach, a polygon whose corners carry their own overlaps. The normal force is then
+// a bed of spring-dashpots at the corners (element_contact_response), which gives a
+// face resting on a face its resultant at the centre of pressure and a restoring,
+// damped torque when it tilts, and reduces to the single point of §2.3 at a vertex or
+// an edge.
 #include <array>
 #include <limits>
 
 #include "dem/contact_law.hpp"
 #include "dem/obstacles.hpp"
 #include "dem/particle_shape.hpp"
+#include "geometry/contact_patch.hpp"
 #include "geometry/gjk.hpp"
 
 namespace sanguis::dem {
@@ -168,6 +177,152 @@ inline ElementContact element_obstacle_contact(const Obstacle& obstacle, std::si
   const ObstacleElement& e = std::get<ShapeObstacle>(obstacle.shape).elements[element];
   const geometry::Pose element_pose{m.point_at(t, e.position), m.rotation_at(t) * e.orientation};
   return element_pair_contact(core, pose, crust, e.shape, element_pose, 0.0, warm);
+}
+
+// The contact patch of two touching elements (ec from element_pair_contact): false,
+// leaving the single point, for curved cores, deep contacts and degenerate faces.
+inline bool element_pair_patch(const geometry::ConvexShape& core_a, const geometry::Pose& pose_a,
+                               double crust_a, const geometry::ConvexShape& core_b,
+                               const geometry::Pose& pose_b, double crust_b,
+                               const ElementContact& ec, geometry::ContactPatch& patch) {
+  if (!ec.touching || ec.deep) return false;
+  geometry::SpaceFace face_a, face_b;
+  return geometry::facing_face(core_a, pose_a, ec.normal, face_a) &&
+         geometry::facing_face(core_b, pose_b, -ec.normal, face_b) &&
+         geometry::face_pair_patch(face_a, face_b, ec.normal, crust_a, crust_b, patch);
+}
+
+// The contact patch of an element and obstacle element `element` at time t (ec from
+// element_obstacle_contact with the same arguments).
+inline bool element_obstacle_patch(const Obstacle& obstacle, std::size_t element, double t,
+                                   const geometry::ConvexShape& core, const geometry::Pose& pose,
+                                   double crust, const ElementContact& ec,
+                                   geometry::ContactPatch& patch) {
+  if (!ec.touching || ec.deep) return false;
+  geometry::SpaceFace face;
+  if (!geometry::facing_face(core, pose, ec.normal, face)) return false;
+  const ObstacleMotion& m = obstacle.motion;
+  if (const auto* plane = std::get_if<PlaneShape>(&obstacle.shape)) {
+    return geometry::face_plane_patch(face, m.point_at(t, plane->point),
+                                      m.direction_to_space(t, plane->normal), crust, patch);
+  }
+  geometry::SpaceFace other;
+  if (const auto* box = std::get_if<AxisAlignedBoxShape>(&obstacle.shape)) {
+    const geometry::ConvexShape box_core = geometry::Box{0.5 * (box->max - box->min)};
+    const geometry::Pose box_pose{m.point_at(t, 0.5 * (box->min + box->max)), m.rotation_at(t)};
+    if (!geometry::facing_face(box_core, box_pose, -ec.normal, other)) return false;
+  } else {
+    const ObstacleElement& e = std::get<ShapeObstacle>(obstacle.shape).elements[element];
+    const geometry::Pose element_pose{m.point_at(t, e.position), m.rotation_at(t) * e.orientation};
+    if (!geometry::facing_face(e.shape, element_pose, -ec.normal, other)) return false;
+  }
+  return geometry::face_pair_patch(face, other, ec.normal, crust, 0.0, patch);
+}
+
+// What one element contact does to its first body.
+struct ElementResponse {
+  ContactResponse response;  // force and rolling torque on the first body
+  Vec3 point;                // where the force acts: the contact point or the patch's
+                             // centre of pressure
+  double overlap = 0.0;      // the point's, or the patch's weighted mean
+  Vec3 arm_first, arm_second;  // from the bodies' centres to `point`
+  Vec3 twist_torque;           // the patch's torsional resistance, on the first body [N m]
+};
+
+// The response of one element contact: at its single point, or (patch with two corners
+// or more) as a bed of normal spring-dashpots at the patch corners plus the tangential
+// spring and rolling resistance of §2.3 at their centre of pressure, with the contact's
+// one memory.
+//
+// Corner k weighs w_k = d_k s_k / sum(d s), d its overlap and s its perimeter share:
+// each corner pushes with w_k (kn d_k + eta_n vn_k), clipped at 0 (eq. 2.5 per
+// corner), vn_k the normal speed at the corner. Weighting by the overlap makes the
+// law the point law of §2.3 wherever the patch is a sliver at a vertex, an edge or
+// two crossing edges (the corners at the far side have zero overlap), and kn d for a
+// flat face pressed evenly; corners enter with zero overlap and split or merge with
+// their perimeter shares, so the force has no jumps as faces tilt and slide. The
+// normal damping acts at the corners, so a rocking face is damped, which a single
+// point at its centre does not do.
+//
+// A patch also resists twisting about the normal, which the tangential spring at its
+// centre does not see: a torsional spring-dashpot with memory `twist` (the relative
+// rotation about the normal), as if each corner had the tangential spring and dashpot
+// of §2.3 with the corner's weight, M = -(kt theta + eta_t dtheta/dt) sum(w r^2), r the
+// corner's distance from the centre, bounded by mu_c |Fn| sum(w r) (a disc of radius R
+// pressed evenly slips at 2/3 mu_c |Fn| R) and kept continuous through slipping as
+// eq. 2.8 does. A single point has no twist: `twist` is zeroed.
+//
+// `other_velocity(x)` is the second body's velocity at the space point x;
+// `other_centre` its centre, or null for an obstacle (no lever arm: the arm is zero).
+template <typename OtherVelocity>
+ElementResponse element_contact_response(const ContactParameters& params, const ElementContact& ec,
+                                         const geometry::ContactPatch* patch, const Vec3& xi,
+                                         const Vec3& vi, const Vec3& wi,
+                                         OtherVelocity&& other_velocity, const Vec3& other_omega,
+                                         const Vec3* other_centre, ContactHistory& h,
+                                         double& twist, double dt) {
+  ElementResponse out;
+  const auto kinematics_at = [&](const Vec3& point, double overlap) {
+    out.point = point;
+    out.overlap = overlap;
+    out.arm_first = point - xi;
+    out.arm_second = other_centre != nullptr ? point - *other_centre : Vec3{};
+    ContactKinematics c;
+    c.normal = ec.normal;
+    c.overlap = overlap;
+    c.relative_velocity = vi + cross(wi, out.arm_first) - other_velocity(point);
+    c.relative_angular_velocity = wi - other_omega;
+    const double li = norm(out.arm_first), lj = norm(out.arm_second);
+    c.reduced_radius = lj > 0.0 ? li * lj / (li + lj) : li;
+    return c;
+  };
+  double weights = 0.0;
+  if (patch != nullptr && patch->count >= 2) {
+    for (int k = 0; k < patch->count; ++k) weights += patch->overlap[k] * patch->perimeter_share[k];
+  }
+  if (!(weights > 0.0)) {
+    out.response = evaluate_contact(params, kinematics_at(ec.point, ec.overlap), h, dt);
+    twist = 0.0;
+    return out;
+  }
+  double fn = 0.0, overlap = 0.0;
+  Vec3 pressed, centre;
+  for (int k = 0; k < patch->count; ++k) {
+    const Vec3& x = patch->point[k];
+    const double w = patch->overlap[k] * patch->perimeter_share[k] / weights;
+    const double vn = dot(vi + cross(wi, x - xi) - other_velocity(x), ec.normal);
+    const double f = w * normal_force_magnitude(params, patch->overlap[k], vn);
+    fn += f;
+    pressed += f * x;
+    centre += w * x;
+    overlap += w * patch->overlap[k];
+  }
+  if (fn > 0.0) centre = pressed / fn;
+  const ContactKinematics c = kinematics_at(centre, overlap);
+  out.response = contact_response_for_normal_force(params, c, h, dt, fn);
+
+  double second_moment = 0.0, mean_arm = 0.0;
+  for (int k = 0; k < patch->count; ++k) {
+    const double w = patch->overlap[k] * patch->perimeter_share[k] / weights;
+    const Vec3 r = patch->point[k] - centre;
+    const double r2 = norm2(r - dot(r, ec.normal) * ec.normal);
+    second_moment += w * r2;
+    mean_arm += w * std::sqrt(r2);
+  }
+  const double spin = dot(c.relative_angular_velocity, ec.normal);
+  twist += dt * spin;
+  double moment =
+      -(params.tangential_stiffness * twist + params.tangential_damping * spin) * second_moment;
+  const double moment_max = params.friction * fn * mean_arm;
+  if (std::abs(moment) > moment_max) {
+    moment = std::copysign(moment_max, moment);
+    twist = params.tangential_stiffness > 0.0 && second_moment > 0.0
+                ? -(moment / second_moment + params.tangential_damping * spin) /
+                      params.tangential_stiffness
+                : 0.0;
+  }
+  out.twist_torque = moment * ec.normal;
+  return out;
 }
 
 }  // namespace sanguis::dem

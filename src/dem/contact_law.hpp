@@ -62,17 +62,23 @@ struct ContactOutcome {
   return c * v + cross(k, v) + (dot(k, v) / (1.0 + c)) * k;
 }
 
-// Forced inline: it runs once per contact per step inside the force loops.
-[[gnu::always_inline]] inline ContactResponse evaluate_contact(const ContactParameters& p,
-                                                               const ContactKinematics& c,
-                                                               ContactHistory& h, double dt) {
+// eq. 2.5: the normal force |Fn| of one contact point, viscoelastic, never attractive.
+[[gnu::always_inline]] inline double normal_force_magnitude(const ContactParameters& p,
+                                                            double overlap, double normal_speed) {
+  const double fn_trial = p.normal_stiffness * overlap + p.normal_damping * normal_speed;
+  return fn_trial > 0.0 ? fn_trial : 0.0;  // (std::fmax is a libm call here)
+}
+
+// The contact's force and rolling torque given its normal force magnitude `fn`: the
+// tangential spring-dashpot and the rolling resistance, both with memory. `fn` is
+// eq. 2.5 at one point (evaluate_contact) or the resultant of a patch of points
+// (dem/body_contacts.hpp).
+[[gnu::always_inline]] inline ContactResponse contact_response_for_normal_force(
+    const ContactParameters& p, const ContactKinematics& c, ContactHistory& h, double dt,
+    double fn) {
   ContactResponse out;
   const Vec3& n = c.normal;
   const double normal_speed = dot(c.relative_velocity, n);  // d(dn)/dt
-
-  // eq. 2.5: viscoelastic, never attractive.
-  const double fn_trial = p.normal_stiffness * c.overlap + p.normal_damping * normal_speed;
-  const double fn = fn_trial > 0.0 ? fn_trial : 0.0;  // (std::fmax is a libm call here)
   out.normal_force = fn;
   out.force = -fn * n;
 
@@ -114,6 +120,15 @@ struct ContactOutcome {
   }
   h.normal = n;
   return out;
+}
+
+// One contact point, eq. 2.5-2.13. Forced inline: it runs once per contact per step
+// inside the force loops.
+[[gnu::always_inline]] inline ContactResponse evaluate_contact(const ContactParameters& p,
+                                                               const ContactKinematics& c,
+                                                               ContactHistory& h, double dt) {
+  const double fn = normal_force_magnitude(p, c.overlap, dot(c.relative_velocity, c.normal));
+  return contact_response_for_normal_force(p, c, h, dt, fn);
 }
 
 }  // namespace sanguis::dem

@@ -94,6 +94,10 @@ struct BodyContactList {
   std::vector<std::uint16_t> element_first, element_second;
   std::vector<ContactHistory> history;
   std::vector<geometry::GjkWarmStart> warm;  // last GJK simplex: the next call starts there
+  // Twist held by the contact patch's torsional spring (body_contacts.hpp): the relative
+  // rotation of the first body about the normal since the spring was last unloaded [rad].
+  // The same number seen from either body, so it is not turned round with the pair.
+  std::vector<double> twist;
 
   std::size_t size() const { return first.size(); }
   void clear() {
@@ -103,6 +107,7 @@ struct BodyContactList {
     element_second.clear();
     history.clear();
     warm.clear();
+    twist.clear();
   }
   void push(std::uint32_t a, std::uint32_t b, std::uint16_t ea, std::uint16_t eb) {
     first.push_back(a);
@@ -111,6 +116,7 @@ struct BodyContactList {
     element_second.push_back(eb);
     history.push_back({});
     warm.push_back({});
+    twist.push_back(0.0);
   }
   // Sort key (first, second, element_first, element_second), compared lexicographically.
   std::pair<std::uint64_t, std::uint32_t> key(std::size_t k) const {
@@ -128,6 +134,7 @@ inline void carry_history(const BodyContactList& previous, BodyContactList& fres
     if (p < np && previous.key(p) == key) {
       fresh.history[k] = previous.history[p];
       fresh.warm[k] = previous.warm[p];
+      fresh.twist[k] = previous.twist[p];
     }
   }
 }
@@ -154,6 +161,7 @@ struct ContactMemory {
   std::int64_t second_id = 0;  // particle id, or obstacle index for walls
   ContactHistory history;
   geometry::GjkWarmStart warm;  // body contacts only
+  double twist = 0.0;           // body contacts only (BodyContactList::twist)
 
   bool is_pair() const { return kind == kSpherePair || kind == kBodyPair; }
   // (kind, smaller id, larger id, element of the smaller, element of the larger) for
@@ -211,6 +219,7 @@ void renumber(List& list, std::span<const std::uint32_t> new_index, bool pair_li
     permute_in_place(list.element_first, order, visited);
     permute_in_place(list.element_second, order, visited);
     permute_in_place(list.warm, order, visited);
+    permute_in_place(list.twist, order, visited);
   }
 }
 

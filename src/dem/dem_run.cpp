@@ -302,20 +302,25 @@ std::vector<ContactRecord> touching_contacts(const DemSimulation& sim) {
     out.push_back(r);
   }
 
-  // Element contacts: the simulation's narrow phase again, from the stored warm starts.
-  const auto element_kinematics = [&](std::size_t i, const ElementContact& ec,
-                                      const Vec3& other_point_velocity, const Vec3& other_omega,
-                                      const Vec3& other_centre) {
-    const Vec3 arm_i = ec.point - x[i];
-    const Vec3 arm_j = ec.point - other_centre;
-    ContactKinematics c;
-    c.normal = ec.normal;
-    c.overlap = ec.overlap;
-    c.relative_velocity = v[i] + cross(w[i], arm_i) - other_point_velocity;
-    c.relative_angular_velocity = w[i] - other_omega;
-    const double li = norm(arm_i), lj = norm(arm_j);
-    c.reduced_radius = lj > 0.0 ? li * lj / (li + lj) : li;
-    return c;
+  // Element contacts: the simulation's narrow phase again, from the stored warm starts,
+  // and its patch or point response (body_contacts.hpp) at dt = 0.
+  const auto element_record = [&](const ContactParameters& law, std::size_t i,
+                                  const ElementContact& ec, const geometry::ContactPatch* patch,
+                                  const auto& other_velocity, const Vec3& other_omega,
+                                  const Vec3* other_centre, const ContactHistory& stored,
+                                  double stored_twist, ContactRecord& r) {
+    ContactHistory h = stored;
+    double twist = stored_twist;
+    const ElementResponse e = element_contact_response(law, ec, patch, x[i], v[i], w[i],
+                                                       other_velocity, other_omega, other_centre,
+                                                       h, twist, 0.0);
+    r.point = e.point;
+    r.first_centre = x[i];
+    r.second_centre = other_centre != nullptr ? *other_centre : e.point;
+    r.normal = ec.normal;
+    r.overlap = e.overlap;
+    r.force = e.response.force;
+    r.normal_force = e.response.normal_force;
   };
   const BodyContactList& body_pairs = sim.body_contacts();
   for (std::size_t k = 0; k < body_pairs.size(); ++k) {
@@ -330,16 +335,16 @@ std::vector<ContactRecord> touching_contacts(const DemSimulation& sim) {
     const ElementContact ec =
         element_pair_contact(*a.core, a.pose, a.crust, *b.core, b.pose, b.crust, &warm);
     if (!ec.touching) continue;
+    geometry::ContactPatch patch;
+    const bool flat =
+        element_pair_patch(*a.core, a.pose, a.crust, *b.core, b.pose, b.crust, ec, patch);
     ContactRecord r;
     r.kind = ContactKind::kBodyPair;
     r.first = i;
     r.second = j;
-    r.point = ec.point;
-    r.first_centre = x[i];
-    r.second_centre = xj;
-    const Vec3 vj = v[j] + cross(w[j], ec.point - xj);
-    respond(params(p.material[i], p.material[j]), element_kinematics(i, ec, vj, w[j], xj),
-            body_pairs.history[k], r);
+    const auto vj = [&](const Vec3& point) { return v[j] + cross(w[j], point - xj); };
+    element_record(params(p.material[i], p.material[j]), i, ec, flat ? &patch : nullptr, vj, w[j],
+                   &xj, body_pairs.history[k], body_pairs.twist[k], r);
     out.push_back(r);
   }
 
@@ -354,18 +359,20 @@ std::vector<ContactRecord> touching_contacts(const DemSimulation& sim) {
     const ElementContact ec = element_obstacle_contact(obstacle, body_walls.element_second[k], now,
                                                        *a.core, a.pose, a.crust, &warm);
     if (!ec.touching) continue;
+    geometry::ContactPatch patch;
+    const bool flat = element_obstacle_patch(obstacle, body_walls.element_second[k], now, *a.core,
+                                             a.pose, a.crust, ec, patch);
     ContactRecord r;
     r.kind = ContactKind::kBodyWall;
     r.first = i;
     r.second = body_walls.second[k];
-    r.point = ec.point;
-    r.first_centre = x[i];
-    r.second_centre = ec.point;
-    const Vec3 wall_velocity = m.is_static() ? Vec3{} : m.velocity_at(now, ec.point);
+    const auto wall_velocity = [&](const Vec3& point) {
+      return m.is_static() ? Vec3{} : m.velocity_at(now, point);
+    };
     const Vec3 wall_omega = m.rotation.moving() ? m.rotation.speed_at(now) * m.axis : Vec3{};
-    respond(params(p.material[i], obstacle.material),
-            element_kinematics(i, ec, wall_velocity, wall_omega, ec.point), body_walls.history[k],
-            r);
+    element_record(params(p.material[i], obstacle.material), i, ec, flat ? &patch : nullptr,
+                   wall_velocity, wall_omega, nullptr, body_walls.history[k], body_walls.twist[k],
+                   r);
     out.push_back(r);
   }
   // A pair is reported from its particle of smaller id: the storage order, which orients

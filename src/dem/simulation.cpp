@@ -291,23 +291,19 @@ void DemSimulation::compute_forces() {
     return p.spherical[i] ? rad[i]
                           : shapes[static_cast<std::size_t>(p.species[i])].equivalent_radius;
   };
-  const auto element_response = [&](std::size_t i, const Vec3& xi, const ElementContact& ec,
-                                    const Vec3& other_point_velocity, const Vec3& other_omega,
-                                    const Vec3& other_centre, const ContactParameters& params,
-                                    ContactHistory& h, ContactOutcome& out) {
-    const Vec3 arm_i = ec.point - xi;
-    const Vec3 arm_j = ec.point - other_centre;
-    ContactKinematics c;
-    c.normal = ec.normal;
-    c.overlap = ec.overlap;
-    c.relative_velocity = v[i] + cross(w[i], arm_i) - other_point_velocity;
-    c.relative_angular_velocity = w[i] - other_omega;
-    const double li = norm(arm_i), lj = norm(arm_j);
-    c.reduced_radius = lj > 0.0 ? li * lj / (li + lj) : li;
-    const ContactResponse r = evaluate_contact(params, c, h, dt);
-    out.force = r.force;
-    out.torque_first = cross(arm_i, r.force) + r.rolling_torque;
-    out.torque_second = -(cross(arm_j, r.force) + r.rolling_torque);
+  // The patch or point response of an element contact, on both bodies (body_contacts.hpp).
+  const auto element_response = [&](std::size_t i, const ElementContact& ec,
+                                    const geometry::ContactPatch* patch,
+                                    const auto& other_velocity, const Vec3& other_omega,
+                                    const Vec3* other_centre, const ContactParameters& params,
+                                    ContactHistory& h, double& twist, ContactOutcome& out) {
+    const ElementResponse r = element_contact_response(params, ec, patch, x[i], v[i], w[i],
+                                                       other_velocity, other_omega, other_centre,
+                                                       h, twist, dt);
+    const Vec3 couple = r.response.rolling_torque + r.twist_torque;
+    out.force = r.response.force;
+    out.torque_first = cross(r.arm_first, r.response.force) + couple;
+    out.torque_second = -(cross(r.arm_second, r.response.force) + couple);
     out.touching = true;
   };
   std::int64_t deep = 0;
@@ -323,6 +319,7 @@ void DemSimulation::compute_forces() {
     const double reach = a.reach + b.reach;
     if (norm2(b.position - a.position) > reach * reach) {  // bounding balls apart: no GJK
       if (h.normal.x != 0.0 || h.normal.y != 0.0 || h.normal.z != 0.0) h = ContactHistory{};
+      body_pairs_.twist[k] = 0.0;
       return out;
     }
     const ElementContact ec =
@@ -330,13 +327,17 @@ void DemSimulation::compute_forces() {
                              {b.position, b.orientation}, b.crust, &body_pairs_.warm[k]);
     if (!ec.touching) {
       if (h.normal.x != 0.0 || h.normal.y != 0.0 || h.normal.z != 0.0) h = ContactHistory{};
+      body_pairs_.twist[k] = 0.0;
       return out;
     }
-    const Vec3 vj = v[j] + cross(w[j], ec.point - xj);
+    geometry::ContactPatch patch;
+    const bool flat = element_pair_patch(*a.core, {a.position, a.orientation}, a.crust, *b.core,
+                                         {b.position, b.orientation}, b.crust, ec, patch);
+    const auto vj = [&](const Vec3& point) { return v[j] + cross(w[j], point - xj); };
     element_response(
-        i, x[i], ec, vj, w[j], xj,
+        i, ec, flat ? &patch : nullptr, vj, w[j], &xj,
         setup_.contacts.get(static_cast<std::size_t>(mat[i]), static_cast<std::size_t>(mat[j])), h,
-        out);
+        body_pairs_.twist[k], out);
     out.overlap_ratio = ec.overlap / std::min(size_of(i), size_of(j));
     out.deep = ec.deep;
     return out;
@@ -346,24 +347,31 @@ void DemSimulation::compute_forces() {
     const std::uint32_t i = body_walls_.first[k];
     const Obstacle& obstacle = setup_.obstacles[body_walls_.second[k]];
     ContactHistory& h = body_walls_.history[k];
+    const ElementView a = element_view(p, shapes, i, body_walls_.element_first[k], x[i]);
     ElementContact ec;
     if (obstacle.active(now)) {
-      const ElementView a = element_view(p, shapes, i, body_walls_.element_first[k], x[i]);
       ec = element_obstacle_contact(obstacle, body_walls_.element_second[k], now, *a.core,
                                     {a.position, a.orientation}, a.crust, &body_walls_.warm[k]);
     }
     if (!ec.touching) {
       if (h.normal.x != 0.0 || h.normal.y != 0.0 || h.normal.z != 0.0) h = ContactHistory{};
+      body_walls_.twist[k] = 0.0;
       return out;
     }
+    geometry::ContactPatch patch;
+    const bool flat =
+        element_obstacle_patch(obstacle, body_walls_.element_second[k], now, *a.core,
+                               {a.position, a.orientation}, a.crust, ec, patch);
     const ObstacleMotion& m = obstacle.motion;
-    const Vec3 wall_velocity = m.is_static() ? Vec3{} : m.velocity_at(now, ec.point);
+    const auto wall_velocity = [&](const Vec3& point) {
+      return m.is_static() ? Vec3{} : m.velocity_at(now, point);
+    };
     const Vec3 wall_omega = m.rotation.moving() ? m.rotation.speed_at(now) * m.axis : Vec3{};
-    // The obstacle has no centre: its lever arm is irrelevant (no torque on it); use the point.
-    element_response(i, x[i], ec, wall_velocity, wall_omega, ec.point,
+    // The obstacle takes no torque: no centre, no lever arm.
+    element_response(i, ec, flat ? &patch : nullptr, wall_velocity, wall_omega, nullptr,
                      setup_.contacts.get(static_cast<std::size_t>(mat[i]),
                                          static_cast<std::size_t>(obstacle.material)),
-                     h, out);
+                     h, body_walls_.twist[k], out);
     out.overlap_ratio = ec.overlap / size_of(i);
     out.deep = ec.deep;
     return out;
@@ -1100,6 +1108,7 @@ std::vector<ContactMemory> DemSimulation::export_contacts() const {
       m.history = list.history[k];
       if constexpr (std::is_same_v<std::decay_t<decltype(list)>, BodyContactList>) {
         m.warm = list.warm[k];
+        m.twist = list.twist[k];
       }
       out.push_back(m);
     }
@@ -1124,6 +1133,7 @@ void DemSimulation::import_contacts(std::span<const ContactMemory> contacts) {
       list.history[k] = m.history;
       if constexpr (std::is_same_v<std::decay_t<decltype(list)>, BodyContactList>) {
         list.warm[k] = m.warm;
+        list.twist[k] = m.twist;
       }
     }
   };
@@ -1168,8 +1178,11 @@ void DemSimulation::replace_particles(ParticleStore particles, std::vector<std::
 
 namespace {
 
-constexpr char kMagic[16] = "SANGUIS-DEM-CK2";
-// Before the storage sort: no sort keys (particles in the order of their creation).
+constexpr char kMagic[16] = "SANGUIS-DEM-CK3";
+// Before the contact patches: no twist memory on body contacts (read as zero twist).
+constexpr char kMagicWithoutTwist[16] = "SANGUIS-DEM-CK2";
+// Before the storage sort: no sort keys (particles in the order of their creation), no
+// twist.
 constexpr char kMagicWithoutSortKeys[16] = "SANGUIS-DEM-CK1";
 
 template <typename T>
@@ -1226,6 +1239,7 @@ void put_body_list(std::ostream& out, const BodyContactList& list) {
   put(out, list.warm);
 }
 
+// The twists are read at the end of the file (get_twists); zero until then.
 void get_body_list(std::istream& in, BodyContactList& list) {
   get(in, list.first);
   get(in, list.second);
@@ -1233,6 +1247,7 @@ void get_body_list(std::istream& in, BodyContactList& list) {
   get(in, list.element_second);
   get(in, list.history);
   get(in, list.warm);
+  list.twist.assign(list.first.size(), 0.0);
   const std::size_t n = list.first.size();
   if (list.second.size() != n || list.element_first.size() != n ||
       list.element_second.size() != n || list.history.size() != n || list.warm.size() != n) {
@@ -1296,6 +1311,9 @@ void DemSimulation::save_checkpoint(const std::filesystem::path& file) const {
     put(out, touching_pairs_);
     put(out, touching_walls_);
     put(out, setup_.particles.sort_key);
+    // Last, so that a file of an older format is this one cut short.
+    put(out, body_pairs_.twist);
+    put(out, body_walls_.twist);
   });
 }
 
@@ -1307,7 +1325,10 @@ void DemSimulation::load_checkpoint(const std::filesystem::path& file) {
     in.read(magic, sizeof(magic));
     const bool without_keys =
         in && std::memcmp(magic, kMagicWithoutSortKeys, sizeof(kMagicWithoutSortKeys)) == 0;
-    if (!in || (!without_keys && std::memcmp(magic, kMagic, sizeof(kMagic)) != 0)) {
+    const bool without_twist =
+        without_keys ||
+        (in && std::memcmp(magic, kMagicWithoutTwist, sizeof(kMagicWithoutTwist)) == 0);
+    if (!in || (!without_twist && std::memcmp(magic, kMagic, sizeof(kMagic)) != 0)) {
       throw std::runtime_error("not a sanguis DEM checkpoint");
     }
     double dt = 0.0;
@@ -1354,6 +1375,14 @@ void DemSimulation::load_checkpoint(const std::filesystem::path& file) {
     } else {
       get(in, p.sort_key);
       if (p.sort_key.size() != p.size()) throw std::runtime_error("checkpoint is inconsistent");
+    }
+    if (!without_twist) {
+      get(in, body_pairs_.twist);
+      get(in, body_walls_.twist);
+      if (body_pairs_.twist.size() != body_pairs_.size() ||
+          body_walls_.twist.size() != body_walls_.size()) {
+        throw std::runtime_error("checkpoint contact list is inconsistent");
+      }
     }
     choose_threads();
     build_incidence();

@@ -299,33 +299,81 @@ TEST(StorageSort, SpaceKeysRunLayerByLayerAlongTheAxisAndInZOrderWithin) {
                                         3 * layer + 15, 0}));
 }
 
+// The bytes of `sim`'s checkpoint cut to an older format: CK2 (before the contact
+// patches) lacks the body contacts' twists, CK1 (before the storage sort) the sort keys
+// as well; both were written in the same order, so the older files are prefixes.
+std::string older_checkpoint(const DemSimulation& sim, const char* magic, bool keep_sort_keys) {
+  const auto file = std::filesystem::temp_directory_path() / "sanguis_ck3.ck";
+  sim.save_checkpoint(file);
+  std::string bytes = file_bytes(file);
+  std::filesystem::remove(file);
+  const std::size_t twists = 8 + 8 * sim.body_contacts().size() + 8 +
+                             8 * sim.body_wall_contacts().size();
+  const std::size_t keys = keep_sort_keys ? 0 : 8 + 8 * sim.particles().size();
+  EXPECT_EQ(bytes.substr(0, 15), "SANGUIS-DEM-CK3");
+  bytes.resize(bytes.size() - twists - keys);
+  bytes.replace(0, 15, magic);
+  return bytes;
+}
+
+// A run continued from an older-format copy of `original`'s checkpoint.
+DemSimulation restarted_from(const DemSimulation& original, const char* magic,
+                             bool keep_sort_keys) {
+  const auto file = std::filesystem::temp_directory_path() / "sanguis_older.ck";
+  std::ofstream(file, std::ios::binary) << older_checkpoint(original, magic, keep_sort_keys);
+  DemSimulation restarted(crosses_and_spheres(1, 0, IntegratorKind::kLeapfrog));
+  restarted.load_checkpoint(file);
+  std::filesystem::remove(file);
+  return restarted;
+}
+
 TEST(StorageSort, CheckpointsWrittenBeforeSortKeysStillLoad) {
   // The format before the storage sort (CK1) had no sort keys, the particles in the
   // order of their creation (here not id order): it loads with keys that keep that order
   // the (key, id) order (their ranks), and continues as the unsorted run it came from.
-  const auto dir = std::filesystem::temp_directory_path();
+  // Both old formats lack the twists, so the CK1 run is compared with the run from the
+  // CK2 copy, which has the written keys (CheckpointsWrittenBeforeContactPatches...).
   DemSimulation original(crosses_and_spheres(1, 0, IntegratorKind::kLeapfrog));
   for (int k = 0; k < 1500; ++k) original.step();
-  original.save_checkpoint(dir / "sanguis_ck2.ck");
-  std::string bytes = file_bytes(dir / "sanguis_ck2.ck");
+  DemSimulation from_ck1 = restarted_from(original, "SANGUIS-DEM-CK1", false);
+  DemSimulation from_ck2 = restarted_from(original, "SANGUIS-DEM-CK2", true);
   const std::size_t n = original.particles().size();
-  bytes.resize(bytes.size() - 8 - 8 * n);  // drop the trailing sort keys (count + values)
-  bytes.replace(0, 15, "SANGUIS-DEM-CK1");
-  std::ofstream(dir / "sanguis_ck1.ck", std::ios::binary) << bytes;
-  DemSimulation restarted(crosses_and_spheres(1, 0, IntegratorKind::kLeapfrog));
-  restarted.load_checkpoint(dir / "sanguis_ck1.ck");
-  std::filesystem::remove(dir / "sanguis_ck1.ck");
-  std::filesystem::remove(dir / "sanguis_ck2.ck");
   std::vector<std::uint64_t> ranks(n);
   std::iota(ranks.begin(), ranks.end(), std::uint64_t{0});
-  EXPECT_EQ(restarted.particles().sort_key, ranks);
-  EXPECT_NE(id_order(restarted.particles().id),
+  EXPECT_EQ(from_ck1.particles().sort_key, ranks);
+  EXPECT_NE(id_order(from_ck1.particles().id),
             std::vector<std::uint32_t>(ranks.begin(), ranks.end()));
+  EXPECT_NE(from_ck2.particles().sort_key, ranks);
   for (int k = 0; k < 500; ++k) {
+    from_ck1.step();
+    from_ck2.step();
+  }
+  EXPECT_TRUE(same_bits(from_ck1.particles().position, from_ck2.particles().position));
+}
+
+TEST(StorageSort, CheckpointsWrittenBeforeContactPatchesLoadWithZeroTwist) {
+  // CK2 had no twist memory on body contacts: it loads with every twist at zero and
+  // everything else as written. Saved once a cross lies on the floor with a twist held,
+  // the continued run is then another run, close to the original.
+  DemSimulation original(crosses_and_spheres(1, 0, IntegratorKind::kLeapfrog));
+  const auto twisted = [](const BodyContactList& list) {
+    return std::any_of(list.twist.begin(), list.twist.end(), [](double t) { return t != 0.0; });
+  };
+  for (int k = 0; k < 40000 && !twisted(original.body_wall_contacts()); ++k) original.step();
+  ASSERT_TRUE(twisted(original.body_wall_contacts()));
+  DemSimulation restarted = restarted_from(original, "SANGUIS-DEM-CK2", true);
+  EXPECT_EQ(restarted.particles().sort_key, original.particles().sort_key);
+  EXPECT_TRUE(same_bits(original.particles().position, restarted.particles().position));
+  ASSERT_EQ(restarted.body_wall_contacts().size(), original.body_wall_contacts().size());
+  for (double t : restarted.body_contacts().twist) EXPECT_EQ(t, 0.0);
+  for (double t : restarted.body_wall_contacts().twist) EXPECT_EQ(t, 0.0);
+  for (int k = 0; k < 100; ++k) {
     original.step();
     restarted.step();
   }
-  EXPECT_TRUE(same_bits(original.particles().position, restarted.particles().position));
+  for (std::size_t i = 0; i < original.particles().size(); ++i) {
+    EXPECT_LT(norm(original.particles().position[i] - restarted.particles().position[i]), 1e-6);
+  }
 }
 
 TEST(StorageSort, PermuteMovesEveryFieldOfAParticleTogether) {

@@ -1,0 +1,233 @@
+#include "geometry/contact_patch.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <span>
+#include <type_traits>
+#include <utility>
+#include <variant>
+
+namespace sanguis::geometry {
+namespace {
+
+// A face steeper than this to the contact normal (cosine) is not measured along the
+// normal: its heights would blow up. The faces chosen by facing_face lean by at most
+// 55 degrees for a box (cosine 1/sqrt 3).
+constexpr double kSteepestCosine = 0.1;
+
+struct Point2 {
+  double x = 0.0, y = 0.0;
+};
+
+// A convex polygon in the patch plane, with room for the clipping to grow it.
+struct Polygon2 {
+  int count = 0;
+  std::array<Point2, ContactPatch::kCapacity> p;
+};
+
+double cross2(const Point2& o, const Point2& a, const Point2& b) {
+  return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
+}
+
+double signed_area2(const Polygon2& poly) {
+  double twice = 0.0;
+  for (int k = 0; k < poly.count; ++k) {
+    const Point2& a = poly.p[k];
+    const Point2& b = poly.p[(k + 1) % poly.count];
+    twice += a.x * b.y - b.x * a.y;
+  }
+  return twice;
+}
+
+// Keeps the part of `poly` where the affine function with values `value[k]` at its
+// corners is >= 0 (Sutherland-Hodgman against one half-plane).
+template <typename ValueAt>
+Polygon2 clip(const Polygon2& poly, ValueAt value_at) {
+  Polygon2 out;
+  for (int k = 0; k < poly.count; ++k) {
+    const Point2& a = poly.p[k];
+    const Point2& b = poly.p[(k + 1) % poly.count];
+    const double va = value_at(a), vb = value_at(b);
+    if (va >= 0.0) out.p[out.count++] = a;
+    if ((va >= 0.0) != (vb >= 0.0)) {
+      const double t = va / (va - vb);
+      out.p[out.count++] = {a.x + t * (b.x - a.x), a.y + t * (b.y - a.y)};
+    }
+    if (out.count + 2 > ContactPatch::kCapacity) break;  // cannot happen for convex input
+  }
+  return out;
+}
+
+// Projects a face onto the patch plane (origin o, axes t1, t2), counter-clockwise.
+bool project(const SpaceFace& f, const Vec3& o, const Vec3& t1, const Vec3& t2, Polygon2& out) {
+  out.count = f.count;
+  for (int k = 0; k < f.count; ++k) {
+    const Vec3 r = f.corner[k] - o;
+    out.p[k] = {dot(r, t1), dot(r, t2)};
+  }
+  const double area = signed_area2(out);
+  if (!(std::abs(area) > 0.0)) return false;
+  if (area < 0.0) {
+    for (int k = 0; k < f.count / 2; ++k) std::swap(out.p[k], out.p[f.count - 1 - k]);
+  }
+  return true;
+}
+
+// Height along n, above the patch plane, of the plane dot(normal, x) = offset at the
+// patch-plane point (p.x, p.y): affine in p.
+struct PlaneHeight {
+  double at_origin = 0.0, slope_x = 0.0, slope_y = 0.0;
+  PlaneHeight(const Vec3& normal, double offset, const Vec3& n, const Vec3& o, const Vec3& t1,
+              const Vec3& t2) {
+    const double along = dot(normal, n);
+    at_origin = (offset - dot(normal, o)) / along;
+    slope_x = -dot(normal, t1) / along;
+    slope_y = -dot(normal, t2) / along;
+  }
+  double operator()(const Point2& p) const { return at_origin + slope_x * p.x + slope_y * p.y; }
+};
+
+// The shared construction: face a against face b (or, with b null, against the plane
+// `b_normal`, `b_offset`).
+bool patch(const SpaceFace& a, const SpaceFace* b, const Vec3& b_normal, double b_offset,
+           const Vec3& n, double crust_a, double crust_b, ContactPatch& out) {
+  out.count = 0;
+  if (dot(a.normal, n) < kSteepestCosine || dot(b_normal, n) > -kSteepestCosine) return false;
+  Vec3 o;
+  for (int k = 0; k < a.count; ++k) o += a.corner[k];
+  o = o / static_cast<double>(a.count);
+  const Vec3 helper = std::abs(n.x) < 0.6 ? Vec3{1.0, 0.0, 0.0} : Vec3{0.0, 1.0, 0.0};
+  const Vec3 side = cross(n, helper);
+  const Vec3 t1 = side / norm(side);
+  const Vec3 t2 = cross(n, t1);
+
+  Polygon2 poly;
+  if (!project(a, o, t1, t2, poly)) return false;
+  if (b != nullptr) {
+    Polygon2 window;
+    if (!project(*b, o, t1, t2, window)) return false;
+    for (int e = 0; e < window.count && poly.count > 0; ++e) {
+      const Point2 from = window.p[e], to = window.p[(e + 1) % window.count];
+      poly = clip(poly, [&](const Point2& p) { return cross2(from, to, p); });
+    }
+  }
+  const PlaneHeight height_a(a.normal, a.offset, n, o, t1, t2);
+  const PlaneHeight height_b(b_normal, b_offset, n, o, t1, t2);
+  const double reach = crust_a + crust_b;
+  const auto overlap = [&](const Point2& p) { return reach - (height_b(p) - height_a(p)); };
+  poly = clip(poly, overlap);
+  if (poly.count == 0) return false;
+
+  bool any = false;
+  for (int k = 0; k < poly.count; ++k) {
+    const Point2& p = poly.p[k];
+    const Point2& prev = poly.p[(k + poly.count - 1) % poly.count];
+    const Point2& next = poly.p[(k + 1) % poly.count];
+    const double mid = 0.5 * (height_a(p) + crust_a + height_b(p) - crust_b);
+    out.point[k] = o + p.x * t1 + p.y * t2 + mid * n;
+    out.overlap[k] = std::max(overlap(p), 0.0);
+    out.perimeter_share[k] = 0.5 * (std::hypot(p.x - prev.x, p.y - prev.y) +
+                                    std::hypot(next.x - p.x, next.y - p.y));
+    any = any || out.overlap[k] > 0.0;
+  }
+  out.count = poly.count;
+  return any;
+}
+
+bool box_face(const Box& box, const Pose& pose, const Vec3& d_body, SpaceFace& out) {
+  const double c[3] = {d_body.x, d_body.y, d_body.z};
+  const double h[3] = {box.half_extents.x, box.half_extents.y, box.half_extents.z};
+  int i = 0;
+  for (int k = 1; k < 3; ++k) {
+    if (std::abs(c[k]) > std::abs(c[i])) i = k;
+  }
+  if (!(std::abs(c[i]) > 0.0)) return false;
+  const double s = c[i] > 0.0 ? 1.0 : -1.0;
+  const int j = (i + 1) % 3, l = (i + 2) % 3;
+  static constexpr double kSigns[4][2] = {{1.0, 1.0}, {-1.0, 1.0}, {-1.0, -1.0}, {1.0, -1.0}};
+  out.count = 4;
+  for (int k = 0; k < 4; ++k) {
+    double v[3];
+    v[i] = s * h[i];
+    v[j] = kSigns[k][0] * h[j];
+    v[l] = kSigns[k][1] * h[l];
+    out.corner[k] = pose.position + rotate(pose.orientation, Vec3{v[0], v[1], v[2]});
+  }
+  double e[3] = {0.0, 0.0, 0.0};
+  e[i] = s;
+  out.normal = rotate(pose.orientation, Vec3{e[0], e[1], e[2]});
+  out.offset = dot(out.normal, out.corner[0]);
+  return true;
+}
+
+bool polyhedron_face(const ConvexPolyhedron& poly, const Pose& pose, const Vec3& d_body,
+                     SpaceFace& out) {
+  const std::uint32_t top = poly.support_index(d_body);
+  const double length = norm(d_body);
+  std::size_t best = poly.face_count();
+  double best_lean = kSteepestCosine * length;
+  for (std::size_t f = 0; f < poly.face_count(); ++f) {
+    const double lean = dot(poly.face_planes()[f].normal, d_body);
+    if (lean <= best_lean) continue;
+    const std::span<const std::uint32_t> loop = poly.face(f);
+    if (std::find(loop.begin(), loop.end(), top) == loop.end()) continue;
+    best = f;
+    best_lean = lean;
+  }
+  if (best == poly.face_count()) return false;
+  const std::span<const std::uint32_t> loop = poly.face(best);
+  if (loop.size() > static_cast<std::size_t>(SpaceFace::kCapacity)) return false;
+  out.count = static_cast<int>(loop.size());
+  for (int k = 0; k < out.count; ++k) {
+    out.corner[k] = pose.position + rotate(pose.orientation, poly.vertices()[loop[k]]);
+  }
+  out.normal = rotate(pose.orientation, poly.face_planes()[best].normal);
+  out.offset = dot(out.normal, out.corner[0]);
+  return true;
+}
+
+bool triangle_face(const Triangle& t, const Pose& pose, const Vec3& d_body, SpaceFace& out) {
+  const Vec3 normal = cross(t.b - t.a, t.c - t.a);
+  const double length = norm(normal);
+  if (!(length > 0.0)) return false;
+  const bool flip = dot(normal, d_body) < 0.0;
+  out.count = 3;
+  const Vec3 corners[3] = {t.a, flip ? t.c : t.b, flip ? t.b : t.c};
+  for (int k = 0; k < 3; ++k) out.corner[k] = pose.position + rotate(pose.orientation, corners[k]);
+  out.normal = rotate(pose.orientation, (flip ? -1.0 / length : 1.0 / length) * normal);
+  out.offset = dot(out.normal, out.corner[0]);
+  return true;
+}
+
+}  // namespace
+
+bool facing_face(const ConvexShape& shape, const Pose& pose, const Vec3& d, SpaceFace& out) {
+  const Vec3 d_body = rotate_inverse(pose.orientation, d);
+  return std::visit(
+      [&](const auto& s) {
+        using S = std::decay_t<decltype(s)>;
+        if constexpr (std::is_same_v<S, Box>) {
+          return box_face(s, pose, d_body, out);
+        } else if constexpr (std::is_same_v<S, ConvexPolyhedron>) {
+          return polyhedron_face(s, pose, d_body, out);
+        } else if constexpr (std::is_same_v<S, Triangle>) {
+          return triangle_face(s, pose, d_body, out);
+        } else {
+          return false;
+        }
+      },
+      shape);
+}
+
+bool face_pair_patch(const SpaceFace& a, const SpaceFace& b, const Vec3& n, double crust_a,
+                     double crust_b, ContactPatch& out) {
+  return patch(a, &b, b.normal, b.offset, n, crust_a, crust_b, out);
+}
+
+bool face_plane_patch(const SpaceFace& a, const Vec3& plane_point, const Vec3& plane_normal,
+                      double crust, ContactPatch& out) {
+  return patch(a, nullptr, plane_normal, dot(plane_normal, plane_point), -plane_normal, crust, 0.0,
+               out);
+}
+
+}  // namespace sanguis::geometry
