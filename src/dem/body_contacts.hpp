@@ -14,6 +14,7 @@
 // face resting on a face its resultant at the centre of pressure and a restoring,
 // damped torque when it tilts, and reduces to the single point of §2.3 at a vertex or
 // an edge.
+#include <algorithm>
 #include <array>
 #include <limits>
 
@@ -179,6 +180,20 @@ inline ElementContact element_obstacle_contact(const Obstacle& obstacle, std::si
   return element_pair_contact(core, pose, crust, e.shape, element_pose, 0.0, warm);
 }
 
+namespace detail {
+
+// The patch's deepest corner should be the closest points' overlap: no part of two
+// separated convex cores is nearer than their distance, and the closest points lie on
+// the facing faces. They may not on a polyhedron whose best-facing face at the support
+// vertex misses the support edge; the single point is kept then.
+inline bool patch_holds_the_contact(const geometry::ContactPatch& patch, const ElementContact& ec) {
+  double deepest = 0.0;
+  for (int k = 0; k < patch.count; ++k) deepest = std::max(deepest, patch.overlap[k]);
+  return deepest >= 0.99 * ec.overlap;
+}
+
+}  // namespace detail
+
 // The contact patch of two touching elements (ec from element_pair_contact): false,
 // leaving the single point, for curved cores, deep contacts and degenerate faces.
 inline bool element_pair_patch(const geometry::ConvexShape& core_a, const geometry::Pose& pose_a,
@@ -189,7 +204,8 @@ inline bool element_pair_patch(const geometry::ConvexShape& core_a, const geomet
   geometry::SpaceFace face_a, face_b;
   return geometry::facing_face(core_a, pose_a, ec.normal, face_a) &&
          geometry::facing_face(core_b, pose_b, -ec.normal, face_b) &&
-         geometry::face_pair_patch(face_a, face_b, ec.normal, crust_a, crust_b, patch);
+         geometry::face_pair_patch(face_a, face_b, ec.normal, crust_a, crust_b, patch) &&
+         detail::patch_holds_the_contact(patch, ec);
 }
 
 // The contact patch of an element and obstacle element `element` at time t (ec from
@@ -216,7 +232,8 @@ inline bool element_obstacle_patch(const Obstacle& obstacle, std::size_t element
     const geometry::Pose element_pose{m.point_at(t, e.position), m.rotation_at(t) * e.orientation};
     if (!geometry::facing_face(e.shape, element_pose, -ec.normal, other)) return false;
   }
-  return geometry::face_pair_patch(face, other, ec.normal, crust, 0.0, patch);
+  return geometry::face_pair_patch(face, other, ec.normal, crust, 0.0, patch) &&
+         detail::patch_holds_the_contact(patch, ec);
 }
 
 // What one element contact does to its first body.

@@ -15,8 +15,10 @@ namespace {
 // 55 degrees for a box (cosine 1/sqrt 3).
 constexpr double kSteepestCosine = 0.1;
 
+// No member initialisers: the polygons below are scratch space, filled before use
+// (zeroing them cost more than clipping them).
 struct Point2 {
-  double x = 0.0, y = 0.0;
+  double x, y;
 };
 
 // A convex polygon in the patch plane, with room for the clipping to grow it.
@@ -31,31 +33,32 @@ double cross2(const Point2& o, const Point2& a, const Point2& b) {
 
 double signed_area2(const Polygon2& poly) {
   double twice = 0.0;
-  for (int k = 0; k < poly.count; ++k) {
-    const Point2& a = poly.p[k];
-    const Point2& b = poly.p[(k + 1) % poly.count];
-    twice += a.x * b.y - b.x * a.y;
+  for (int k = 0, prev = poly.count - 1; k < poly.count; prev = k++) {
+    twice += poly.p[prev].x * poly.p[k].y - poly.p[k].x * poly.p[prev].y;
   }
   return twice;
 }
 
-// Keeps the part of `poly` where the affine function with values `value[k]` at its
-// corners is >= 0 (Sutherland-Hodgman against one half-plane).
+// Keeps the part of `in` where the affine function value_at is >= 0 (Sutherland-Hodgman
+// against one half-plane), into `out`.
 template <typename ValueAt>
-Polygon2 clip(const Polygon2& poly, ValueAt value_at) {
-  Polygon2 out;
-  for (int k = 0; k < poly.count; ++k) {
-    const Point2& a = poly.p[k];
-    const Point2& b = poly.p[(k + 1) % poly.count];
-    const double va = value_at(a), vb = value_at(b);
-    if (va >= 0.0) out.p[out.count++] = a;
+void clip(const Polygon2& in, ValueAt value_at, Polygon2& out) {
+  out.count = 0;
+  if (in.count == 0) return;
+  Point2 a = in.p[in.count - 1];
+  double va = value_at(a);
+  for (int k = 0; k < in.count; ++k) {
+    const Point2 b = in.p[k];
+    const double vb = value_at(b);
     if ((va >= 0.0) != (vb >= 0.0)) {
       const double t = va / (va - vb);
       out.p[out.count++] = {a.x + t * (b.x - a.x), a.y + t * (b.y - a.y)};
     }
-    if (out.count + 2 > ContactPatch::kCapacity) break;  // cannot happen for convex input
+    if (vb >= 0.0) out.p[out.count++] = b;
+    if (out.count + 2 > ContactPatch::kCapacity) return;  // cannot happen for convex input
+    a = b;
+    va = vb;
   }
-  return out;
 }
 
 // Projects a face onto the patch plane (origin o, axes t1, t2), counter-clockwise.
@@ -101,67 +104,83 @@ bool patch(const SpaceFace& a, const SpaceFace* b, const Vec3& b_normal, double 
   const Vec3 t1 = side / norm(side);
   const Vec3 t2 = cross(n, t1);
 
-  Polygon2 poly;
-  if (!project(a, o, t1, t2, poly)) return false;
+  // Two buffers: each clip writes the other.
+  Polygon2 buffer[2];
+  int current = 0;
+  if (!project(a, o, t1, t2, buffer[0])) return false;
   if (b != nullptr) {
     Polygon2 window;
     if (!project(*b, o, t1, t2, window)) return false;
-    for (int e = 0; e < window.count && poly.count > 0; ++e) {
-      const Point2 from = window.p[e], to = window.p[(e + 1) % window.count];
-      poly = clip(poly, [&](const Point2& p) { return cross2(from, to, p); });
+    for (int e = 0, prev = window.count - 1; e < window.count && buffer[current].count > 0;
+         prev = e++) {
+      const Point2 from = window.p[prev], to = window.p[e];
+      clip(buffer[current], [&](const Point2& p) { return cross2(from, to, p); },
+           buffer[1 - current]);
+      current = 1 - current;
     }
   }
   const PlaneHeight height_a(a.normal, a.offset, n, o, t1, t2);
   const PlaneHeight height_b(b_normal, b_offset, n, o, t1, t2);
   const double reach = crust_a + crust_b;
   const auto overlap = [&](const Point2& p) { return reach - (height_b(p) - height_a(p)); };
-  poly = clip(poly, overlap);
+  clip(buffer[current], overlap, buffer[1 - current]);
+  const Polygon2& poly = buffer[1 - current];
   if (poly.count == 0) return false;
 
   bool any = false;
+  const auto edge = [&](int from, int to) {
+    const double dx = poly.p[to].x - poly.p[from].x, dy = poly.p[to].y - poly.p[from].y;
+    return std::sqrt(dx * dx + dy * dy);
+  };
+  double before = edge(poly.count - 1, 0);
   for (int k = 0; k < poly.count; ++k) {
     const Point2& p = poly.p[k];
-    const Point2& prev = poly.p[(k + poly.count - 1) % poly.count];
-    const Point2& next = poly.p[(k + 1) % poly.count];
+    const double after = edge(k, k + 1 < poly.count ? k + 1 : 0);
     const double mid = 0.5 * (height_a(p) + crust_a + height_b(p) - crust_b);
     out.point[k] = o + p.x * t1 + p.y * t2 + mid * n;
     out.overlap[k] = std::max(overlap(p), 0.0);
-    out.perimeter_share[k] = 0.5 * (std::hypot(p.x - prev.x, p.y - prev.y) +
-                                    std::hypot(next.x - p.x, next.y - p.y));
+    out.perimeter_share[k] = 0.5 * (before + after);
     any = any || out.overlap[k] > 0.0;
+    before = after;
   }
   out.count = poly.count;
   return any;
 }
 
-bool box_face(const Box& box, const Pose& pose, const Vec3& d_body, SpaceFace& out) {
-  const double c[3] = {d_body.x, d_body.y, d_body.z};
+bool box_face(const Box& box, const Pose& pose, const Vec3& d, SpaceFace& out) {
+  // The body axes in space (the columns of the rotation matrix of the unit quaternion),
+  // which give both the body-frame direction and the face.
+  const Quaternion& q = pose.orientation;
+  const Vec3 axis[3] = {
+      {1.0 - 2.0 * (q.y * q.y + q.z * q.z), 2.0 * (q.x * q.y + q.w * q.z),
+       2.0 * (q.x * q.z - q.w * q.y)},
+      {2.0 * (q.x * q.y - q.w * q.z), 1.0 - 2.0 * (q.x * q.x + q.z * q.z),
+       2.0 * (q.y * q.z + q.w * q.x)},
+      {2.0 * (q.x * q.z + q.w * q.y), 2.0 * (q.y * q.z - q.w * q.x),
+       1.0 - 2.0 * (q.x * q.x + q.y * q.y)}};
+  const double c[3] = {dot(axis[0], d), dot(axis[1], d), dot(axis[2], d)};
   const double h[3] = {box.half_extents.x, box.half_extents.y, box.half_extents.z};
   int i = 0;
   for (int k = 1; k < 3; ++k) {
     if (std::abs(c[k]) > std::abs(c[i])) i = k;
   }
   if (!(std::abs(c[i]) > 0.0)) return false;
-  const double s = c[i] > 0.0 ? 1.0 : -1.0;
   const int j = (i + 1) % 3, l = (i + 2) % 3;
-  static constexpr double kSigns[4][2] = {{1.0, 1.0}, {-1.0, 1.0}, {-1.0, -1.0}, {1.0, -1.0}};
+  out.normal = c[i] > 0.0 ? axis[i] : -axis[i];
+  const Vec3 centre = pose.position + h[i] * out.normal;
+  const Vec3 u = h[j] * axis[j], v = h[l] * axis[l];
   out.count = 4;
-  for (int k = 0; k < 4; ++k) {
-    double v[3];
-    v[i] = s * h[i];
-    v[j] = kSigns[k][0] * h[j];
-    v[l] = kSigns[k][1] * h[l];
-    out.corner[k] = pose.position + rotate(pose.orientation, Vec3{v[0], v[1], v[2]});
-  }
-  double e[3] = {0.0, 0.0, 0.0};
-  e[i] = s;
-  out.normal = rotate(pose.orientation, Vec3{e[0], e[1], e[2]});
-  out.offset = dot(out.normal, out.corner[0]);
+  out.corner[0] = centre + u + v;
+  out.corner[1] = centre - u + v;
+  out.corner[2] = centre - u - v;
+  out.corner[3] = centre + u - v;
+  out.offset = dot(out.normal, centre);
   return true;
 }
 
-bool polyhedron_face(const ConvexPolyhedron& poly, const Pose& pose, const Vec3& d_body,
+bool polyhedron_face(const ConvexPolyhedron& poly, const Pose& pose, const Vec3& d,
                      SpaceFace& out) {
+  const Vec3 d_body = rotate_inverse(pose.orientation, d);
   const std::uint32_t top = poly.support_index(d_body);
   const double length = norm(d_body);
   std::size_t best = poly.face_count();
@@ -186,7 +205,8 @@ bool polyhedron_face(const ConvexPolyhedron& poly, const Pose& pose, const Vec3&
   return true;
 }
 
-bool triangle_face(const Triangle& t, const Pose& pose, const Vec3& d_body, SpaceFace& out) {
+bool triangle_face(const Triangle& t, const Pose& pose, const Vec3& d, SpaceFace& out) {
+  const Vec3 d_body = rotate_inverse(pose.orientation, d);
   const Vec3 normal = cross(t.b - t.a, t.c - t.a);
   const double length = norm(normal);
   if (!(length > 0.0)) return false;
@@ -202,16 +222,15 @@ bool triangle_face(const Triangle& t, const Pose& pose, const Vec3& d_body, Spac
 }  // namespace
 
 bool facing_face(const ConvexShape& shape, const Pose& pose, const Vec3& d, SpaceFace& out) {
-  const Vec3 d_body = rotate_inverse(pose.orientation, d);
   return std::visit(
       [&](const auto& s) {
         using S = std::decay_t<decltype(s)>;
         if constexpr (std::is_same_v<S, Box>) {
-          return box_face(s, pose, d_body, out);
+          return box_face(s, pose, d, out);
         } else if constexpr (std::is_same_v<S, ConvexPolyhedron>) {
-          return polyhedron_face(s, pose, d_body, out);
+          return polyhedron_face(s, pose, d, out);
         } else if constexpr (std::is_same_v<S, Triangle>) {
-          return triangle_face(s, pose, d_body, out);
+          return triangle_face(s, pose, d, out);
         } else {
           return false;
         }
