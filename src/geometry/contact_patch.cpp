@@ -115,8 +115,9 @@ bool patch(const SpaceFace& a, const SpaceFace* b, const Vec3& b_normal, double 
     for (int e = 0, prev = window.count - 1; e < window.count && buffer[current].count > 0;
          prev = e++) {
       const Point2 from = window.p[prev], to = window.p[e];
-      clip(buffer[current], [&](const Point2& p) { return cross2(from, to, p); },
-           buffer[1 - current]);
+      clip(
+          buffer[current], [&](const Point2& p) { return cross2(from, to, p); },
+          buffer[1 - current]);
       current = 1 - current;
     }
   }
@@ -152,13 +153,12 @@ bool box_face(const Box& box, const Pose& pose, const Vec3& d, SpaceFace& out) {
   // The body axes in space (the columns of the rotation matrix of the unit quaternion),
   // which give both the body-frame direction and the face.
   const Quaternion& q = pose.orientation;
-  const Vec3 axis[3] = {
-      {1.0 - 2.0 * (q.y * q.y + q.z * q.z), 2.0 * (q.x * q.y + q.w * q.z),
-       2.0 * (q.x * q.z - q.w * q.y)},
-      {2.0 * (q.x * q.y - q.w * q.z), 1.0 - 2.0 * (q.x * q.x + q.z * q.z),
-       2.0 * (q.y * q.z + q.w * q.x)},
-      {2.0 * (q.x * q.z + q.w * q.y), 2.0 * (q.y * q.z - q.w * q.x),
-       1.0 - 2.0 * (q.x * q.x + q.y * q.y)}};
+  const Vec3 axis[3] = {{1.0 - 2.0 * (q.y * q.y + q.z * q.z), 2.0 * (q.x * q.y + q.w * q.z),
+                         2.0 * (q.x * q.z - q.w * q.y)},
+                        {2.0 * (q.x * q.y - q.w * q.z), 1.0 - 2.0 * (q.x * q.x + q.z * q.z),
+                         2.0 * (q.y * q.z + q.w * q.x)},
+                        {2.0 * (q.x * q.z + q.w * q.y), 2.0 * (q.y * q.z - q.w * q.x),
+                         1.0 - 2.0 * (q.x * q.x + q.y * q.y)}};
   const double c[3] = {dot(axis[0], d), dot(axis[1], d), dot(axis[2], d)};
   const double h[3] = {box.half_extents.x, box.half_extents.y, box.half_extents.z};
   int i = 0;

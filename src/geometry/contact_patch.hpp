@@ -45,7 +45,7 @@ bool facing_face(const ConvexShape& shape, const Pose& pose, const Vec3& d, Spac
 struct ContactPatch {
   static constexpr int kCapacity = 2 * SpaceFace::kCapacity + 2;
   int count = 0;
-  std::array<Vec3, kCapacity> point;     // on the middle of the two crusts, space frame
+  std::array<Vec3, kCapacity> point;      // on the middle of the two crusts, space frame
   std::array<double, kCapacity> overlap;  // reach - gap at the corner, >= 0 [m]
   // Half the lengths of the two patch edges that meet at the corner [m]: the corner's
   // share of the perimeter, which is continuous as corners split or merge while the

@@ -27,7 +27,8 @@ double patch_perimeter(const ContactPatch& p) {
 
 TEST(ContactPatch, FacingFaceOfABoxIsTheFaceMostAlongTheDirection) {
   const ConvexShape box = Box{{3.0, 2.0, 1.0}};
-  const Pose pose{{10.0, 0.0, 0.0}, Quaternion::from_axis_angle({0.0, 0.0, 1.0}, 0.5 * std::numbers::pi)};
+  const Pose pose{{10.0, 0.0, 0.0},
+                  Quaternion::from_axis_angle({0.0, 0.0, 1.0}, 0.5 * std::numbers::pi)};
   SpaceFace f;
   // Body +x is space +y after the quarter turn about z.
   ASSERT_TRUE(facing_face(box, pose, {0.2, 1.0, 0.1}, f));
@@ -40,8 +41,8 @@ TEST(ContactPatch, FacingFaceOfABoxIsTheFaceMostAlongTheDirection) {
 
 TEST(ContactPatch, FacingFaceOfAPolyhedronHoldsTheSupportPoint) {
   // A unit cube as a hull: the face most along d among those at the support vertex.
-  const ConvexShape cube = make_convex_polyhedron({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0},
-                                                   {0, 0, 1}, {1, 0, 1}, {0, 1, 1}, {1, 1, 1}});
+  const ConvexShape cube = make_convex_polyhedron(
+      {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {0, 0, 1}, {1, 0, 1}, {0, 1, 1}, {1, 1, 1}});
   SpaceFace f;
   ASSERT_TRUE(facing_face(cube, {}, {0.1, -0.2, -1.0}, f));
   EXPECT_EQ(f.count, 4);
@@ -111,7 +112,8 @@ TEST(ContactPatch, CrossingEdgesGiveASliverWhoseApexIsTheClosestPoint) {
   // crossing point, with overlap 0.1 - 0.01; the other corners have none.
   const ConvexShape box = Box{{1.0, 1.0, 1.0}};
   const double s = std::sqrt(2.0);
-  const Pose lower{{0.0, 0.0, 0.0}, Quaternion::from_axis_angle({1.0, 0.0, 0.0}, 0.25 * std::numbers::pi)};
+  const Pose lower{{0.0, 0.0, 0.0},
+                   Quaternion::from_axis_angle({1.0, 0.0, 0.0}, 0.25 * std::numbers::pi)};
   const Pose upper{{0.0, 0.0, 2.0 * s + 0.01},
                    Quaternion::from_axis_angle({0.0, 1.0, 0.0}, 0.25 * std::numbers::pi)};
   const Vec3 n{0.0, 0.0, 1.0};

@@ -195,8 +195,12 @@ def main():
                   "column still settling: the case's seed was (H0 20.9 cm, 4.94 neighbours, "
                   "and the memory check passed only just, 5.09), seeds 1-3 changed little "
                   "(crosses_tangential_packings). At "
-                  "rest, the case's seed gives H0 17.9 cm, 6.31 touching neighbours and 8.03 "
-                  "contact points per cross, and the ratio 8.9.",
+                  "rest, with one contact point per element pair (run of 2026-12-02 12:03, "
+                  "commit f4aaf9e), the case's seed gave H0 17.9 cm, 6.31 touching "
+                  "neighbours and 8.03 contact points per cross, and the ratio 8.9. With the "
+                  "contact patches of flat faces (docs/theory/dem.md, from 2026-12-02 "
+                  f"evening) it gives H0 {100 * h0:.1f} cm, {zp:.2f} touching neighbours and "
+                  f"{zc:.2f} contact points per cross, and the ratio {ratio:.2g}.",
                   "Coordination: this column of 300 crosses is 3.9 cm long, one and a half "
                   "cross lengths: many crosses touch the back wall, the gate, a side wall "
                   f"or the floor ({100 * wall_share:.0f} % at the opening), and a cross has "

@@ -174,6 +174,9 @@ def main():
     fig.savefig(FIGURE, dpi=130)
 
     ok = all(c["pass"] for c in checks)
+    packing = read_summary(os.path.join(RUNS, f"kt_{TABLE_31[0]:g}_gamma_{TABLE_31[1]:g}"))
+    stable = ", ".join(f"kt {r['kt']:g} γt {r['gamma']:g}" for r in results
+                       if r["region"] == 3) or "none"
     summary = {
         "name": "crosses_tangential_map",
         "title": "Cross column: flow regime against kt and γt",
@@ -206,11 +209,19 @@ def main():
                   # Measured 2026-11-25 on the pour of crosses_memory to its opening at
                   # t = 3.0 s (at rest: 3e-5 m/s); the earlier runs' readings are quoted
                   # from this file's notes of 2026-11-23/24.
+                  "With the contact patches of flat faces (docs/theory/dem.md, from "
+                  "2026-12-02 evening) the pour stands at H0 "
+                  f"{100 * packing['H0_m']:.1f} cm with {packing['pair_coordination']:.2f} "
+                  "touching neighbours per cross; the Table 3.1 point loses "
+                  f"{100 * table[TABLE_31]['height_loss']:.1f} % of H0 in {DURATION} s "
+                  f"(region {table[TABLE_31]['region']}); the points that stand (region 3): "
+                  f"{stable}. The reading below is that of the runs with one contact point "
+                  "per element pair.",
                   "The map is a property of the packing as much as of kt and γt, and it needs "
                   "the column at rest when the gate opens. Since 2026-11-25 it is (the "
                   "opening moved from t = 2.4 s, when the pour's last crosses were still "
-                  "landing, to 3.0 s; crosses_memory). On this settled column (H0 17.9 cm, "
-                  "6.31 touching neighbours per cross) the Table 3.1 point collapses "
+                  "landing, to 3.0 s; crosses_memory). On that settled column (H0 17.9 cm, "
+                  "6.31 touching neighbours per cross) the Table 3.1 point collapsed "
                   "top-driven (height loss 0.23 in 0.5 s), the points 3x stiffer in kt or "
                   "γt beside it (kt 1e3 and γt 1e3; kt 3e2 and γt 3e3) and kt 1e3 with γt 3e3 "
                   "stand (region 3, losses 0.5-5 %), kt 1e5 stands unless γt is 1e5, and "

@@ -58,6 +58,12 @@ def run_two_at_a_time(jobs):
             sys.exit(f"run failed: {d}")
 
 
+def span(values, fmt):
+    """'a-b' for the smallest and largest of the values, or 'a' when they print alike."""
+    low, high = format(min(values), fmt), format(max(values), fmt)
+    return low if low == high else f"{low}-{high}"
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--build", default="build")
@@ -173,9 +179,18 @@ def main():
                   "settling). For these three seeds it changed little: with the opening at "
                   "2.4 s they stood at H0 17.8-18.2 cm with 6.35-6.66 neighbours, the Table "
                   "3.1 point lost 1.7-3.8 % (region 3) and the lower point 27-55 % (region 2); "
-                  "now 17.8-18.1 cm, 6.35-6.65, 1.2-3.1 % and 35-59 %. On the case's own seed, "
-                  "settled, the Table 3.1 point collapses (23 %, crosses_tangential_map): the "
-                  "point sits on the border of regions 2 and 3."],
+                  "opened at 3.0 s, with one contact point per element pair (2026-11-25), "
+                  "17.8-18.1 cm, 6.35-6.65, 1.2-3.1 % and 35-59 %. On the case's own seed, "
+                  "settled, the Table 3.1 point collapsed then (23 %, crosses_tangential_map): "
+                  "the point sat on the border of regions 2 and 3.",
+                  "With the contact patches of flat faces (docs/theory/dem.md, from "
+                  "2026-12-02 evening) the pours stand at H0 "
+                  f"{span([100 * packing[s]['H0_m'] for s in SEEDS], '.1f')} cm with "
+                  f"{span([packing[s]['pair_coordination'] for s in SEEDS], '.2f')} "
+                  "neighbours per cross; the Table 3.1 point loses "
+                  f"{span([100 * results[(s, *TABLE_31)]['height_loss'] for s in SEEDS], '.1f')} "
+                  "% of H0 and the lower point "
+                  f"{span([100 * results[(s, *LOWER)]['height_loss'] for s in SEEDS], '.0f')} %."],
     }
     write_summary(summary, RESULTS, elapsed, args.quick, ok)
     print(f"{'PASS' if ok else 'FAIL'}: Table 3.1 regions {table31}, lower point {lower}, "
