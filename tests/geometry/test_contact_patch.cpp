@@ -131,7 +131,9 @@ TEST(ContactPatch, CrossingEdgesGiveASliverWhoseApexIsTheClosestPoint) {
   EXPECT_NEAR(p.point[deepest].y, 0.0, 1e-13);
   EXPECT_NEAR(p.point[deepest].z, s + 0.005, 1e-13);
   for (int k = 0; k < p.count; ++k) {
-    if (k != deepest) EXPECT_LT(p.overlap[k], 1e-13);
+    if (k != deepest) {
+      EXPECT_LT(p.overlap[k], 1e-13);
+    }
   }
 }
 
