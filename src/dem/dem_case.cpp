@@ -557,6 +557,7 @@ DemCase load_dem_case(const ConfigTable& cfg, const std::filesystem::path& sourc
   const std::int64_t sort_steps = sim.get_int("storage_sort_steps", s.storage_sort_interval);
   if (sort_steps < 0) sim.fail("storage_sort_steps", "must be >= 0 (0: never sort)");
   s.storage_sort_interval = sort_steps;
+  s.contact_patches = sim.get_choice("flat_contacts", {"patch", "point"}, "patch") == "patch";
   const bool allow_large_dt = sim.get_bool("allow_large_time_step", false);
   const bool dt_given = sim.has("time_step_s");
   const double dt_value = dt_given ? sim.get_positive("time_step_s") : 0.0;
@@ -799,6 +800,12 @@ std::string describe(const DemCase& c) {
     o << "along space every " << s.storage_sort_interval << " steps\n";
   } else {
     o << "off (particles stay in the order they were created)\n";
+  }
+  if (!s.shapes.empty()) {
+    o << "flat contacts   "
+      << (s.contact_patches ? "patch (spring-dashpots at the patch corners)"
+                            : "point (one per element pair, thesis §2.3)")
+      << "\n";
   }
   o << "integrator      " << to_string(s.integrator) << " (order " << order_of(s.integrator)
     << ")\n";

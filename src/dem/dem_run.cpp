@@ -336,8 +336,8 @@ std::vector<ContactRecord> touching_contacts(const DemSimulation& sim) {
         element_pair_contact(*a.core, a.pose, a.crust, *b.core, b.pose, b.crust, &warm);
     if (!ec.touching) continue;
     geometry::ContactPatch patch;
-    const bool flat =
-        element_pair_patch(*a.core, a.pose, a.crust, *b.core, b.pose, b.crust, ec, patch);
+    const bool flat = s.contact_patches && element_pair_patch(*a.core, a.pose, a.crust, *b.core,
+                                                              b.pose, b.crust, ec, patch);
     ContactRecord r;
     r.kind = ContactKind::kBodyPair;
     r.first = i;
@@ -360,7 +360,8 @@ std::vector<ContactRecord> touching_contacts(const DemSimulation& sim) {
                                                        *a.core, a.pose, a.crust, &warm);
     if (!ec.touching) continue;
     geometry::ContactPatch patch;
-    const bool flat = element_obstacle_patch(obstacle, body_walls.element_second[k], now, *a.core,
+    const bool flat = s.contact_patches &&
+                      element_obstacle_patch(obstacle, body_walls.element_second[k], now, *a.core,
                                              a.pose, a.crust, ec, patch);
     ContactRecord r;
     r.kind = ContactKind::kBodyWall;

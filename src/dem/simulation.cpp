@@ -331,7 +331,8 @@ void DemSimulation::compute_forces() {
       return out;
     }
     geometry::ContactPatch patch;
-    const bool flat = element_pair_patch(*a.core, {a.position, a.orientation}, a.crust, *b.core,
+    const bool flat = setup_.contact_patches &&
+                      element_pair_patch(*a.core, {a.position, a.orientation}, a.crust, *b.core,
                                          {b.position, b.orientation}, b.crust, ec, patch);
     const auto vj = [&](const Vec3& point) { return v[j] + cross(w[j], point - xj); };
     element_response(
@@ -359,9 +360,10 @@ void DemSimulation::compute_forces() {
       return out;
     }
     geometry::ContactPatch patch;
-    const bool flat =
-        element_obstacle_patch(obstacle, body_walls_.element_second[k], now, *a.core,
-                               {a.position, a.orientation}, a.crust, ec, patch);
+    const bool flat = setup_.contact_patches &&
+                      element_obstacle_patch(obstacle, body_walls_.element_second[k], now,
+                                             *a.core, {a.position, a.orientation}, a.crust, ec,
+                                             patch);
     const ObstacleMotion& m = obstacle.motion;
     const auto wall_velocity = [&](const Vec3& point) {
       return m.is_static() ? Vec3{} : m.velocity_at(now, point);

@@ -83,6 +83,10 @@ struct DemSetup {
   // With bodies each thread takes up to 4 slabs, as many as leave at most this share
   // of the particles with a contact across slabs (simulation.cpp, kBodySlabsPerThread).
   double most_shared_fraction = 0.15;
+  // Flat faces (boxes, polyhedra, obstacle facets) touch through contact patches
+  // (body_contacts.hpp); false: at one point per element pair as in thesis §2.3 and
+  // Grains3D (GJK's closest points; the overlap-weighted face centre against planes).
+  bool contact_patches = true;
   std::vector<std::string> material_names;
   ContactTable contacts;
   std::vector<Obstacle> obstacles;

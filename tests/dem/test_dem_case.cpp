@@ -275,7 +275,8 @@ integrator = "adams_bashforth_3"
 gravity_m_s2 = [0.0, -1.0, 0.0]
 skin_m = 2e-4
 abort_overlap_ratio = 0.2
-storage_sort_steps = 0)");
+storage_sort_steps = 0
+flat_contacts = "point")");
   text += R"(
 [output]
 interval_s = 0.002
@@ -293,6 +294,8 @@ check_after_s = 0.003
   EXPECT_EQ(c.setup.max_overlap_ratio, 0.2);
   EXPECT_EQ(c.setup.storage_sort_interval, 0);
   EXPECT_EQ(load(kValidCase).setup.storage_sort_interval, 2000);  // the default
+  EXPECT_FALSE(c.setup.contact_patches);
+  EXPECT_TRUE(load(kValidCase).setup.contact_patches);  // the default
   EXPECT_EQ(c.output.interval, 0.002);
   EXPECT_FALSE(c.output.vtk);
   EXPECT_EQ(c.output.checkpoint_interval, 0.005);
@@ -403,6 +406,11 @@ TEST(DemCaseErrors, MissingRequiredKey) {
 TEST(DemCaseErrors, NegativeStorageSortInterval) {
   expect_case_error(replaced(kValidCase, "seed = 3", "seed = 3\nstorage_sort_steps = -5"),
                     "simulation.storage_sort_steps", "must be >= 0");
+}
+
+TEST(DemCaseErrors, UnknownFlatContactModel) {
+  expect_case_error(replaced(kValidCase, "seed = 3", "seed = 3\nflat_contacts = \"manifold\""),
+                    "simulation.flat_contacts", "patch");
 }
 
 TEST(DemCaseErrors, NegativeOrZeroRadius) {
