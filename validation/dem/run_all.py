@@ -73,6 +73,10 @@ def verdict(p):
 
 # When the DEM solver began re-sorting its particle storage (summation order changed).
 STORAGE_SORT_SINCE = "2026-11-23 23:30"
+# When flat faces began to touch through contact patches (docs/theory/dem.md).
+CONTACT_PATCHES_SINCE = "2026-12-02 16:30"
+# The cases whose runs hold non-spherical particles (their physics changed then).
+BODY_CASES = ("crosses_",)
 
 
 def report(summaries, meta):
@@ -97,6 +101,15 @@ def report(summaries, meta):
                       "crosses_memory, rerun so on 2026-11-24, poured to H0 18.0 cm against 17.9 "
                       "in its run of 2026-11-22. Pours of crosses are chaotic, so such a rerun is "
                       "another packing (see crosses_memory's notes).", ""]
+    point_model = [name for name, s in summaries
+                   if s and name.startswith(BODY_CASES) and s.get("date", "") < CONTACT_PATCHES_SINCE]
+    if point_model:
+        out[-2:-2] = [f"{len(point_model)} cases of crosses ran before the contact patches of flat "
+                      f"faces ({CONTACT_PATCHES_SINCE}, docs/theory/dem.md), with one contact point "
+                      "per pair of elements as in thesis §2.3: " + ", ".join(point_model) + ". "
+                      "That model is still there, `--set simulation.flat_contacts=\"point\"`; "
+                      "the patches make flat contacts hold where the single point rocked, so these "
+                      "cases' numbers are those of the point model until they are run again.", ""]
     for name, s in summaries:
         if s is None:
             out.append(f"| {name} | — | — | **FAIL** (no summary) | — |")

@@ -73,6 +73,21 @@ class Report(unittest.TestCase):
         text = run_all.report([("old", old)], self.META)
         self.assertIn("1 of these 1 cases were run before the particle storage sort", text)
 
+    def test_names_the_cases_of_crosses_run_with_one_contact_point(self):
+        old = summary("crosses_old", True, date="2026-11-30 10:00")
+        new = summary("crosses_new", True, date="2026-12-02 17:00")
+        spheres = summary("spheres_old", True, date="2026-11-30 10:00")
+        text = run_all.report([("crosses_old", old), ("crosses_new", new),
+                               ("spheres_old", spheres)], self.META)
+        flagged = [line for line in text.splitlines() if "ran before the contact patches" in line]
+        self.assertEqual(len(flagged), 1)
+        self.assertIn("1 cases of crosses", flagged[0])
+        self.assertIn("as in thesis §2.3: crosses_old.", flagged[0])
+        self.assertNotIn("crosses_new", flagged[0])
+        self.assertNotIn("spheres_old", flagged[0])
+        text = run_all.report([("crosses_new", new), ("spheres_old", spheres)], self.META)
+        self.assertNotIn("contact patches", text)
+
 
 class StampHardware(unittest.TestCase):
     def test_stamps_only_a_summary_written_by_this_run(self):
