@@ -274,6 +274,10 @@ int main(int argc, char** argv) {
                    "dem: re-sort particles along space every N steps (0: never; default: "
                    "the solver's, 2000)")
       ->check(CLI::Range(std::int64_t{0}, std::int64_t{1} << 40));
+  bench_cmd
+      ->add_option("--flat-contacts", bo.flat_contacts,
+                   "dem-crosses: \"patch\" (default) or \"point\", as flat_contacts in a case")
+      ->check(CLI::IsMember({"patch", "point"}));
   std::string bench_case;
   bench_cmd->add_option("--case", bench_case,
                         "flow-adaptive: flow case file (default cases/flow/obstacle-wake.toml)");

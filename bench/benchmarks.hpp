@@ -35,6 +35,8 @@ struct BenchOptions {
   bool scatter = false;
   // dem-spheres, dem-crosses: DemSetup::storage_sort_interval; -1: its default.
   std::int64_t storage_sort_interval = -1;
+  // dem-crosses: DemSetup::contact_patches ("patch", the default, or "point").
+  std::string flat_contacts = "patch";
   // dem-spheres under mpirun: the processes share the system (domain decomposition).
   MPI_Comm comm = MPI_COMM_NULL;
 };

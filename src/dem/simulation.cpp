@@ -10,6 +10,7 @@
 #include <fstream>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <type_traits>
@@ -330,13 +331,16 @@ void DemSimulation::compute_forces() {
       body_pairs_.twist[k] = 0.0;
       return out;
     }
-    geometry::ContactPatch patch;
-    const bool flat = setup_.contact_patches &&
-                      element_pair_patch(*a.core, {a.position, a.orientation}, a.crust, *b.core,
-                                         {b.position, b.orientation}, b.crust, ec, patch);
+    // Built only for the patch model (the struct is 1 kB, zeroed when made).
+    std::optional<geometry::ContactPatch> patch;
+    if (setup_.contact_patches &&
+        !element_pair_patch(*a.core, {a.position, a.orientation}, a.crust, *b.core,
+                            {b.position, b.orientation}, b.crust, ec, patch.emplace())) {
+      patch.reset();
+    }
     const auto vj = [&](const Vec3& point) { return v[j] + cross(w[j], point - xj); };
     element_response(
-        i, ec, flat ? &patch : nullptr, vj, w[j], &xj,
+        i, ec, patch ? &*patch : nullptr, vj, w[j], &xj,
         setup_.contacts.get(static_cast<std::size_t>(mat[i]), static_cast<std::size_t>(mat[j])), h,
         body_pairs_.twist[k], out);
     out.overlap_ratio = ec.overlap / std::min(size_of(i), size_of(j));
@@ -359,18 +363,19 @@ void DemSimulation::compute_forces() {
       body_walls_.twist[k] = 0.0;
       return out;
     }
-    geometry::ContactPatch patch;
-    const bool flat = setup_.contact_patches &&
-                      element_obstacle_patch(obstacle, body_walls_.element_second[k], now,
-                                             *a.core, {a.position, a.orientation}, a.crust, ec,
-                                             patch);
+    std::optional<geometry::ContactPatch> patch;
+    if (setup_.contact_patches &&
+        !element_obstacle_patch(obstacle, body_walls_.element_second[k], now, *a.core,
+                                {a.position, a.orientation}, a.crust, ec, patch.emplace())) {
+      patch.reset();
+    }
     const ObstacleMotion& m = obstacle.motion;
     const auto wall_velocity = [&](const Vec3& point) {
       return m.is_static() ? Vec3{} : m.velocity_at(now, point);
     };
     const Vec3 wall_omega = m.rotation.moving() ? m.rotation.speed_at(now) * m.axis : Vec3{};
     // The obstacle takes no torque: no centre, no lever arm.
-    element_response(i, ec, flat ? &patch : nullptr, wall_velocity, wall_omega, nullptr,
+    element_response(i, ec, patch ? &*patch : nullptr, wall_velocity, wall_omega, nullptr,
                      setup_.contacts.get(static_cast<std::size_t>(mat[i]),
                                          static_cast<std::size_t>(obstacle.material)),
                      h, body_walls_.twist[k], out);
