@@ -1246,7 +1246,7 @@ void put_body_list(std::ostream& out, const BodyContactList& list) {
   put(out, list.warm);
 }
 
-// The twists are read at the end of the file (get_twists); zero until then.
+// The twists come last in the file (load_checkpoint reads them there); zero until then.
 void get_body_list(std::istream& in, BodyContactList& list) {
   get(in, list.first);
   get(in, list.second);

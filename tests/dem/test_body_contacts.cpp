@@ -500,14 +500,9 @@ BoxOnPlane box_on_plane(double tilt, double overlap) {
   return b;
 }
 
+// The Table 3.1 law (particle-wall) for the box of flat_box() on a plane.
 ContactParameters patch_law() {
-  ContactParameters p;
-  p.normal_stiffness = 4.5e5;
-  p.normal_damping = 0.3;
-  p.tangential_stiffness = 3e2;
-  p.tangential_damping = 0.02;
-  p.friction = 0.5;
-  return p;
+  return contact_parameters(Law{}, kCrossDensity * flat_box().shape.volume);
 }
 
 ElementResponse respond(const BoxOnPlane& b, const ContactParameters& law, const Vec3& omega,
