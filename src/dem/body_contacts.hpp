@@ -267,7 +267,8 @@ struct ElementResponse {
 // of §2.3 with the corner's weight, M = -(kt theta + eta_t dtheta/dt) sum(w r^2), r the
 // corner's distance from the centre, bounded by mu_c |Fn| sum(w r) (a disc of radius R
 // pressed evenly slips at 2/3 mu_c |Fn| R) and kept continuous through slipping as
-// eq. 2.8 does. A single point has no twist: `twist` is zeroed.
+// eq. 2.8 does; the rolling resistance then acts on the relative rotation less its
+// twist. A single point has no twist: `twist` is zeroed.
 //
 // `other_velocity(x)` is the second body's velocity at the space point x;
 // `other_centre` its centre, or null for an obstacle (no lever arm: the arm is zero).
@@ -315,7 +316,11 @@ ElementResponse element_contact_response(const ContactParameters& params, const 
     overlap += w * patch->overlap[k];
   }
   if (fn > 0.0) centre = pressed / fn;
-  const ContactKinematics c = kinematics_at(centre, overlap);
+  ContactKinematics c = kinematics_at(centre, overlap);
+  // The twist about the normal is the torsional spring's (below): the rolling resistance
+  // gets the rest of the relative rotation, so that no twist is resisted twice.
+  const double spin = dot(c.relative_angular_velocity, ec.normal);
+  c.relative_angular_velocity -= spin * ec.normal;
   out.response = contact_response_for_normal_force(params, c, h, dt, fn);
 
   double second_moment = 0.0, mean_arm = 0.0;
@@ -326,7 +331,6 @@ ElementResponse element_contact_response(const ContactParameters& params, const 
     second_moment += w * r2;
     mean_arm += w * std::sqrt(r2);
   }
-  const double spin = dot(c.relative_angular_velocity, ec.normal);
   twist += dt * spin;
   double moment =
       -(params.tangential_stiffness * twist + params.tangential_damping * spin) * second_moment;

@@ -585,5 +585,27 @@ TEST(BodyContacts, PatchResistsTwistWithASpringThatSlipsAtTheCoulombMoment) {
   EXPECT_NEAR(r.twist_torque.z, -limit + law.tangential_damping * spin * j, 1e-9 * limit);
 }
 
+TEST(BodyContacts, PatchLeavesTheTwistToTheTorsionalSpring) {
+  // With rolling resistance on (eq. 2.9-2.13, mu_r 0.1, R 3 mm), a spin about the normal
+  // is resisted by the torsional spring alone: the rolling spring gets the relative
+  // rotation less its twist, here nothing. A rocking rotation still reaches it.
+  const BoxOnPlane b = box_on_plane(0.0, 1e-7);
+  Law with_rolling;
+  with_rolling.mu_r = 0.1;
+  with_rolling.rolling_radius = 3e-3;
+  const ContactParameters law =
+      contact_parameters(with_rolling, kCrossDensity * flat_box().shape.volume);
+  ContactHistory h;
+  double twist = 0.0;
+  ElementResponse r = respond(b, law, {0.0, 0.0, 0.01}, h, twist, 1e-3);
+  EXPECT_EQ(norm(r.response.rolling_torque), 0.0);
+  EXPECT_GT(std::abs(r.twist_torque.z), 0.0);
+  ContactHistory h_rock;
+  double twist_rock = 0.0;
+  r = respond(b, law, {0.01, 0.0, 0.0}, h_rock, twist_rock, 1e-3);
+  EXPECT_GT(std::abs(r.response.rolling_torque.x), 0.0);
+  EXPECT_EQ(twist_rock, 0.0);
+}
+
 }  // namespace
 }  // namespace sanguis::dem
