@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <array>
 #include <limits>
+#include <optional>
 
 #include "dem/contact_law.hpp"
 #include "dem/obstacles.hpp"
@@ -194,46 +195,57 @@ inline bool patch_holds_the_contact(const geometry::ContactPatch& patch, const E
 
 }  // namespace detail
 
-// The contact patch of two touching elements (ec from element_pair_contact): false,
-// leaving the single point, for curved cores, deep contacts and degenerate faces.
-inline bool element_pair_patch(const geometry::ConvexShape& core_a, const geometry::Pose& pose_a,
-                               double crust_a, const geometry::ConvexShape& core_b,
-                               const geometry::Pose& pose_b, double crust_b,
-                               const ElementContact& ec, geometry::ContactPatch& patch) {
-  if (!ec.touching || ec.deep) return false;
+// The contact patch of two touching elements (ec from element_pair_contact), or none,
+// leaving the single point: curved cores, deep contacts, degenerate faces.
+inline std::optional<geometry::ContactPatch> element_pair_patch(
+    const geometry::ConvexShape& core_a, const geometry::Pose& pose_a, double crust_a,
+    const geometry::ConvexShape& core_b, const geometry::Pose& pose_b, double crust_b,
+    const ElementContact& ec) {
+  std::optional<geometry::ContactPatch> patch;
+  if (!ec.touching || ec.deep) return patch;
   geometry::SpaceFace face_a, face_b;
-  return geometry::facing_face(core_a, pose_a, ec.normal, face_a) &&
-         geometry::facing_face(core_b, pose_b, -ec.normal, face_b) &&
-         geometry::face_pair_patch(face_a, face_b, ec.normal, crust_a, crust_b, patch) &&
-         detail::patch_holds_the_contact(patch, ec);
+  if (!geometry::facing_face(core_a, pose_a, ec.normal, face_a) ||
+      !geometry::facing_face(core_b, pose_b, -ec.normal, face_b) ||
+      !geometry::face_pair_patch(face_a, face_b, ec.normal, crust_a, crust_b, patch.emplace()) ||
+      !detail::patch_holds_the_contact(*patch, ec)) {
+    patch.reset();
+  }
+  return patch;
 }
 
 // The contact patch of an element and obstacle element `element` at time t (ec from
-// element_obstacle_contact with the same arguments).
-inline bool element_obstacle_patch(const Obstacle& obstacle, std::size_t element, double t,
-                                   const geometry::ConvexShape& core, const geometry::Pose& pose,
-                                   double crust, const ElementContact& ec,
-                                   geometry::ContactPatch& patch) {
-  if (!ec.touching || ec.deep) return false;
-  geometry::SpaceFace face;
-  if (!geometry::facing_face(core, pose, ec.normal, face)) return false;
+// element_obstacle_contact with the same arguments), or none.
+inline std::optional<geometry::ContactPatch> element_obstacle_patch(
+    const Obstacle& obstacle, std::size_t element, double t, const geometry::ConvexShape& core,
+    const geometry::Pose& pose, double crust, const ElementContact& ec) {
+  std::optional<geometry::ContactPatch> patch;
+  geometry::SpaceFace face, other;
+  if (!ec.touching || ec.deep || !geometry::facing_face(core, pose, ec.normal, face)) {
+    return patch;
+  }
   const ObstacleMotion& m = obstacle.motion;
+  bool formed = false;
   if (const auto* plane = std::get_if<PlaneShape>(&obstacle.shape)) {
-    return geometry::face_plane_patch(face, m.point_at(t, plane->point),
-                                      m.direction_to_space(t, plane->normal), crust, patch);
-  }
-  geometry::SpaceFace other;
-  if (const auto* box = std::get_if<AxisAlignedBoxShape>(&obstacle.shape)) {
-    const geometry::ConvexShape box_core = geometry::Box{0.5 * (box->max - box->min)};
-    const geometry::Pose box_pose{m.point_at(t, 0.5 * (box->min + box->max)), m.rotation_at(t)};
-    if (!geometry::facing_face(box_core, box_pose, -ec.normal, other)) return false;
+    formed = geometry::face_plane_patch(face, m.point_at(t, plane->point),
+                                        m.direction_to_space(t, plane->normal), crust,
+                                        patch.emplace());
   } else {
-    const ObstacleElement& e = std::get<ShapeObstacle>(obstacle.shape).elements[element];
-    const geometry::Pose element_pose{m.point_at(t, e.position), m.rotation_at(t) * e.orientation};
-    if (!geometry::facing_face(e.shape, element_pose, -ec.normal, other)) return false;
+    bool faced = false;
+    if (const auto* box = std::get_if<AxisAlignedBoxShape>(&obstacle.shape)) {
+      const geometry::ConvexShape box_core = geometry::Box{0.5 * (box->max - box->min)};
+      const geometry::Pose box_pose{m.point_at(t, 0.5 * (box->min + box->max)), m.rotation_at(t)};
+      faced = geometry::facing_face(box_core, box_pose, -ec.normal, other);
+    } else {
+      const ObstacleElement& e = std::get<ShapeObstacle>(obstacle.shape).elements[element];
+      const geometry::Pose element_pose{m.point_at(t, e.position),
+                                        m.rotation_at(t) * e.orientation};
+      faced = geometry::facing_face(e.shape, element_pose, -ec.normal, other);
+    }
+    formed = faced && geometry::face_pair_patch(face, other, ec.normal, crust, 0.0,
+                                                patch.emplace());
   }
-  return geometry::face_pair_patch(face, other, ec.normal, crust, 0.0, patch) &&
-         detail::patch_holds_the_contact(patch, ec);
+  if (!formed || !detail::patch_holds_the_contact(*patch, ec)) patch.reset();
+  return patch;
 }
 
 // What one element contact does to its first body.

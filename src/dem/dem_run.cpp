@@ -335,15 +335,15 @@ std::vector<ContactRecord> touching_contacts(const DemSimulation& sim) {
     const ElementContact ec =
         element_pair_contact(*a.core, a.pose, a.crust, *b.core, b.pose, b.crust, &warm);
     if (!ec.touching) continue;
-    geometry::ContactPatch patch;
-    const bool flat = s.contact_patches && element_pair_patch(*a.core, a.pose, a.crust, *b.core,
-                                                              b.pose, b.crust, ec, patch);
+    const auto patch = s.contact_patches ? element_pair_patch(*a.core, a.pose, a.crust, *b.core,
+                                                              b.pose, b.crust, ec)
+                                         : std::nullopt;
     ContactRecord r;
     r.kind = ContactKind::kBodyPair;
     r.first = i;
     r.second = j;
     const auto vj = [&](const Vec3& point) { return v[j] + cross(w[j], point - xj); };
-    element_record(params(p.material[i], p.material[j]), i, ec, flat ? &patch : nullptr, vj, w[j],
+    element_record(params(p.material[i], p.material[j]), i, ec, patch ? &*patch : nullptr, vj, w[j],
                    &xj, body_pairs.history[k], body_pairs.twist[k], r);
     out.push_back(r);
   }
@@ -359,10 +359,10 @@ std::vector<ContactRecord> touching_contacts(const DemSimulation& sim) {
     const ElementContact ec = element_obstacle_contact(obstacle, body_walls.element_second[k], now,
                                                        *a.core, a.pose, a.crust, &warm);
     if (!ec.touching) continue;
-    geometry::ContactPatch patch;
-    const bool flat = s.contact_patches &&
-                      element_obstacle_patch(obstacle, body_walls.element_second[k], now, *a.core,
-                                             a.pose, a.crust, ec, patch);
+    const auto patch = s.contact_patches
+                           ? element_obstacle_patch(obstacle, body_walls.element_second[k], now,
+                                                    *a.core, a.pose, a.crust, ec)
+                           : std::nullopt;
     ContactRecord r;
     r.kind = ContactKind::kBodyWall;
     r.first = i;
@@ -371,7 +371,7 @@ std::vector<ContactRecord> touching_contacts(const DemSimulation& sim) {
       return m.is_static() ? Vec3{} : m.velocity_at(now, point);
     };
     const Vec3 wall_omega = m.rotation.moving() ? m.rotation.speed_at(now) * m.axis : Vec3{};
-    element_record(params(p.material[i], obstacle.material), i, ec, flat ? &patch : nullptr,
+    element_record(params(p.material[i], obstacle.material), i, ec, patch ? &*patch : nullptr,
                    wall_velocity, wall_omega, nullptr, body_walls.history[k], body_walls.twist[k],
                    r);
     out.push_back(r);

@@ -292,6 +292,14 @@ void DemSimulation::compute_forces() {
     return p.spherical[i] ? rad[i]
                           : shapes[static_cast<std::size_t>(p.species[i])].equivalent_radius;
   };
+  // An element contact that no longer touches forgets its memory (the twist is held only
+  // while the history is, so it needs no test of its own).
+  const auto forget = [](ContactHistory& h, double& twist) {
+    if (h.normal.x != 0.0 || h.normal.y != 0.0 || h.normal.z != 0.0) {
+      h = ContactHistory{};
+      twist = 0.0;
+    }
+  };
   // The patch or point response of an element contact, on both bodies (body_contacts.hpp).
   const auto element_response = [&](std::size_t i, const ElementContact& ec,
                                     const geometry::ContactPatch* patch,
@@ -319,25 +327,21 @@ void DemSimulation::compute_forces() {
     const ElementView b = element_view(p, shapes, j, body_pairs_.element_second[k], xj);
     const double reach = a.reach + b.reach;
     if (norm2(b.position - a.position) > reach * reach) {  // bounding balls apart: no GJK
-      if (h.normal.x != 0.0 || h.normal.y != 0.0 || h.normal.z != 0.0) h = ContactHistory{};
-      body_pairs_.twist[k] = 0.0;
+      forget(h, body_pairs_.twist[k]);
       return out;
     }
     const ElementContact ec =
         element_pair_contact(*a.core, {a.position, a.orientation}, a.crust, *b.core,
                              {b.position, b.orientation}, b.crust, &body_pairs_.warm[k]);
     if (!ec.touching) {
-      if (h.normal.x != 0.0 || h.normal.y != 0.0 || h.normal.z != 0.0) h = ContactHistory{};
-      body_pairs_.twist[k] = 0.0;
+      forget(h, body_pairs_.twist[k]);
       return out;
     }
     // Built only for the patch model (the struct is 1 kB, zeroed when made).
-    std::optional<geometry::ContactPatch> patch;
-    if (setup_.contact_patches &&
-        !element_pair_patch(*a.core, {a.position, a.orientation}, a.crust, *b.core,
-                            {b.position, b.orientation}, b.crust, ec, patch.emplace())) {
-      patch.reset();
-    }
+    const auto patch = setup_.contact_patches
+                           ? element_pair_patch(*a.core, {a.position, a.orientation}, a.crust,
+                                                *b.core, {b.position, b.orientation}, b.crust, ec)
+                           : std::nullopt;
     const auto vj = [&](const Vec3& point) { return v[j] + cross(w[j], point - xj); };
     element_response(
         i, ec, patch ? &*patch : nullptr, vj, w[j], &xj,
@@ -359,16 +363,14 @@ void DemSimulation::compute_forces() {
                                     {a.position, a.orientation}, a.crust, &body_walls_.warm[k]);
     }
     if (!ec.touching) {
-      if (h.normal.x != 0.0 || h.normal.y != 0.0 || h.normal.z != 0.0) h = ContactHistory{};
-      body_walls_.twist[k] = 0.0;
+      forget(h, body_walls_.twist[k]);
       return out;
     }
-    std::optional<geometry::ContactPatch> patch;
-    if (setup_.contact_patches &&
-        !element_obstacle_patch(obstacle, body_walls_.element_second[k], now, *a.core,
-                                {a.position, a.orientation}, a.crust, ec, patch.emplace())) {
-      patch.reset();
-    }
+    const auto patch = setup_.contact_patches
+                           ? element_obstacle_patch(obstacle, body_walls_.element_second[k], now,
+                                                    *a.core, {a.position, a.orientation}, a.crust,
+                                                    ec)
+                           : std::nullopt;
     const ObstacleMotion& m = obstacle.motion;
     const auto wall_velocity = [&](const Vec3& point) {
       return m.is_static() ? Vec3{} : m.velocity_at(now, point);
