@@ -3,6 +3,7 @@
 # already present it does nothing (no apt-get update, no network).
 #   scripts/install-deps.sh            build + test + validation plots
 #   scripts/install-deps.sh --bench    also the peer codes used by bench/ (LAMMPS, Gerris)
+#   scripts/install-deps.sh --clang    also Clang and its OpenMP runtime (CXX=clang++ builds)
 set -euo pipefail
 
 packages=(
@@ -11,9 +12,12 @@ packages=(
   libp4est-dev libopenmpi-dev openmpi-bin
   python3 python3-numpy python3-matplotlib
 )
-if [[ "${1:-}" == "--bench" ]]; then
-  packages+=(lammps gerris)
-fi
+case "${1:-}" in
+  --bench) packages+=(lammps gerris) ;;
+  --clang) packages+=(clang libomp-dev) ;;
+  "") ;;
+  *) echo "install-deps: unknown option '$1' (expected --bench or --clang)" >&2; exit 2 ;;
+esac
 
 missing=()
 for p in "${packages[@]}"; do

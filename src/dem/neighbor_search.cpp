@@ -9,7 +9,7 @@
 namespace sanguis::dem {
 
 NeighborSearch::NeighborSearch(const Domain& domain, double skin, double max_radius)
-    : domain_(domain), skin_(skin), max_radius_(max_radius) {
+    : domain_(domain), skin_(skin) {
   const double cutoff = 2.0 * max_radius + skin;
   const Vec3 length = domain.length();
   for (int k = 0; k < 3; ++k) {

@@ -69,7 +69,6 @@ class NeighborSearch {
 
   Domain domain_;
   double skin_ = 0.0;
-  double max_radius_ = 0.0;
   std::array<std::int64_t, 3> cells_{1, 1, 1};
   Vec3 cell_size_;
   std::vector<std::uint32_t> cell_start_;          // CSR offsets, size n_cells + 1

@@ -134,6 +134,8 @@ void for_each_particle(const ParticleStore& p, int threads, Body&& body) {
 }
 
 // Plain pointers to the per-particle arrays the integrators use, taken once per pass.
+// The loops read them as m.x[i], not through a structured binding: clang before 16
+// (Debian 12 ships 14) cannot capture structured bindings in a lambda.
 struct MotionArrays {
   Vec3* x;
   Vec3* v;
@@ -169,17 +171,17 @@ inline Vec3 gravity_on(double inverse_mass, const Vec3& gravity) {
 
 void TimeIntegrator::advance(ParticleStore& p, const Vec3& gravity, double dt) {
   const std::size_t n = p.size();
-  const auto [x, v, w, q, f, t, inv_m, inv_j, j_body, sphere] = motion_arrays(p);
+  const MotionArrays m = motion_arrays(p);
 
   switch (kind_) {
     case IntegratorKind::kForwardEuler:  // eq. 2.30
       for_each_particle(p, threads_, [&](std::size_t i, auto all_spheres) {
-        x[i] += dt * v[i];
-        v[i] += dt * (inv_m[i] * f[i] + gravity_on(inv_m[i], gravity));
-        if (all_spheres || sphere[i]) {
-          w[i] += (dt * inv_j[i].x) * t[i];
+        m.x[i] += dt * m.v[i];
+        m.v[i] += dt * (m.inv_m[i] * m.f[i] + gravity_on(m.inv_m[i], gravity));
+        if (all_spheres || m.sphere[i]) {
+          m.w[i] += (dt * m.inv_j[i].x) * m.t[i];
         } else {
-          rotate_first_order(q[i], w[i], t[i], j_body[i], inv_j[i], dt);
+          rotate_first_order(m.q[i], m.w[i], m.t[i], m.j_body[i], m.inv_j[i], dt);
         }
       });
       break;
@@ -189,26 +191,26 @@ void TimeIntegrator::advance(ParticleStore& p, const Vec3& gravity, double dt) {
       Vec3* half_v = half_velocity_.data();
       Vec3* half_w = half_angular_velocity_.data();
       for_each_particle(p, threads_, [&](std::size_t i, auto all_spheres) {
-        const Vec3 kick = (0.5 * dt) * (inv_m[i] * f[i] + gravity_on(inv_m[i], gravity));
-        half_v[i] = v[i] + kick;
-        x[i] += dt * half_v[i];
+        const Vec3 kick = (0.5 * dt) * (m.inv_m[i] * m.f[i] + gravity_on(m.inv_m[i], gravity));
+        half_v[i] = m.v[i] + kick;
+        m.x[i] += dt * half_v[i];
         // The forces at x_{n+1} see the predicted v_{n+1} = v_n + dt a_n rather than
         // v_{n+1/2}: with velocity-dependent (damping) forces this keeps the scheme
         // second order (the half-step velocity makes it first order, see Fig. 2.5 report).
-        v[i] = half_v[i] + kick;
-        if (all_spheres || sphere[i]) {
-          const Vec3 spin = (0.5 * dt * inv_j[i].x) * t[i];
-          half_w[i] = w[i] + spin;
-          w[i] = half_w[i] + spin;
+        m.v[i] = half_v[i] + kick;
+        if (all_spheres || m.sphere[i]) {
+          const Vec3 spin = (0.5 * dt * m.inv_j[i].x) * m.t[i];
+          half_w[i] = m.w[i] + spin;
+          m.w[i] = half_w[i] + spin;
         } else {
           // Half kick of the body-frame angular momentum, free rotation over dt (DLM), and
           // the predicted omega_{n+1} for the forces; finish() applies the second half kick.
-          Vec3 lb = scale(j_body[i], rotate_inverse(q[i], w[i])) +
-                    (0.5 * dt) * rotate_inverse(q[i], t[i]);
-          free_rotation(q[i], lb, dt, inv_j[i]);
+          Vec3 lb = scale(m.j_body[i], rotate_inverse(m.q[i], m.w[i])) +
+                    (0.5 * dt) * rotate_inverse(m.q[i], m.t[i]);
+          free_rotation(m.q[i], lb, dt, m.inv_j[i]);
           half_w[i] = lb;  // body-frame angular momentum L_{n+1/2}
-          const Vec3 lb_predicted = lb + (0.5 * dt) * rotate_inverse(q[i], t[i]);
-          w[i] = rotate(q[i], scale(inv_j[i], lb_predicted));
+          const Vec3 lb_predicted = lb + (0.5 * dt) * rotate_inverse(m.q[i], m.t[i]);
+          m.w[i] = rotate(m.q[i], scale(m.inv_j[i], lb_predicted));
         }
       });
       break;
@@ -223,18 +225,18 @@ void TimeIntegrator::advance(ParticleStore& p, const Vec3& gravity, double dt) {
       const int max_order = kind_ == IntegratorKind::kAdamsBashforth2 ? 2 : 3;
       const int order = std::min(max_order, h.depth + 1);
       for_each_particle(p, threads_, [&](std::size_t i, auto all_spheres) {
-        const Vec3 a = inv_m[i] * f[i] + gravity_on(inv_m[i], gravity);
-        const Vec3 alpha = inv_j[i].x * t[i];  // spheres only; bodies below
-        const Vec3 v_now = v[i];
-        const Vec3 w_now = w[i];
-        x[i] += ab_increment(order, dt, v_now, h.velocity[0][i], h.velocity[1][i]);
-        v[i] += ab_increment(order, dt, a, h.acceleration[0][i], h.acceleration[1][i]);
-        if (all_spheres || sphere[i]) {
-          w[i] += ab_increment(order, dt, alpha, h.angular_acceleration[0][i],
-                               h.angular_acceleration[1][i]);
+        const Vec3 a = m.inv_m[i] * m.f[i] + gravity_on(m.inv_m[i], gravity);
+        const Vec3 alpha = m.inv_j[i].x * m.t[i];  // spheres only; bodies below
+        const Vec3 v_now = m.v[i];
+        const Vec3 w_now = m.w[i];
+        m.x[i] += ab_increment(order, dt, v_now, h.velocity[0][i], h.velocity[1][i]);
+        m.v[i] += ab_increment(order, dt, a, h.acceleration[0][i], h.acceleration[1][i]);
+        if (all_spheres || m.sphere[i]) {
+          m.w[i] += ab_increment(order, dt, alpha, h.angular_acceleration[0][i],
+                                 h.angular_acceleration[1][i]);
         } else {
           // Non-spherical bodies rotate with the first-order scheme of §2.5.2.
-          rotate_first_order(q[i], w[i], t[i], j_body[i], inv_j[i], dt);
+          rotate_first_order(m.q[i], m.w[i], m.t[i], m.j_body[i], m.inv_j[i], dt);
         }
         h.velocity[1][i] = h.velocity[0][i];
         h.acceleration[1][i] = h.acceleration[0][i];
@@ -278,17 +280,17 @@ void TimeIntegrator::permute(std::span<const std::uint32_t> order) {
 
 void TimeIntegrator::finish(ParticleStore& p, const Vec3& gravity, double dt) {
   if (kind_ != IntegratorKind::kLeapfrog) return;
-  const auto [x, v, w, q, f, t, inv_m, inv_j, j_body, sphere] = motion_arrays(p);
+  const MotionArrays m = motion_arrays(p);
   const Vec3* half_v = half_velocity_.data();
   const Vec3* half_w = half_angular_velocity_.data();
   // The final half kick with a_{n+1}.
   for_each_particle(p, threads_, [&](std::size_t i, auto all_spheres) {
-    v[i] = half_v[i] + (0.5 * dt) * (inv_m[i] * f[i] + gravity_on(inv_m[i], gravity));
-    if (all_spheres || sphere[i]) {
-      w[i] = half_w[i] + (0.5 * dt * inv_j[i].x) * t[i];
+    m.v[i] = half_v[i] + (0.5 * dt) * (m.inv_m[i] * m.f[i] + gravity_on(m.inv_m[i], gravity));
+    if (all_spheres || m.sphere[i]) {
+      m.w[i] = half_w[i] + (0.5 * dt * m.inv_j[i].x) * m.t[i];
     } else {
-      const Vec3 lb = half_w[i] + (0.5 * dt) * rotate_inverse(q[i], t[i]);
-      w[i] = rotate(q[i], scale(inv_j[i], lb));
+      const Vec3 lb = half_w[i] + (0.5 * dt) * rotate_inverse(m.q[i], m.t[i]);
+      m.w[i] = rotate(m.q[i], scale(m.inv_j[i], lb));
     }
   });
 }

@@ -914,7 +914,9 @@ void Multigrid::coarse_solve() {
     return;
   }
   Level& c = levels_.back();
-  const auto [nx, ny, nz] = coarse_n_;
+  // Named copies, not a structured binding: the lambda below reads them, and clang
+  // before 16 (Debian 12 ships 14) cannot capture structured bindings.
+  const std::int64_t nx = coarse_n_[0], ny = coarse_n_[1], nz = coarse_n_[2];
   const auto cells = static_cast<std::size_t>(nx * ny * nz);
   std::vector<double> rhs(cells, 0.0);
   auto cell = [&](const std::array<std::int64_t, 3>& p) {

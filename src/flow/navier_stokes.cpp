@@ -60,7 +60,9 @@ inline void bcg_face_row(const double* f, std::ptrdiff_t row, int n, const Strid
   const std::ptrdiff_t sd = s[D(Dir)], sa = s[D(Ea)], sb = s[D(Eb)];
   // `store` writes an array that no callback reads (face values or fluxes):
   // without this, the aliasing tests needed exceed what GCC will version.
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC ivdep
+#endif
   for (std::ptrdiff_t c = row; c < row + n; ++c) {
     const double un = normal(c);
     const bool positive = un > 0.0;
@@ -1425,7 +1427,9 @@ StepReport NavierStokes::step(double dt) {
       const bool shut_hi = prescribed[D(face_index(Dir, 1))];
       for_each_row(L, [&](std::ptrdiff_t row, int j, int k) {
       // g and u are written, neither read at another cell.
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC ivdep
+#endif
         for (int i = 0; i < b; ++i) {
           const std::ptrdiff_t c = row + i;
           const int n = Dir == 0 ? i : (Dir == 1 ? j : k);

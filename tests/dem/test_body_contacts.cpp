@@ -532,7 +532,7 @@ TEST(BodyContacts, PatchOnAnEdgeIsThePointLawAtTheMiddleOfTheEdge) {
   // is eq. 2.5 with the edge's overlap, as a single point there would give.
   const BoxOnPlane b = box_on_plane(0.1, 1e-7);
   ASSERT_TRUE(b.flat);
-  ContactHistory h, h_point;
+  ContactHistory h;
   double twist = 0.0;
   const ElementResponse r = respond(b, patch_law(), {}, h, twist, 1e-6);
   EXPECT_NEAR(r.response.normal_force, 4.5e5 * 1e-7, 1e-9 * 4.5e5 * 1e-7);

@@ -346,7 +346,7 @@ std::pair<double, double> masked_channel(int level) {
   for (int s = 0; s < 300; ++s) ns.step(ns.stable_dt());
   const int b = forest.block_cells();
   const double h = forest.block(0).length / b;
-  double flux = 0.0, inside = 0.0, area = 0.0;
+  double flux = 0.0, inside = 0.0;
   for (int blk = 0; blk < forest.local_blocks(); ++blk)
     for (int k = 0; k < b; ++k)
       for (int j = 0; j < b; ++j)
@@ -358,7 +358,6 @@ std::pair<double, double> masked_channel(int level) {
           } else {
             flux += u * h * h * h;  // volume integral of u = flow rate x length x depth
           }
-          area += h * h * h;
         }
   const double length_depth = 0.5 * 0.5;
   const double rate = forest.sum(flux) / length_depth;

@@ -53,7 +53,6 @@ using namespace sanguis::flow;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kSigma = 0.05;
 constexpr double kSwirl = 0.5;  // peak swirl speed (m/s), at r = sigma
 const Vec3 kStream{1.0, 0.0, 0.0};
