@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <charconv>
@@ -192,6 +193,10 @@ struct Job {
   fs::path log;
   fs::path start_from;   // not empty: the run folder starts as a copy of this one
   fs::path done_record;  // not empty: written with the command line once the run succeeded
+  // Not empty: written with the command line when the run starts, so that a later
+  // call can tell an interrupted run of the same command (see interrupted()).
+  fs::path started_record;
+  bool resume = false;  // continue the run folder from its own checkpoint, no fresh start
 };
 
 // The arguments that decide what a run computes: all but the program and the
@@ -215,6 +220,27 @@ bool already_done(const Job& job) {
   std::string line;
   std::getline(in, line);
   return line == command_line(job.argv);
+}
+
+// A job whose run started with exactly this command line and stopped before it
+// finished (a killed call, a closed session) but left a checkpoint: continuing
+// from it gives the bits of one uninterrupted run, as `sanguis run --restart` does.
+bool interrupted(const Job& job) {
+  if (job.started_record.empty() || !fs::exists(job.started_record)) return false;
+  if (!fs::exists(job.log.parent_path() / "checkpoint.bin")) return false;
+  std::ifstream in(job.started_record);
+  std::string line;
+  std::getline(in, line);
+  return line == command_line(job.argv);
+}
+
+// The command line of a resumed job: its own, continued from the run's checkpoint.
+std::vector<std::string> resumed_argv(const Job& job) {
+  std::vector<std::string> argv = job.argv;
+  if (std::find(argv.begin(), argv.end(), "--restart") == argv.end()) {
+    argv.insert(argv.begin() + 2, "--restart");  // after "sanguis run"
+  }
+  return argv;
 }
 
 // The running children, for the signal handler below (async-signal-safe: a
@@ -289,21 +315,31 @@ void run_jobs(const char* self, const std::vector<Job>& jobs, int parallel) {
     if (next < jobs.size() && static_cast<int>(running.size()) < parallel) {
       const Job& job = jobs[next];
       if (!job.done_record.empty()) fs::remove(job.done_record);
-      if (!job.start_from.empty()) {
+      if (!job.start_from.empty() && !job.resume) {
         const fs::path run = job.log.parent_path();
         fs::remove_all(run);
         fs::create_directories(run.parent_path());
         fs::copy(job.start_from, run, fs::copy_options::recursive);
-        if (!job.done_record.empty()) fs::remove(job.done_record);  // the source's own
+        // the source's own records
+        for (const fs::path& record : {job.done_record, job.started_record}) {
+          if (!record.empty()) fs::remove(record);
+        }
       }
       fs::create_directories(job.log.parent_path());
+      if (!job.started_record.empty() && !job.resume) {
+        io::write_file_atomically(
+            job.started_record, [&](std::ostream& out) { out << command_line(job.argv) << "\n"; });
+      }
       posix_spawn_file_actions_t actions;
       posix_spawn_file_actions_init(&actions);
+      // A resumed run appends to its console log: the earlier part stays readable.
       posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, job.log.c_str(),
-                                       O_WRONLY | O_CREAT | O_TRUNC, 0644);
+                                       O_WRONLY | O_CREAT | (job.resume ? O_APPEND : O_TRUNC),
+                                       0644);
       posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+      const std::vector<std::string> args = job.resume ? resumed_argv(job) : job.argv;
       std::vector<char*> argv;
-      for (const std::string& a : job.argv) argv.push_back(const_cast<char*>(a.c_str()));
+      for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
       argv.push_back(nullptr);
       pid_t pid = 0;
       const int rc = posix_spawn(&pid, self, &actions, nullptr, argv.data(), environ);
@@ -423,7 +459,7 @@ int run_calibrate(const char* self, const CalibrateArgs& args) {
                             : fs::path(args.output);
   std::vector<Job> jobs;
   std::vector<std::vector<fs::path>> runs(args.values.size());
-  std::size_t reused = 0;
+  std::size_t reused = 0, resumed = 0;
   for (std::size_t i = 0; i < args.values.size(); ++i) {
     // The shortest text that reads back as the same double: exact in --set,
     // and a readable folder name (0.8, not 0.80000000000000004).
@@ -438,9 +474,12 @@ int run_calibrate(const char* self, const CalibrateArgs& args) {
       runs[i].push_back(root / ("value_" + value) / ("seed_" + std::to_string(seed)));
       Job job = run_job(args.case_file, runs[i].back(), seed, overrides, args.from);
       job.done_record = runs[i].back() / "calibration_run.txt";
+      job.started_record = runs[i].back() / "calibration_started.txt";
       if (args.reuse && already_done(job)) {
         ++reused;
       } else {
+        job.resume = args.reuse && interrupted(job);
+        resumed += job.resume ? 1 : 0;
         jobs.push_back(std::move(job));
       }
     }
@@ -450,9 +489,9 @@ int run_calibrate(const char* self, const CalibrateArgs& args) {
   std::string csv_keys;
   for (const std::string& key : args.parameters) csv_keys += (csv_keys.empty() ? "" : "+") + key;
   std::printf(
-      "sanguis calibrate: %s over %zu values x %d seeds = %zu runs (%zu reused), %d at a "
-      "time%s\n",
-      keys.c_str(), args.values.size(), seeds, jobs.size() + reused, reused,
+      "sanguis calibrate: %s over %zu values x %d seeds = %zu runs (%zu reused, %zu resumed), "
+      "%d at a time%s\n",
+      keys.c_str(), args.values.size(), seeds, jobs.size() + reused, reused, resumed,
       default_jobs(args.jobs),
       args.from.empty() ? "" : (", each continued from " + args.from).c_str());
   std::fflush(stdout);  // the header before the children's progress
@@ -601,7 +640,8 @@ std::function<bool()> add_analysis_commands(CLI::App& app) {
       ->check(CLI::ExistingDirectory);
   ca->add_flag("--reuse", calibrate->reuse,
                "keep the runs that already finished with the same command line "
-               "(VALUE_i/SEED_k/calibration_run.txt) instead of running them again");
+               "(VALUE_i/SEED_k/calibration_run.txt) instead of running them again, and "
+               "continue those it started but did not finish from their last checkpoint");
 
   auto* sl = app.add_subcommand(
       "slice", "a plane slice of a flow run as PNG and CSV (speed, pressure, vorticity...)");

@@ -544,6 +544,15 @@ std::int64_t steps_for(double duration, double dt) {
   return std::max<std::int64_t>(1, std::llround(duration / dt));
 }
 
+// run.log's record of a checkpoint written on the way, in the form of the `done:`
+// line (the time to 10 digits, the wall time of this segment so far).
+std::string checkpoint_line(double time, std::int64_t steps, const ProgressReporter& progress) {
+  std::ostringstream line;
+  line << "checkpoint: t = " << std::setprecision(10) << time << " s, " << steps << " steps in "
+       << ProgressReporter::format_duration(progress.elapsed_seconds()) << "\n";
+  return line.str();
+}
+
 }  // namespace
 
 RunSummary run_dem_case(const DemCase& c, const RunOptions& options, std::ostream& console) {
@@ -676,7 +685,12 @@ RunSummary run_dem_case(const DemCase& c, const RunOptions& options, std::ostrea
       const std::int64_t s = sim.step_index();
       const bool output_now = s % output_every == 0;
       if (output_now) record();
-      if (checkpoint_every > 0 && s % checkpoint_every == 0) save_checkpoint();
+      if (checkpoint_every > 0 && s % checkpoint_every == 0) {
+        save_checkpoint();
+        // A run killed later continues from here (--restart): the line tells scripts
+        // how far it got and what the kept part cost (validation/dem/_outputs.py).
+        if (root) log << checkpoint_line(sim.time(), s - first_step, progress) << std::flush;
+      }
       if (output_now && c.stop.mean_velocity_below && s >= settle_after &&
           diagnostics().mean_velocity < *c.stop.mean_velocity_below) {
         summary.settled = true;

@@ -188,7 +188,7 @@ TEST_F(AnalysisCommandTest, CalibrateContinuesFromAPreparedStateAndReusesRuns) {
   const std::string common = calibrate("0.1,0.8", prepared);
   const CommandResult c = sanguis(common);
   ASSERT_EQ(c.code, 0) << c.err << c.out;
-  EXPECT_NE(c.out.find("(0 reused)"), std::string::npos) << c.out;
+  EXPECT_NE(c.out.find("(0 reused, 0 resumed)"), std::string::npos) << c.out;
   const fs::path run = root / "value_0.8" / "seed_1";
   // The run holds the prepared frames unchanged and continues them with both keys set.
   EXPECT_EQ(read_text_file(run / "particles" / "particles_00000000.vtu"),
@@ -206,13 +206,13 @@ TEST_F(AnalysisCommandTest, CalibrateContinuesFromAPreparedStateAndReusesRuns) {
 
   const CommandResult again = sanguis(common + " --reuse");
   ASSERT_EQ(again.code, 0) << again.err;
-  EXPECT_NE(again.out.find("(2 reused)"), std::string::npos) << again.out;
+  EXPECT_NE(again.out.find("(2 reused, 0 resumed)"), std::string::npos) << again.out;
   EXPECT_EQ(read_text_file(run / "run.log"), log);  // not run again
   EXPECT_EQ(read_text_file(root / "calibration.csv"), table);
   // A value added: the others are kept.
   const CommandResult changed = sanguis(calibrate("0.1,0.5,0.8", prepared) + " --reuse");
   ASSERT_EQ(changed.code, 0) << changed.err;
-  EXPECT_NE(changed.out.find("(2 reused)"), std::string::npos) << changed.out;
+  EXPECT_NE(changed.out.find("(2 reused, 0 resumed)"), std::string::npos) << changed.out;
   EXPECT_EQ(read_text_file(run / "run.log"), log);
   EXPECT_NE(read_text_file(root / "value_0.5" / "seed_1" / "run.log").find("mu_c = 0.5"),
             std::string::npos);
@@ -220,7 +220,7 @@ TEST_F(AnalysisCommandTest, CalibrateContinuesFromAPreparedStateAndReusesRuns) {
   const CommandResult other = sanguis(calibrate("0.1,0.8", prepared) +
                                       " --reuse --set interaction[0].rolling_friction=0.1");
   ASSERT_EQ(other.code, 0) << other.err;
-  EXPECT_NE(other.out.find("(0 reused)"), std::string::npos) << other.out;
+  EXPECT_NE(other.out.find("(0 reused, 0 resumed)"), std::string::npos) << other.out;
 
   const CommandResult seeds = sanguis(common + " --seeds 2");
   EXPECT_EQ(seeds.code, 2);
@@ -228,6 +228,66 @@ TEST_F(AnalysisCommandTest, CalibrateContinuesFromAPreparedStateAndReusesRuns) {
   const CommandResult empty = sanguis(calibrate("0.1,0.8", dir_));
   EXPECT_EQ(empty.code, 2);
   EXPECT_NE(empty.err.find("no checkpoint.bin"), std::string::npos) << empty.err;
+}
+
+// A calibration stopped part-way (a killed call, an ended session) goes on with
+// --reuse from the checkpoint its unfinished run left, to the bits of a run that
+// was never stopped; a run whose command changed starts afresh.
+TEST_F(AnalysisCommandTest, CalibrateResumesAnInterruptedRunToTheSameBits) {
+  const fs::path prepared = dir_ / "prepared";
+  ASSERT_EQ(sanguis("run " + kTinyCase + " --quiet --threads 1 -o " +
+                    shell_quoted(prepared.string()) + " --set simulation.end_time_s=0.2")
+                .code,
+            0);
+  const std::string friction =
+      " --set interaction[0].friction=0.8 --set "
+      "interaction[1].friction=0.8";
+  const auto calibrate = [&](const fs::path& root) {
+    return "calibrate " + kTinyCase +
+           " --parameter interaction[0].friction,interaction[1].friction --values 0.1,0.8"
+           " --measure Linf_m --target 0.05 --jobs 2 --set simulation.end_time_s=0.45 -o " +
+           shell_quoted(root.string()) + " --from " + shell_quoted(prepared.string());
+  };
+  const fs::path whole = dir_ / "whole";
+  ASSERT_EQ(sanguis(calibrate(whole)).code, 0);
+  const fs::path whole_run = whole / "value_0.8" / "seed_1";
+  const std::string command = read_text_file(whole_run / "calibration_run.txt");
+  EXPECT_EQ(read_text_file(whole_run / "calibration_started.txt"), command);
+
+  // The state a call stopped at 0.3 s leaves: the run continued from the
+  // prepared state with the same settings, its start recorded, no finish.
+  const fs::path stopped = dir_ / "stopped";
+  const fs::path run = stopped / "value_0.8" / "seed_1";
+  fs::create_directories(run.parent_path());
+  fs::copy(prepared, run, fs::copy_options::recursive);
+  ASSERT_EQ(sanguis("run " + kTinyCase + " --restart --quiet --threads 1 -o " +
+                    shell_quoted(run.string()) + friction + " --set simulation.end_time_s=0.3")
+                .code,
+            0);
+  {
+    std::ofstream record(run / "calibration_started.txt");
+    record << command;
+  }
+  const CommandResult resumed = sanguis(calibrate(stopped) + " --reuse");
+  ASSERT_EQ(resumed.code, 0) << resumed.err;
+  EXPECT_NE(resumed.out.find("(0 reused, 1 resumed)"), std::string::npos) << resumed.out;
+  const std::string log = read_text_file(run / "run.log");
+  EXPECT_NE(log.find("restart from checkpoint at t = 0.300"), std::string::npos) << log;
+  EXPECT_EQ(read_text_file(run / "checkpoint.bin"), read_text_file(whole_run / "checkpoint.bin"));
+  EXPECT_EQ(read_text_file(run / "calibration_run.txt"), command);
+  EXPECT_EQ(read_text_file(stopped / "calibration.csv"), read_text_file(whole / "calibration.csv"));
+
+  // A started record of another command: not resumed, run afresh from --from.
+  {
+    std::ofstream record(run / "calibration_started.txt");
+    record << "run something else\n";
+  }
+  fs::remove(run / "calibration_run.txt");
+  const CommandResult fresh = sanguis(calibrate(stopped) + " --reuse");
+  ASSERT_EQ(fresh.code, 0) << fresh.err;
+  EXPECT_NE(fresh.out.find("(1 reused, 0 resumed)"), std::string::npos) << fresh.out;
+  EXPECT_EQ(read_text_file(run / "run.log").find("at t = 0.300"), std::string::npos);
+  EXPECT_EQ(read_text_file(run / "checkpoint.bin"), read_text_file(whole_run / "checkpoint.bin"));
 }
 
 // Processes whose command line mentions `text` (a scan of /proc).

@@ -79,23 +79,39 @@ def calibration_value_folder(calibration_dir, value):
 
 
 def finished_segments(run):
-    """(simulated end time [s], wall-clock seconds) of each segment of the run that
-    finished: the `done:` lines of its run.log (a restarted run has one per segment)."""
+    """(simulated end time [s], wall-clock seconds) of each segment of the run: the `done:`
+    lines of its run.log (a restarted run has one per segment). A segment that was
+    stopped on the way (a killed call, an ended session) counts up to its last
+    `checkpoint:` line, the part a restart keeps; what it ran past that is lost and not
+    counted."""
     path = os.path.join(run, "run.log")
     if not os.path.exists(path):
         return
     units = {"h": 3600, "m": 60, "s": 1}
+    kept = None  # the last checkpoint of the segment being read
     with open(path) as f:
         for line in f:
-            m = re.search(r"steps in (\S+) \(", line)
+            if line.startswith("--- restart") and kept:
+                yield kept
+                kept = None
+            m = re.search(r"steps in (\S+)", line)
             end = re.search(r"t = (\S+) s", line)
-            if line.startswith("done:") and m and end:
-                yield (float(end.group(1)),
+            if not (m and end) or not line.startswith(("done:", "checkpoint:")):
+                continue
+            segment = (float(end.group(1)),
                        sum(int(n) * units[u] for n, u in re.findall(r"(\d+)([hms])", m.group(1))))
+            if line.startswith("done:"):
+                yield segment
+                kept = None
+            else:
+                kept = segment
+    if kept:
+        yield kept
 
 
 def reached_time(run):
-    """The latest simulated time [s] a segment of the run finished at, 0 when none did."""
+    """The latest simulated time [s] a segment of the run finished or left a checkpoint at,
+    0 when none did."""
     return max((end for end, _ in finished_segments(run)), default=0.0)
 
 
@@ -120,6 +136,50 @@ def run_pour(cmd, out, end_s, rerun=False):
     if command:
         subprocess.run(command, check=True)
     return bool(command)
+
+
+def command_record(cmd):
+    """A `sanguis run` command as its folder's record keeps it: without the program and the
+    output folder, which do not change what it computes."""
+    kept, skip = [], False
+    for arg in cmd[1:]:
+        if skip:
+            skip = False
+        elif arg in ("--output", "-o"):
+            skip = True
+        else:
+            kept.append(arg)
+    return " ".join(kept)
+
+
+def continuation_command(cmd, out, start_from, after_s):
+    """The command that takes `out`, a run continued from the run folder `start_from` (a
+    pour) past after_s [s], to its end, or None when an earlier call got there. `cmd`: the
+    `sanguis run ... --restart` of it. A continuation stopped on the way (a killed call, an
+    ended session) goes on from its own checkpoint, the bits of one uninterrupted run, when
+    its record (continuation.txt, written when it started) shows the same command;
+    otherwise the folder starts again as a copy of `start_from`."""
+    record = os.path.join(out, "continuation.txt")
+    line = command_record(cmd)
+    if (os.path.exists(record) and open(record).read().strip() == line
+            and os.path.exists(os.path.join(out, "checkpoint.bin"))):
+        return None if any(t > after_s + 1e-9 for t in done_times(out)) else cmd
+    shutil.rmtree(out, ignore_errors=True)
+    shutil.copytree(start_from, out)
+    with open(record, "w") as f:
+        f.write(line + "\n")
+    return cmd
+
+
+def done_times(run):
+    """The simulated end time [s] of each `done:` line of the run's log: the segments that
+    ran to their end (or stopped at rest)."""
+    path = os.path.join(run, "run.log")
+    if not os.path.exists(path):
+        return []
+    with open(path) as f:
+        return [float(m.group(1)) for m in (re.match(r"done: t = (\S+) s", line) for line in f)
+                if m]
 
 
 def wall_time(run, after=-1.0):

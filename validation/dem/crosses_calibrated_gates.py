@@ -104,12 +104,18 @@ def finished(out, tangential, opening):
 
 def collapse(exe, gate, pour, out, opening, threads, tangential=(KT, GAMMA_T), seed=SEED):
     """The collapse from the pour's state with the tangential (kt, gamma_t) given (None:
-    the case's Table 3.1), stopped at rest. A folder without its completion mark (a
-    stopped run) is made again from the pour."""
+    the case's Table 3.1), stopped at rest. A collapse stopped on the way (a killed call,
+    an ended session) goes on from its checkpoint when its start record shows the same
+    settings; otherwise the folder is made again from the pour."""
     if finished(out, tangential, opening):
         return
-    shutil.rmtree(out, ignore_errors=True)
-    shutil.copytree(pour, out)
+    started = os.path.join(out, "collapse_started.txt")
+    if not (os.path.exists(started) and os.path.exists(os.path.join(out, "checkpoint.bin"))
+            and open(started).read().strip() == completion_mark(tangential, opening)):
+        shutil.rmtree(out, ignore_errors=True)
+        shutil.copytree(pour, out)
+        with open(started, "w") as f:
+            f.write(completion_mark(tangential, opening) + "\n")
     advance = gate_runner(exe, gate, out, threads,
                           extra=seed_settings(seed)
                           + (tangential_settings(*tangential) if tangential else [])

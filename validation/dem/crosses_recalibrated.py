@@ -26,13 +26,14 @@ calibration reports its nearest run instead and no run is added.
 
 Writes validation/dem/results/crosses_recalibrated.json and
 docs/validation/figures/crosses_recalibrated.png. `--reuse`: analyse the runs on disk.
+A call stopped on the way (the case takes hours) keeps its work: called again, it goes
+on from the checkpoints its unfinished runs left, to the bits of one uninterrupted call.
 Usage: /usr/bin/python3 validation/dem/crosses_recalibrated.py [--build build]
            [--threads T] [--reuse]
 """
 import argparse
 import csv
 import os
-import shutil
 import subprocess
 import sys
 import time
@@ -40,8 +41,8 @@ import time
 import matplotlib
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import (calibration_value_folder, read_summary, regime_name,  # noqa: E402
-                      run_pour, wall_time, write_summary)
+from _outputs import (calibration_value_folder, continuation_command, read_summary,  # noqa: E402
+                      regime_name, run_pour, wall_time, write_summary)
 from crosses_dam_break import (CASE, RESULTS, ROOT, diagnostics,  # noqa: E402
                                draw_velocity_bands, lajeunesse, opening_time, velocity_curve)
 from crosses_tangential_map import tangential_settings  # noqa: E402
@@ -107,16 +108,15 @@ def run_row(label, s, wall_s):
 
 
 def run_calibrated(exe, gamma):
-    """The collapse from the packing at the fitted gamma_t (kt = CALIBRATION_KT)."""
-    done = os.path.join(CALIBRATED, "gamma_t.txt")
-    if os.path.exists(done) and open(done).read().strip() == f"{gamma:g}":
-        return
-    shutil.rmtree(CALIBRATED, ignore_errors=True)
-    shutil.copytree(os.path.join(RUNS, "pour"), CALIBRATED)
-    subprocess.run([exe, "run", CASE, "--output", CALIBRATED, "--restart", "--quiet",
-                    "--threads", "2"] + tangential_settings(CALIBRATION_KT, gamma) + AT_REST,
-                   check=True)
-    with open(done, "w") as f:
+    """The collapse from the packing at the fitted gamma_t (kt = CALIBRATION_KT); one
+    stopped on the way goes on from its checkpoint."""
+    cmd = continuation_command(
+        [exe, "run", CASE, "--output", CALIBRATED, "--restart", "--quiet", "--threads", "2"]
+        + tangential_settings(CALIBRATION_KT, gamma) + AT_REST, CALIBRATED,
+        os.path.join(RUNS, "pour"), OPENING_S)
+    if cmd:
+        subprocess.run(cmd, check=True)
+    with open(os.path.join(CALIBRATED, "gamma_t.txt"), "w") as f:
         f.write(f"{gamma:g}\n")
 
 
@@ -127,11 +127,11 @@ def run_all(exe, threads):
     running = []
     for name, (_, kt, gamma) in RUNS_OF.items():
         out = os.path.join(RUNS, name)
-        shutil.rmtree(out, ignore_errors=True)
-        shutil.copytree(pour, out)
-        cmd = [exe, "run", CASE, "--output", out, "--restart", "--quiet", "--threads", "1"]
         extra = [] if kt is None else tangential_settings(kt, gamma)
-        running.append(subprocess.Popen(cmd + extra))  # one core each
+        cmd = continuation_command([exe, "run", CASE, "--output", out, "--restart", "--quiet",
+                                    "--threads", "1"] + extra, out, pour, OPENING_S)
+        if cmd:  # a continuation stopped on the way goes on from its checkpoint
+            running.append(subprocess.Popen(cmd))  # one core each
     for proc in running:
         if proc.wait() != 0:
             sys.exit("a continuation failed")

@@ -4,6 +4,7 @@ validation script relies on. Run by ctest (ValidationScripts.DemHelpers) or by h
 import base64
 import json
 import os
+import shutil
 import struct
 import sys
 import tempfile
@@ -125,6 +126,24 @@ class RunSegments(unittest.TestCase):
             self.assertEqual(_outputs.wall_time(tmp), 685 + 3900 + 7)
             self.assertEqual(_outputs.wall_time(tmp, after=3.0), 3900 + 7)
 
+    def test_a_stopped_segment_counts_to_its_last_checkpoint(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            write_run_log(tmp, [
+                "done: t = 5 s, 2000000 steps in 1h56m (2.92e+05 particle-steps/s)",
+                "--- restart from checkpoint at t = 5.000000 s",
+                "checkpoint: t = 5.25 s, 100000 steps in 10m00s",
+                "checkpoint: t = 5.5 s, 200000 steps in 20m05s",
+                "--- restart from checkpoint at t = 5.500000 s",  # the call was killed
+                "checkpoint: t = 5.75 s, 100000 steps in 9m30s",
+                "done: t = 6.1 s, 240000 steps in 22m00s (1e+05 particle-steps/s), settled",
+                "--- restart from checkpoint at t = 6.100000 s",
+                "checkpoint: t = 6.35 s, 100000 steps in 11m00s"])  # running, or killed
+            self.assertEqual(list(_outputs.finished_segments(tmp)),
+                             [(5.0, 6960), (5.5, 1205), (6.1, 1320), (6.35, 660)])
+            self.assertEqual(_outputs.reached_time(tmp), 6.35)
+            self.assertEqual(_outputs.wall_time(tmp, after=5.0), 1205 + 1320 + 660)
+            self.assertEqual(_outputs.done_times(tmp), [5.0, 6.1])
+
     def test_a_folder_without_log_has_no_segments(self):
         with tempfile.TemporaryDirectory() as tmp:
             self.assertEqual(list(_outputs.finished_segments(tmp)), [])
@@ -186,6 +205,58 @@ class PourCommand(unittest.TestCase):
             self.assertEqual(_outputs.pour_command(self.CMD, out, 2.4, rerun=True),
                              self.CMD + ["--set", "simulation.end_time_s=2.4"])
             self.assertFalse(os.path.exists(out))
+
+
+class Continuation(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.mkdtemp()
+        self.pour = os.path.join(self.tmp, "pour")
+        write_run_log(self.pour, ["done: t = 5 s, 10 steps in 5s (1 particle-steps/s)"])
+        open(os.path.join(self.pour, "checkpoint.bin"), "w").close()
+        self.out = os.path.join(self.tmp, "collapse")
+        self.cmd = ["/any/build/sanguis", "run", "case.toml", "--output", self.out, "--restart",
+                    "--set", "a=1"]
+
+    def tearDown(self):
+        shutil.rmtree(self.tmp)
+
+    def log_of_out(self):
+        with open(os.path.join(self.out, "run.log")) as f:
+            return f.read()
+
+    def test_the_record_leaves_out_the_program_and_the_output_folder(self):
+        self.assertEqual(_outputs.command_record(self.cmd), "run case.toml --restart --set a=1")
+        self.assertEqual(_outputs.command_record(["x", "run", "-o", "y", "c.toml"]), "run c.toml")
+
+    def test_a_new_continuation_starts_as_a_copy_of_the_pour(self):
+        self.assertEqual(_outputs.continuation_command(self.cmd, self.out, self.pour, 5.0),
+                         self.cmd)
+        self.assertIn("t = 5 s", self.log_of_out())
+        with open(os.path.join(self.out, "continuation.txt")) as f:
+            self.assertEqual(f.read(), "run case.toml --restart --set a=1\n")
+
+    def test_a_stopped_continuation_goes_on_and_a_finished_one_is_kept(self):
+        _outputs.continuation_command(self.cmd, self.out, self.pour, 5.0)
+        with open(os.path.join(self.out, "run.log"), "a") as f:
+            f.write("--- restart from checkpoint at t = 5.000000 s\n"
+                    "checkpoint: t = 5.25 s, 10 steps in 5s\n")
+        # Stopped: the same command, nothing copied over the folder.
+        self.assertEqual(_outputs.continuation_command(self.cmd, self.out, self.pour, 5.0),
+                         self.cmd)
+        self.assertIn("t = 5.25 s", self.log_of_out())
+        with open(os.path.join(self.out, "run.log"), "a") as f:
+            f.write("done: t = 6.5 s, 10 steps in 5s (1 particle-steps/s), settled\n")
+        self.assertIsNone(_outputs.continuation_command(self.cmd, self.out, self.pour, 5.0))
+        # Another command (other settings, not the folder or program): a fresh copy.
+        other = self.cmd[:-1] + ["a=2"]
+        self.assertEqual(_outputs.continuation_command(other, self.out, self.pour, 5.0), other)
+        self.assertNotIn("t = 5.25 s", self.log_of_out())
+        with open(os.path.join(self.out, "run.log"), "a") as f:
+            f.write("checkpoint: t = 5.5 s, 10 steps in 5s\n")
+        # The same settings from another build, with the folder named otherwise: goes on.
+        moved = ["sanguis", "run", "case.toml", "-o", "elsewhere", "--restart", "--set", "a=2"]
+        self.assertEqual(_outputs.continuation_command(moved, self.out, self.pour, 5.0), moved)
+        self.assertIn("t = 5.5 s", self.log_of_out())
 
 
 if __name__ == "__main__":
