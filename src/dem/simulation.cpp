@@ -1256,6 +1256,7 @@ void get_body_list(std::istream& in, BodyContactList& list) {
   get(in, list.element_second);
   get(in, list.history);
   get(in, list.warm);
+  for (geometry::GjkWarmStart& w : list.warm) w.unused = 0;  // an older file's padding
   list.twist.assign(list.first.size(), 0.0);
   const std::size_t n = list.first.size();
   if (list.second.size() != n || list.element_first.size() != n ||

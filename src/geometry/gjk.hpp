@@ -22,6 +22,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include "core/mat3.hpp"
@@ -63,9 +64,16 @@ struct GjkSettings {
 // is nearly the final one and GJK ends in one or two iterations. Valid only
 // for the same two shapes in the same order.
 struct GjkWarmStart {
-  int size = 0;  // 0: cold start
+  std::int32_t size = 0;  // 0: cold start
+  // The four bytes the alignment of on_a leaves, named so that every copy carries
+  // them and they are zero: checkpoints write warm starts as raw bytes, and an
+  // unnamed gap held whatever the stack had (a Clang build's checkpoints then
+  // differed with the thread count while the states were the same bits).
+  std::int32_t unused = 0;
   std::array<Vec3, 4> on_a{}, on_b{};
 };
+static_assert(sizeof(GjkWarmStart) == 2 * sizeof(std::int32_t) + 8 * sizeof(Vec3),
+              "GjkWarmStart has no unnamed padding");
 
 namespace detail {
 
