@@ -213,25 +213,26 @@ std::string command_line(const std::vector<std::string>& argv) {
   return line;
 }
 
-// A job whose record says it already ran with exactly this command line.
-bool already_done(const Job& job) {
-  if (job.done_record.empty() || !fs::exists(job.done_record)) return false;
-  std::ifstream in(job.done_record);
+// A record file (of a job's start or finish) naming exactly the job's command line.
+bool record_names(const fs::path& record, const Job& job) {
+  if (record.empty() || !fs::exists(record)) return false;
+  std::ifstream in(record);
   std::string line;
   std::getline(in, line);
   return line == command_line(job.argv);
+}
+
+// A job whose record says it already ran with exactly this command line.
+bool already_done(const Job& job) {
+  return record_names(job.done_record, job);
 }
 
 // A job whose run started with exactly this command line and stopped before it
 // finished (a killed call, a closed session) but left a checkpoint: continuing
 // from it gives the bits of one uninterrupted run, as `sanguis run --restart` does.
 bool interrupted(const Job& job) {
-  if (job.started_record.empty() || !fs::exists(job.started_record)) return false;
-  if (!fs::exists(job.log.parent_path() / "checkpoint.bin")) return false;
-  std::ifstream in(job.started_record);
-  std::string line;
-  std::getline(in, line);
-  return line == command_line(job.argv);
+  return fs::exists(job.log.parent_path() / "checkpoint.bin") &&
+         record_names(job.started_record, job);
 }
 
 // The command line of a resumed job: its own, continued from the run's checkpoint.

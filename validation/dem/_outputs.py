@@ -152,22 +152,30 @@ def command_record(cmd):
     return " ".join(kept)
 
 
-def continuation_command(cmd, out, start_from, after_s):
-    """The command that takes `out`, a run continued from the run folder `start_from` (a
-    pour) past after_s [s], to its end, or None when an earlier call got there. `cmd`: the
-    `sanguis run ... --restart` of it. A continuation stopped on the way (a killed call, an
-    ended session) goes on from its own checkpoint, the bits of one uninterrupted run, when
-    its record (continuation.txt, written when it started) shows the same command;
-    otherwise the folder starts again as a copy of `start_from`."""
+def continue_or_copy(out, start_from, record_line):
+    """Prepares `out`, a run continued from the run folder `start_from`: True when `out`
+    holds a continuation stopped on the way whose start record (continuation.txt) is
+    `record_line` and a checkpoint, which a restart takes on to the bits of one run;
+    otherwise the folder starts again as a copy of `start_from` with that record (False)."""
     record = os.path.join(out, "continuation.txt")
-    line = command_record(cmd)
-    if (os.path.exists(record) and open(record).read().strip() == line
+    if (os.path.exists(record) and open(record).read().strip() == record_line
             and os.path.exists(os.path.join(out, "checkpoint.bin"))):
-        return None if any(t > after_s + 1e-9 for t in done_times(out)) else cmd
+        return True
     shutil.rmtree(out, ignore_errors=True)
     shutil.copytree(start_from, out)
     with open(record, "w") as f:
-        f.write(line + "\n")
+        f.write(record_line + "\n")
+    return False
+
+
+def continuation_command(cmd, out, start_from, after_s):
+    """The command that takes `out`, a run continued from the run folder `start_from` (a
+    pour) past after_s [s], to its end, or None when an earlier call got there. `cmd`: the
+    `sanguis run ... --restart` of it; a continuation stopped on the way goes on from its
+    own checkpoint (continue_or_copy)."""
+    if continue_or_copy(out, start_from, command_record(cmd)) and \
+            any(t > after_s + 1e-9 for t in done_times(out)):
+        return None
     return cmd
 
 

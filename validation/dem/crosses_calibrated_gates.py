@@ -36,14 +36,14 @@ Usage: /usr/bin/python3 validation/dem/crosses_calibrated_gates.py [--build buil
 import argparse
 import math
 import os
-import shutil
 import subprocess
 import sys
 
 import matplotlib
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import read_summary, regime_name, wall_time, write_summary  # noqa: E402
+from _outputs import (continue_or_copy, read_summary, regime_name, wall_time,  # noqa: E402
+                      write_summary)
 from crosses_dam_break import (CROSSES, GATE_INDEX, RESULTS, ROOT, SEED,  # noqa: E402
                                diagnostics, draw_velocity_bands, gate_runner, lajeunesse,
                                pour_gate, velocity_curve)
@@ -109,13 +109,7 @@ def collapse(exe, gate, pour, out, opening, threads, tangential=(KT, GAMMA_T), s
     settings; otherwise the folder is made again from the pour."""
     if finished(out, tangential, opening):
         return
-    started = os.path.join(out, "collapse_started.txt")
-    if not (os.path.exists(started) and os.path.exists(os.path.join(out, "checkpoint.bin"))
-            and open(started).read().strip() == completion_mark(tangential, opening)):
-        shutil.rmtree(out, ignore_errors=True)
-        shutil.copytree(pour, out)
-        with open(started, "w") as f:
-            f.write(completion_mark(tangential, opening) + "\n")
+    continue_or_copy(out, pour, completion_mark(tangential, opening))
     advance = gate_runner(exe, gate, out, threads,
                           extra=seed_settings(seed)
                           + (tangential_settings(*tangential) if tangential else [])
