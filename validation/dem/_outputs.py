@@ -84,29 +84,57 @@ def finished_segments(run):
     stopped on the way (a killed call, an ended session) counts up to its last
     `checkpoint:` line, the part a restart keeps; what it ran past that is lost and not
     counted."""
+    return _segments(_log_lines(run))
+
+
+def _log_lines(run):
     path = os.path.join(run, "run.log")
     if not os.path.exists(path):
-        return
+        return []
+    with open(path) as f:
+        return f.readlines()
+
+
+def _segments(lines):
+    """finished_segments of these lines of a run.log."""
     units = {"h": 3600, "m": 60, "s": 1}
     kept = None  # the last checkpoint of the segment being read
-    with open(path) as f:
-        for line in f:
-            if line.startswith("--- restart") and kept:
-                yield kept
-                kept = None
-            m = re.search(r"steps in (\S+)", line)
-            end = re.search(r"t = (\S+) s", line)
-            if not (m and end) or not line.startswith(("done:", "checkpoint:")):
-                continue
-            segment = (float(end.group(1)),
-                       sum(int(n) * units[u] for n, u in re.findall(r"(\d+)([hms])", m.group(1))))
-            if line.startswith("done:"):
-                yield segment
-                kept = None
-            else:
-                kept = segment
+    out = []
+    for line in lines:
+        if line.startswith("--- restart") and kept:
+            out.append(kept)
+            kept = None
+        m = re.search(r"steps in (\S+)", line)
+        end = re.search(r"t = (\S+) s", line)
+        if not (m and end) or not line.startswith(("done:", "checkpoint:")):
+            continue
+        segment = (float(end.group(1)),
+                   sum(int(n) * units[u] for n, u in re.findall(r"(\d+)([hms])", m.group(1))))
+        if line.startswith("done:"):
+            out.append(segment)
+            kept = None
+        else:
+            kept = segment
     if kept:
-        yield kept
+        out.append(kept)
+    return out
+
+
+def uncounted_spans(run):
+    """(from, to) simulated times [s] the run went through with no wall time on record: a
+    segment stopped before run.log recorded checkpoints (logs written before 2026-12-03)
+    leaves no line, yet the restart after it starts from a later checkpoint than the last
+    one counted. wall_time leaves these spans out; a report should say so."""
+    lines = _log_lines(run)
+    spans = []
+    for i, line in enumerate(lines):
+        m = re.match(r"--- restart from checkpoint at t = (\S+) s", line)
+        if not m:
+            continue
+        last = max((end for end, _ in _segments(lines[:i])), default=0.0)
+        if float(m.group(1)) > last + 1e-9:
+            spans.append((last, float(m.group(1))))
+    return spans
 
 
 def reached_time(run):

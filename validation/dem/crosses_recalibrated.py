@@ -42,7 +42,7 @@ import matplotlib
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from _outputs import (calibration_value_folder, continuation_command, read_summary,  # noqa: E402
-                      regime_name, run_pour, wall_time, write_summary)
+                      regime_name, run_pour, uncounted_spans, wall_time, write_summary)
 from crosses_dam_break import (CASE, RESULTS, ROOT, diagnostics,  # noqa: E402
                                draw_velocity_bands, lajeunesse, opening_time, velocity_curve)
 from crosses_tangential_map import tangential_settings  # noqa: E402
@@ -264,6 +264,8 @@ def main():
         elapsed += max(wall_time(os.path.join(value_folder(r["value"]), "seed_1"),
                                  OPENING_S) for r in table)
     ok = all(c["pass"] for c in checks if c["pass"] is not None)
+    uncounted = [f"{name} {a:g}-{b:g} s" for name in ["pour", *RUNS_OF, "calibrated"]
+                 for a, b in uncounted_spans(os.path.join(RUNS, name))]
     summary = {
         "name": "crosses_recalibrated",
         "title": "Dam break of crosses with kt and γt recalibrated",
@@ -327,7 +329,11 @@ def main():
                   "Wall times: the pour on 2 threads; the two 3 s collapses side by side, one "
                   "thread each; the calibration's runs side by side, one thread each; the run "
                   "at the fit on 2 threads; all on the 2-core VM, with other jobs for part of "
-                  "the time."],
+                  "the time."
+                  + (" Not counted in the run time: the simulated spans "
+                     + ", ".join(uncounted) + ", run by calls stopped before run.log "
+                     "recorded checkpoints (their restarts began from later checkpoints)."
+                     if uncounted else "")],
     }
     write_summary(summary, RESULTS, elapsed, args.quick, ok)
     print(f"{'PASS' if ok else 'FAIL'}: {elapsed / 3600:.2f} h")

@@ -144,6 +144,20 @@ class RunSegments(unittest.TestCase):
             self.assertEqual(_outputs.wall_time(tmp, after=5.0), 1205 + 1320 + 660)
             self.assertEqual(_outputs.done_times(tmp), [5.0, 6.1])
 
+    def test_a_span_run_before_checkpoint_lines_is_named_as_not_counted(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            write_run_log(tmp, [
+                "done: t = 5 s, 2000000 steps in 1h56m (2.92e+05 particle-steps/s)",
+                "--- restart from checkpoint at t = 5.000000 s",  # killed, no lines
+                "--- restart from checkpoint at t = 6.750000 s",
+                "checkpoint: t = 7 s, 100000 steps in 10m00s",
+                "--- restart from checkpoint at t = 7.000000 s",  # killed after a line
+                "done: t = 8 s, 400000 steps in 40m00s (1e+05 particle-steps/s)"])
+            self.assertEqual(_outputs.uncounted_spans(tmp), [(5.0, 6.75)])
+            self.assertEqual(_outputs.wall_time(tmp, after=5.0), 600 + 2400)
+            write_run_log(tmp, self.LOG)
+            self.assertEqual(_outputs.uncounted_spans(tmp), [])
+
     def test_a_folder_without_log_has_no_segments(self):
         with tempfile.TemporaryDirectory() as tmp:
             self.assertEqual(list(_outputs.finished_segments(tmp)), [])
