@@ -2,15 +2,14 @@
 """The calibrated tangential parameters of the crosses tested on another gate (issue #4).
 
 crosses_recalibrated fits gamma_t at kt = 1e2 N/m to the 4 cm gate's run-out: with the
-contact patches of flat faces, gamma_t = 1.91e3 1/s (the run of 2026-12-03; with one contact
-point per element pair it found no crossing and its nearest run, 2e3). One number fitted
-is a calibration; this
-case is the test: the same parameters on the wider gates of §3.2.1, where the column is
-lower (a = H0/L0 about 1.9 at 8 cm), with a packing poured anew exactly as
-crosses_dam_break pours it (Table 3.1 parameters, gate in place, at rest), then the gate
-removed at once and the collapse followed with kt = 1e2 N/m, gamma_t = 1.91e3 1/s (both
-interactions) until the pile is at rest (mean speed below 1 mm/s, checked from 1.5 s
-after the opening; at most 3 s).
+contact patches of flat faces, gamma_t = 1.91e3 1/s (the run of 2026-12-03; with one
+contact point per element pair it found no crossing, nearest at 2e3). One number fitted is
+a calibration; this case is the test: the same parameters on the wider gates of §3.2.1,
+where the column is lower (a = H0/L0 about 1.9 at 8 cm), with a packing poured anew
+exactly as crosses_dam_break pours it (Table 3.1 parameters, gate in place, at rest), then
+the gate removed at once and the collapse followed with kt = 1e2 N/m, gamma_t = 1.91e3
+1/s (both interactions) until the pile is at rest (mean speed below 1 mm/s, checked from
+1.5 s after the opening; at most 3 s).
 
 Checks (tolerances fixed before running):
 - K = (L_inf - L0)/(L0 a): the thesis finds the crosses on a linear law K a with K
