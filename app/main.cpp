@@ -253,6 +253,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   bench_cmd->add_flag("--general-kernels", bo.general_kernels,
                       "flow-cavity: multigrid kernels that read constant coefficients too (A/B)");
+  bench_cmd->add_flag("--unmerged-solver", bo.unmerged_solver,
+                      "flow-cavity: multigrids on the flow's blocks, not on their families of 8 "
+                      "merged into one block (A/B)");
   bench_cmd
       ->add_option("--relaxation", bo.relaxation,
                    "flow-cavity: over-relaxation of the multigrid smoother in the pressure "

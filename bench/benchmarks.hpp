@@ -23,6 +23,9 @@ struct BenchOptions {
   // flow-cavity: multigrid kernels that read the coefficient arrays even where they
   // are constant (MultigridOptions::uniform_coefficient_kernels = false), for A/B runs.
   bool general_kernels = false;
+  // flow-cavity: the multigrids on the flow's own blocks instead of their families of 8
+  // merged (NavierStokesOptions::merge_solver_blocks = false), for A/B runs.
+  bool unmerged_solver = false;
   // flow-cavity: over-relaxation of the red-black smoother in the pressure and viscous
   // solves (0: the solver's, NavierStokesOptions), for A/B runs.
   double relaxation = 0.0;

@@ -672,8 +672,8 @@ double MultigridReport::mean_reduction() const {
   return std::pow(residuals.front() / residuals.back(), 1.0 / cycles_done);
 }
 
-Multigrid::Multigrid(const Forest& forest, const std::array<BcKind, 6>& kinds)
-    : forest_(forest), kinds_(kinds) {
+Multigrid::Multigrid(const Forest& forest, const std::array<BcKind, 6>& kinds, bool merge_blocks)
+    : forest_(forest), kinds_(kinds), merge_blocks_(merge_blocks) {
   for (int d = 0; d < 3; ++d) {
     const bool periodic = forest.spec().periodic[D(d)];
     for (int side = 0; side < 2; ++side) {
@@ -688,6 +688,22 @@ Multigrid::Multigrid(const Forest& forest, const std::array<BcKind, 6>& kinds)
 
 void Multigrid::rebuild() {
   composite_ = !forest_.uniform();
+  merged_.reset();
+  const auto merged_spec = merge_blocks_ ? merged_forest_spec(forest_) : std::nullopt;
+  if (merged_spec) {
+    // The levels of the caller's blocks are not needed: free them.
+    levels_.clear();
+    shifted_rhs_ = BlockField();
+    merged_ = std::make_unique<Merged>();
+    merged_->forest = std::make_unique<Forest>(*merged_spec);
+    merged_->copies = std::make_unique<MergedBlocks>(forest_, *merged_->forest);
+    merged_->solver = std::make_unique<Multigrid>(*merged_->forest, kinds_, false);
+    const int blocks = merged_->forest->local_blocks(), cells = merged_spec->block_cells;
+    merged_->x.reshape(blocks, cells);
+    merged_->rhs.reshape(blocks, cells);
+    set_coefficients(nullptr, nullptr);
+    return;
+  }
   const int n = forest_.local_blocks();
   std::size_t m = 0;
   for (int b = forest_.block_cells(); b >= 1; b /= 2, ++m) {
@@ -717,6 +733,20 @@ void Multigrid::rebuild() {
 }
 
 void Multigrid::set_coefficients(const BlockField* alpha, const FaceField* beta) {
+  if (merged_) {
+    Merged& m = *merged_;
+    const int blocks = m.forest->local_blocks(), cells = m.forest->block_cells();
+    if (alpha) {
+      m.alpha.reshape(blocks, cells);
+      m.copies->to_merged(*alpha, m.alpha);
+    }
+    if (beta) {
+      reshape(m.beta, blocks, cells);
+      for (int d = 0; d < 3; ++d) m.copies->faces_to_merged((*beta)[D(d)], d, m.beta[D(d)]);
+    }
+    m.solver->set_coefficients(alpha ? &m.alpha : nullptr, beta ? &m.beta : nullptr);
+    return;
+  }
   has_alpha_ = alpha != nullptr;
   Level& fine = levels_.front();
   if (alpha) {
@@ -821,6 +851,7 @@ void Multigrid::detect_constant_coefficients() {
 }
 
 int Multigrid::constant_blocks(int level) const {
+  if (merged_) return merged_->solver->constant_blocks(level);
   int count = 0;
   for (const unsigned char c : levels_[D(level)].block_constant) count += c ? 1 : 0;
   return count;
@@ -1365,8 +1396,30 @@ void Multigrid::shift_interior(BlockField& f, double by) const {
   });
 }
 
+void Multigrid::to_merged(const BlockField* x, const BlockField& rhs) {
+  if (x) merged_->copies->to_merged(*x, merged_->x);
+  merged_->copies->to_merged(rhs, merged_->rhs);
+}
+
+void Multigrid::from_merged(BlockField& x, const ScalarBoundary& bc, bool fill_ghosts) const {
+  merged_->copies->to_fine(merged_->x, x);
+  if (fill_ghosts) {
+    forest_.exchange(x, 1, false, CoarseGhosts::Interpolated);
+    fill_boundary_ghosts(forest_, x, bc, 1, false);
+  }
+}
+
 void Multigrid::residual(BlockField& x, const BlockField& rhs, const ScalarBoundary& bc,
                          BlockField& r) {
+  if (merged_) {
+    to_merged(&x, rhs);
+    Merged& m = *merged_;
+    m.r.reshape(m.forest->local_blocks(), m.forest->block_cells());
+    m.solver->residual(m.x, m.rhs, bc, m.r);
+    m.copies->to_fine(m.r, r);
+    from_merged(x, bc, true);  // this fills x's ghosts with bc, as below
+    return;
+  }
   compute_residual(0, x, rhs, &bc, &r, true, true);
 }
 
@@ -1380,12 +1433,26 @@ void Multigrid::take_options(const MultigridOptions& options) {
 
 void Multigrid::relax(BlockField& x, const BlockField& rhs, const ScalarBoundary& bc, int sweeps,
                       const MultigridOptions& options) {
+  if (merged_) {
+    to_merged(&x, rhs);
+    merged_->solver->relax(merged_->x, merged_->rhs, bc, sweeps, options);
+    from_merged(x, bc, false);
+    return;
+  }
   take_options(options);
   smooth(0, x, rhs, &bc, sweeps);
 }
 
 MultigridReport Multigrid::solve(BlockField& x, const BlockField& rhs, const ScalarBoundary& bc,
                                  const MultigridOptions& options) {
+  if (merged_) {
+    to_merged(&x, rhs);
+    MultigridOptions inner = options;
+    inner.fill_ghosts_on_return = false;  // filled on the caller's blocks
+    const MultigridReport report = merged_->solver->solve(merged_->x, merged_->rhs, bc, inner);
+    from_merged(x, bc, options.fill_ghosts_on_return);
+    return report;
+  }
   take_options(options);
   const BlockField* source = &rhs;
   BlockField& shifted = shifted_rhs_;

@@ -326,8 +326,8 @@ NavierStokes::NavierStokes(const Forest& forest, const std::array<FlowBoundary, 
       boundaries_(checked(forest, boundaries)),
       fluid_(fluid),
       options_(options),
-      pressure_mg_(std::in_place, forest, pressure_kinds(boundaries)),
-      viscous_mg_(std::in_place, forest, velocity_kinds(boundaries)) {
+      pressure_mg_(std::in_place, forest, pressure_kinds(boundaries), options.merge_solver_blocks),
+      viscous_mg_(std::in_place, forest, velocity_kinds(boundaries), options.merge_solver_blocks) {
   if (!(fluid.density > 0.0) || !(fluid.viscosity >= 0.0)) {
     throw std::invalid_argument("navier-stokes: density must be > 0 and viscosity >= 0");
   }

@@ -11,6 +11,7 @@
 
 #include "adapt_poisson.hpp"
 #include "flow/adapt_criterion.hpp"
+#include "flow/merged_blocks.hpp"
 #include "flow/mpi_session.hpp"
 #include "flow/navier_stokes.hpp"
 #include "navier_stokes_problems.hpp"
@@ -40,13 +41,14 @@ std::vector<double> gathered(const Forest& forest, const BlockField& field) {
   return all;
 }
 
-int check(bool periodic) {
-  // Fixed number of cycles (tolerance 0) so both runs do the same work.
-  const int cells = 16;
+/// Poisson on `cells`^3 (blocks of 8^3): 16^3 solves on the blocks, 32^3 on
+/// their families merged (Multigrid::merged), whose blocks lie on other
+/// ranks than their children's.
+int check(bool periodic, int cells) {
   auto run = [&](MPI_Comm comm, std::vector<double>& values) {
     ForestSpec spec;
     spec.periodic = {periodic, periodic, periodic};
-    spec.level = 1;
+    spec.level = cells == 16 ? 1 : 2;
     spec.comm = comm;
     const Forest forest(spec);
     auto result = testing::solve_manufactured(periodic, cells, comm, 1e-13);
@@ -62,18 +64,35 @@ int check(bool periodic) {
     diff = std::max(diff, std::abs(shared[i] - alone[i]));
   const auto& session = MpiSession::ensure();
   if (session.rank() == 0) {
-    std::printf("%s: %d ranks vs 1: max difference %.3e, errors %.6e / %.6e, cycles %d / %d\n",
-                periodic ? "periodic" : "Dirichlet", session.size(), diff, r2.error, r1.error,
-                r2.report.cycles, r1.report.cycles);
+    std::printf(
+        "%s %d^3%s: %d ranks vs 1: max difference %.3e, errors %.6e / %.6e, cycles %d / %d\n",
+        periodic ? "periodic" : "Dirichlet", cells, r2.merged ? " (merged blocks)" : "",
+        session.size(), diff, r2.error, r1.error, r2.report.cycles, r1.report.cycles);
   }
-  return diff <= 1e-11 ? 0 : 1;
+  const bool merged_as_expected = r2.merged == (cells >= 32) && r1.merged == r2.merged;
+  if (r2.merged) {
+    // How many blocks' values crossed ranks on their way to the merged blocks.
+    ForestSpec spec;
+    spec.periodic = {periodic, periodic, periodic};
+    spec.level = 2;
+    const Forest forest(spec);
+    const Forest merged(*merged_forest_spec(forest));
+    const double elsewhere =
+        forest.sum(static_cast<double>(MergedBlocks(forest, merged).children_elsewhere()));
+    if (session.rank() == 0) {
+      std::printf("  (%.0f of %lld blocks' values went to a merged block on another rank)\n",
+                  elsewhere, static_cast<long long>(forest.global_blocks()));
+    }
+  }
+  return diff <= 1e-11 && merged_as_expected ? 0 : 1;
 }
 
-/// Ten steps of the Re = 100 cavity (16^3, 8 blocks) on the shared forest and alone.
-int check_navier_stokes() {
-  auto run = [](MPI_Comm comm) {
+/// Ten steps of the Re = 100 cavity on the shared forest and alone: 16^3 (8
+/// blocks), or 32^3 (64 blocks, the multigrids on merged blocks).
+int check_navier_stokes(int level) {
+  auto run = [&](MPI_Comm comm) {
     ForestSpec spec;
-    spec.level = 1;
+    spec.level = level;
     spec.comm = comm;
     const Forest forest(spec);
     const auto bcs = testing::lid_driven_cavity();
@@ -101,8 +120,9 @@ int check_navier_stokes() {
   const auto& session = MpiSession::ensure();
   if (session.rank() == 0) {
     std::printf(
-        "cavity 16^3, 10 steps: %d ranks vs 1: max difference of u and p %.3e (max |value| %.3f)\n",
-        session.size(), diff, scale);
+        "cavity %d^3, 10 steps: %d ranks vs 1: max difference of u and p %.3e (max |value| "
+        "%.3f)\n",
+        8 << level, session.size(), diff, scale);
   }
   return diff <= 1e-11 ? 0 : 1;
 }
@@ -362,8 +382,14 @@ int main(int argc, char** argv) {
   // "adaptive": only the adaptive run (ctest also runs it on 3 ranks, whose
   // even first split differs from adapt()'s family-keeping one).
   if (argc > 1 && std::string(argv[1]) == "adaptive") return check_adaptive_navier_stokes();
-  const int failures = check(true) + check(false) + check_navier_stokes() +
-                       check_adaptive_ghosts() + check_refined(true) + check_refined(false) +
-                       check_refined_navier_stokes() + check_adaptive_navier_stokes();
+  // "merged": only the solves on merged blocks (ctest runs them on 3 ranks too,
+  // where merged blocks and their children's blocks lie on different ranks).
+  if (argc > 1 && std::string(argv[1]) == "merged") {
+    return check(true, 32) + check(false, 32) + check_navier_stokes(2) == 0 ? 0 : 1;
+  }
+  const int failures = check(true, 16) + check(false, 16) + check(true, 32) + check(false, 32) +
+                       check_navier_stokes(1) + check_navier_stokes(2) + check_adaptive_ghosts() +
+                       check_refined(true) + check_refined(false) + check_refined_navier_stokes() +
+                       check_adaptive_navier_stokes();
   return failures == 0 ? 0 : 1;
 }

@@ -65,6 +65,7 @@ struct PoissonResult {
   double error = 0.0;
   MultigridReport report;
   BlockField solution;
+  bool merged = false;  ///< the multigrid solved on merged blocks (Multigrid::merged)
 };
 
 /// Solves -lap u = f on the unit cube with `cells` cells per direction (block size 8).
@@ -89,6 +90,7 @@ inline PoissonResult solve_manufactured(bool periodic, int cells, MPI_Comm comm 
   MultigridOptions options;
   options.tolerance = tolerance;
   result.report = mg.solve(result.solution, rhs, bc, options);
+  result.merged = mg.merged();
   result.error = periodic ? max_error(forest, result.solution, periodic_exact)
                           : max_error(forest, result.solution, dirichlet_exact);
   return result;

@@ -1,0 +1,229 @@
+#include "flow/merged_blocks.hpp"
+
+#include <mpi.h>
+
+#include <stdexcept>
+#include <unordered_map>
+
+namespace sanguis::flow {
+
+namespace {
+
+constexpr std::size_t D(int d) {
+  return static_cast<std::size_t>(d);
+}
+
+/// Key of the block at integer coordinates c among n blocks per direction.
+std::int64_t block_key(const std::array<std::int64_t, 3>& c, const std::array<std::int64_t, 3>& n) {
+  return (c[2] * n[1] + c[1]) * n[0] + c[0];
+}
+
+int octant_of(const std::array<std::int64_t, 3>& c) {
+  return static_cast<int>((c[0] & 1) | ((c[1] & 1) << 1) | ((c[2] & 1) << 2));
+}
+
+/// Values a child moves: its cells (face_dir < 0), or its faces along face_dir,
+/// the last one (slot b) only for the child on the upper side, so that every
+/// merged face has one writer.
+std::array<int, 3> child_box(int b, int face_dir, int octant) {
+  std::array<int, 3> n{b, b, b};
+  if (face_dir >= 0 && ((octant >> face_dir) & 1) != 0) n[D(face_dir)] = b + 1;
+  return n;
+}
+
+/// Calls body(fine offset, merged offset) for every value of a child's box.
+template <typename Body>
+void for_child_values(const BlockLayout& fine, const BlockLayout& merged, int face_dir, int octant,
+                      Body&& body) {
+  const int b = fine.cells;
+  const auto n = child_box(b, face_dir, octant);
+  const int ox = (octant & 1) * b, oy = ((octant >> 1) & 1) * b, oz = ((octant >> 2) & 1) * b;
+  for (int k = 0; k < n[2]; ++k)
+    for (int j = 0; j < n[1]; ++j) {
+      const std::ptrdiff_t f = fine.index(0, j, k), m = merged.index(ox, oy + j, oz + k);
+      for (int i = 0; i < n[0]; ++i) body(f + i, m + i);
+    }
+}
+
+}  // namespace
+
+std::optional<ForestSpec> merged_forest_spec(const Forest& fine, int max_cells) {
+  if (!fine.uniform()) return std::nullopt;
+  const ForestSpec& s = fine.spec();
+  if (2 * s.block_cells > max_cells) return std::nullopt;
+  ForestSpec m = s;
+  m.block_cells = 2 * s.block_cells;
+  const int level = fine.max_level();
+  if (level >= 1) {
+    m.level = level - 1;
+  } else {
+    for (int d = 0; d < 3; ++d) {
+      if (s.trees[D(d)] % 2 != 0) return std::nullopt;
+      m.trees[D(d)] = s.trees[D(d)] / 2;
+    }
+    m.tree_length = 2.0 * s.tree_length;
+    m.level = 0;
+  }
+  for (int d = 0; d < 3; ++d) {
+    if ((std::int64_t{m.trees[D(d)]} << m.level) < 2) return std::nullopt;
+  }
+  return m;
+}
+
+MergedBlocks::MergedBlocks(const Forest& fine, const Forest& merged)
+    : fine_(fine), merged_(merged), b_(fine.block_cells()) {
+  if (merged.block_cells() != 2 * b_ || !fine.uniform() || !merged.uniform()) {
+    throw std::invalid_argument("merged blocks: the forests are not a uniform one and its merge");
+  }
+  const int ranks = fine.ranks();
+  const auto n = merged.blocks_per_direction(merged.max_level());
+  // Every merged block's rank and local number, by key.
+  std::vector<std::int64_t> mine;
+  for (int m = 0; m < merged.local_blocks(); ++m) {
+    mine.push_back(block_key(merged.block(m).coord, n));
+  }
+  std::vector<int> counts(static_cast<std::size_t>(ranks), 0), offsets(counts.size(), 0);
+  const int count = static_cast<int>(mine.size());
+  MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, fine.comm());
+  for (std::size_t r = 1; r < counts.size(); ++r) offsets[r] = offsets[r - 1] + counts[r - 1];
+  std::vector<std::int64_t> all(static_cast<std::size_t>(offsets.back() + counts.back()));
+  MPI_Allgatherv(mine.data(), count, MPI_INT64_T, all.data(), counts.data(), offsets.data(),
+                 MPI_INT64_T, fine.comm());
+  std::unordered_map<std::int64_t, std::pair<int, std::int32_t>> owner;
+  for (int r = 0; r < ranks; ++r)
+    for (int m = 0; m < counts[D(r)]; ++m) {
+      owner[all[static_cast<std::size_t>(offsets[D(r)] + m)]] = {r, m};
+    }
+
+  send_.assign(static_cast<std::size_t>(ranks), {});
+  receive_.assign(static_cast<std::size_t>(ranks), {});
+  local_.assign(static_cast<std::size_t>(fine.local_blocks()), Child{-1, -1, 0});
+  for (int blk = 0; blk < fine.local_blocks(); ++blk) {
+    const auto& c = fine.block(blk).coord;
+    const auto found = owner.find(block_key({c[0] >> 1, c[1] >> 1, c[2] >> 1}, n));
+    if (found == owner.end()) throw std::logic_error("merged blocks: a family has no merged block");
+    const auto [rank, m] = found->second;
+    const Child child{blk, m, octant_of(c)};
+    if (rank == fine.rank()) {
+      local_[D(blk)] = child;
+    } else {
+      send_[D(rank)].push_back(child);
+    }
+  }
+  if (ranks == 1) return;
+  // Each rank tells the merged blocks' ranks which (merged block, octant) its
+  // children fill, in the order their values will travel.
+  std::vector<int> send_counts(counts.size()), receive_counts(counts.size());
+  std::vector<int> send_offsets(counts.size(), 0), receive_offsets(counts.size(), 0);
+  std::vector<std::int32_t> headers;
+  for (int r = 0; r < ranks; ++r) {
+    send_counts[D(r)] = 2 * static_cast<int>(send_[D(r)].size());
+    for (const Child& child : send_[D(r)]) {
+      headers.push_back(child.merged);
+      headers.push_back(child.octant);
+    }
+  }
+  MPI_Alltoall(send_counts.data(), 1, MPI_INT, receive_counts.data(), 1, MPI_INT, fine.comm());
+  for (std::size_t r = 1; r < counts.size(); ++r) {
+    send_offsets[r] = send_offsets[r - 1] + send_counts[r - 1];
+    receive_offsets[r] = receive_offsets[r - 1] + receive_counts[r - 1];
+  }
+  std::vector<std::int32_t> received(
+      static_cast<std::size_t>(receive_offsets.back() + receive_counts.back()));
+  MPI_Alltoallv(headers.data(), send_counts.data(), send_offsets.data(), MPI_INT32_T,
+                received.data(), receive_counts.data(), receive_offsets.data(), MPI_INT32_T,
+                fine.comm());
+  for (int r = 0; r < ranks; ++r)
+    for (int e = 0; e < receive_counts[D(r)]; e += 2) {
+      const auto at = static_cast<std::size_t>(receive_offsets[D(r)] + e);
+      receive_[D(r)].push_back(Child{-1, received[at], received[at + 1]});
+    }
+}
+
+template <bool kToMerged>
+void MergedBlocks::transfer(const BlockField& from, BlockField& to, int face_dir) const {
+  const BlockField& fine_field = kToMerged ? from : to;
+  const BlockField& merged_field = kToMerged ? to : from;
+  if (fine_field.cells() != b_ || merged_field.cells() != 2 * b_ ||
+      fine_field.blocks() != fine_.local_blocks() ||
+      merged_field.blocks() != merged_.local_blocks()) {
+    throw std::invalid_argument("merged blocks: a field does not match its forest");
+  }
+  const BlockLayout& F = fine_field.layout();
+  const BlockLayout& M = merged_field.layout();
+  // This rank's children: one block each, in parallel (each merged value has one writer).
+  fine_.for_each_block([&](int blk) {
+    const Child& child = local_[D(blk)];
+    if (child.merged < 0) return;
+    if constexpr (kToMerged) {
+      const double* src = from.block(blk);
+      double* dst = to.block(child.merged);
+      for_child_values(F, M, face_dir, child.octant,
+                       [&](std::ptrdiff_t f, std::ptrdiff_t m) { dst[m] = src[f]; });
+    } else {
+      const double* src = from.block(child.merged);
+      double* dst = to.block(blk);
+      for_child_values(F, M, face_dir, child.octant,
+                       [&](std::ptrdiff_t f, std::ptrdiff_t m) { dst[f] = src[m]; });
+    }
+  });
+  const int ranks = fine_.ranks();
+  if (ranks == 1) return;
+  // The others: packed in the order of send_ (fine side) and receive_ (merged side).
+  const auto& outgoing = kToMerged ? send_ : receive_;
+  const auto& incoming = kToMerged ? receive_ : send_;
+  std::vector<int> send_counts(D(ranks), 0), receive_counts(D(ranks), 0);
+  std::vector<int> send_offsets(D(ranks), 0), receive_offsets(D(ranks), 0);
+  const auto values = [&](const Child& c) {
+    const auto n = child_box(b_, face_dir, c.octant);
+    return n[0] * n[1] * n[2];
+  };
+  for (int r = 0; r < ranks; ++r) {
+    for (const Child& c : outgoing[D(r)]) send_counts[D(r)] += values(c);
+    for (const Child& c : incoming[D(r)]) receive_counts[D(r)] += values(c);
+    if (r > 0) {
+      send_offsets[D(r)] = send_offsets[D(r - 1)] + send_counts[D(r - 1)];
+      receive_offsets[D(r)] = receive_offsets[D(r - 1)] + receive_counts[D(r - 1)];
+    }
+  }
+  std::vector<double> packed(D(send_offsets.back() + send_counts.back()));
+  std::vector<double> unpacked(D(receive_offsets.back() + receive_counts.back()));
+  std::size_t at = 0;
+  for (int r = 0; r < ranks; ++r)
+    for (const Child& c : outgoing[D(r)]) {
+      const double* src = kToMerged ? from.block(c.block) : from.block(c.merged);
+      for_child_values(F, M, face_dir, c.octant, [&](std::ptrdiff_t f, std::ptrdiff_t m) {
+        packed[at++] = src[kToMerged ? f : m];
+      });
+    }
+  MPI_Alltoallv(packed.data(), send_counts.data(), send_offsets.data(), MPI_DOUBLE, unpacked.data(),
+                receive_counts.data(), receive_offsets.data(), MPI_DOUBLE, fine_.comm());
+  at = 0;
+  for (int r = 0; r < ranks; ++r)
+    for (const Child& c : incoming[D(r)]) {
+      double* dst = kToMerged ? to.block(c.merged) : to.block(c.block);
+      for_child_values(F, M, face_dir, c.octant, [&](std::ptrdiff_t f, std::ptrdiff_t m) {
+        dst[kToMerged ? m : f] = unpacked[at++];
+      });
+    }
+}
+
+std::int64_t MergedBlocks::children_elsewhere() const {
+  std::int64_t count = 0;
+  for (const auto& list : send_) count += static_cast<std::int64_t>(list.size());
+  return count;
+}
+
+void MergedBlocks::to_merged(const BlockField& fine, BlockField& merged) const {
+  transfer<true>(fine, merged, -1);
+}
+
+void MergedBlocks::to_fine(const BlockField& merged, BlockField& fine) const {
+  transfer<false>(merged, fine, -1);
+}
+
+void MergedBlocks::faces_to_merged(const BlockField& fine, int d, BlockField& merged) const {
+  transfer<true>(fine, merged, d);
+}
+
+}  // namespace sanguis::flow
