@@ -5,10 +5,12 @@
 # cells, fixed dt = 0.01, projection tolerance 1e-3), one core each.
 #
 #   bench/flow_cavity_vs_gerris.sh [--cells-per-side N] [--steps S] [--block-cells B]
-#                                  [--repeat R] [--pairs P]
+#                                  [--repeat R] [--pairs P] [--unmerged-solver]
 #
 # B: sanguis' cells per block edge (default 8, its case-file default; 16 runs
-# a uniform grid about twice as fast per cell, see docs/performance.md).
+# a uniform grid faster per cell, see docs/performance.md). Blocks below 16^3
+# are merged 8 by 8 for the multigrid (Multigrid's merge_blocks);
+# --unmerged-solver solves on the blocks themselves instead (A/B).
 # N must be a power of two for Gerris (2^level); default 64 and 10 steps.
 # Gerris' time is the wall time between its step 0 and its last step (its own
 # log), so its set-up is excluded as for sanguis. A pair is one Gerris run
@@ -34,6 +36,7 @@ steps=10
 block=8
 repeat=5
 pairs=1
+unmerged=()
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --cells-per-side) cells="${2:?--cells-per-side needs a value}"; shift 2 ;;
@@ -41,7 +44,8 @@ while [[ $# -gt 0 ]]; do
     --block-cells) block="${2:?--block-cells needs a value}"; shift 2 ;;
     --repeat) repeat="${2:?--repeat needs a value}"; shift 2 ;;
     --pairs) pairs="${2:?--pairs needs a value}"; shift 2 ;;
-    -h|--help) sed -n '2,25p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --unmerged-solver) unmerged=(--unmerged-solver); shift ;;
+    -h|--help) sed -n '2,27p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "flow_cavity_vs_gerris: unknown option $1" >&2; exit 2 ;;
   esac
 done
@@ -69,7 +73,7 @@ run_sanguis() {
   local rates=() r line
   for ((r = 1; r <= repeat; r++)); do
     echo "flow-cavity: sanguis run $r of $repeat (pair $1 of $pairs) ..." >&2
-    line=$("$sanguis" bench flow-cavity --cells-per-side "$cells" --steps "$steps" --threads 1 --block-cells "$block")
+    line=$("$sanguis" bench flow-cavity --cells-per-side "$cells" --steps "$steps" --threads 1 --block-cells "$block" "${unmerged[@]}")
     echo "$line"
     rates+=("$(echo "$line" | sed 's/.*"cell_updates_per_s":\([0-9.e+-]*\).*/\1/')")
   done

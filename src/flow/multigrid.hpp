@@ -20,6 +20,13 @@
 // active coarse cells only (renormalised weights), so that masked walls act
 // as Neumann boundaries on every level.
 //
+// Uniform forests of blocks smaller than 16^3 (the default 8^3) are solved on
+// a second forest of their families of 8 merged (merged_blocks.hpp), the
+// caller's fields copied in and out: per block the V-cycle pays for ghost
+// fills, loop heads and in-block levels of 4^3 and 2^3 cells, so on the 64^3
+// cavity it runs 2-3x faster on 16^3 blocks (docs/performance.md, "Solver
+// blocks").
+//
 // Composite grids (blocks at several levels, issue #7): every in-block level
 // is itself a composite grid with the same 2:1 structure, so the V-cycle is
 // unchanged: Forest::exchange fills fine ghosts from coarser blocks by
