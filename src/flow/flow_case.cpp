@@ -338,7 +338,7 @@ std::string block_size_hint(const FlowCase& c) {
       std::all_of(c.cells.begin(), c.cells.end(), [](int n) { return n % 16 == 0; });
   if (c.adapt.enabled || b >= 16 || !sixteens) return {};
   return "hint: this grid does not adapt, and its cell counts are multiples of 16: "
-         "block_cells = 16 runs it about 1.5-2x faster per cell than " +
+         "block_cells = 16 runs it about 1.4x faster per cell than " +
          std::to_string(b) +
          " (docs/case-file.md, [flow.grid]; docs/performance.md, \"Block size\")";
 }

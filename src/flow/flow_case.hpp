@@ -72,7 +72,8 @@ double viscosity_at(const FlowCase& c, const Vec3& x);
 
 /// A line suggesting 16^3 blocks where the grid does not adapt, its cell
 /// counts allow them and the blocks are smaller (they run a uniform grid
-/// 1.5-2x faster per cell); empty otherwise. describe() includes it.
+/// about 1.4x faster per cell, the multigrid already solving on 16^3 blocks);
+/// empty otherwise. describe() includes it.
 std::string block_size_hint(const FlowCase& c);
 
 /// The resolved parameters, one per line (for run.log).

@@ -701,8 +701,7 @@ void Multigrid::rebuild() {
     const int blocks = merged_->forest->local_blocks(), cells = merged_spec->block_cells;
     merged_->x.reshape(blocks, cells);
     merged_->rhs.reshape(blocks, cells);
-    set_coefficients(nullptr, nullptr);
-    return;
+    return;  // the new solver's coefficients are the reset ones (alpha 0, beta 1)
   }
   const int n = forest_.local_blocks();
   std::size_t m = 0;
@@ -736,12 +735,17 @@ void Multigrid::set_coefficients(const BlockField* alpha, const FaceField* beta)
   if (merged_) {
     Merged& m = *merged_;
     const int blocks = m.forest->local_blocks(), cells = m.forest->block_cells();
+    // Shaped once (a new Merged per rebuild); the copies then write every
+    // cell and face the solver reads, each time the coefficients change.
+    const auto shaped = [&](const BlockField& f) {
+      return f.blocks() == blocks && f.cells() == cells;
+    };
     if (alpha) {
-      m.alpha.reshape(blocks, cells);
+      if (!shaped(m.alpha)) m.alpha.reshape(blocks, cells);
       m.copies->to_merged(*alpha, m.alpha);
     }
     if (beta) {
-      reshape(m.beta, blocks, cells);
+      if (!shaped(m.beta[0])) reshape(m.beta, blocks, cells);
       for (int d = 0; d < 3; ++d) m.copies->faces_to_merged((*beta)[D(d)], d, m.beta[D(d)]);
     }
     m.solver->set_coefficients(alpha ? &m.alpha : nullptr, beta ? &m.beta : nullptr);
@@ -1403,10 +1407,12 @@ void Multigrid::to_merged(const BlockField* x, const BlockField& rhs) {
 
 void Multigrid::from_merged(BlockField& x, const ScalarBoundary& bc, bool fill_ghosts) const {
   merged_->copies->to_fine(merged_->x, x);
-  if (fill_ghosts) {
-    forest_.exchange(x, 1, false, CoarseGhosts::Interpolated);
-    fill_boundary_ghosts(forest_, x, bc, 1, false);
-  }
+  if (fill_ghosts) fill_caller_ghosts(x, bc);
+}
+
+void Multigrid::fill_caller_ghosts(BlockField& x, const ScalarBoundary& bc) const {
+  forest_.exchange(x, 1, false, CoarseGhosts::Interpolated);
+  fill_boundary_ghosts(forest_, x, bc, 1, false);
 }
 
 void Multigrid::residual(BlockField& x, const BlockField& rhs, const ScalarBoundary& bc,
@@ -1414,10 +1420,12 @@ void Multigrid::residual(BlockField& x, const BlockField& rhs, const ScalarBound
   if (merged_) {
     to_merged(&x, rhs);
     Merged& m = *merged_;
-    m.r.reshape(m.forest->local_blocks(), m.forest->block_cells());
+    if (m.r.blocks() != m.forest->local_blocks()) {
+      m.r.reshape(m.forest->local_blocks(), m.forest->block_cells());
+    }
     m.solver->residual(m.x, m.rhs, bc, m.r);
     m.copies->to_fine(m.r, r);
-    from_merged(x, bc, true);  // this fills x's ghosts with bc, as below
+    fill_caller_ghosts(x, bc);  // x unchanged; its ghosts filled with bc, as below
     return;
   }
   compute_residual(0, x, rhs, &bc, &r, true, true);

@@ -12,13 +12,17 @@
 // Levels: inside every block the cells halve B -> B/2 -> ... -> 2 (red-black
 // Gauss-Seidel smoothing, residual by 8-cell averaging, trilinear
 // prolongation of the correction); the level with one cell per block is the
-// forest's own grid of blocks, gathered on every rank and solved there by
+// forest's own grid of blocks (the merged ones, below, when merged), gathered
+// on every rank and solved there by
 // conjugate gradients (identical on every rank). Boundary values are applied
 // on the finest level only; corrections carry homogeneous conditions.
 // Cells closed on all faces with alpha = 0 (solid cells of a mask) are
-// inactive: they keep their value, and the prolongation interpolates from
-// active coarse cells only (renormalised weights), so that masked walls act
-// as Neumann boundaries on every level.
+// inactive: no row of the operator reads them and the smoother leaves them,
+// and the prolongation interpolates from active coarse cells only
+// (renormalised weights), so that masked walls act as Neumann boundaries on
+// every level. Their values carry whatever corrections the prolongation adds
+// there, which depend on the hierarchy (merged solver blocks or not): no part
+// of the solution.
 //
 // Uniform forests of blocks smaller than 16^3 (the default 8^3) are solved on
 // a second forest of their families of 8 merged (merged_blocks.hpp), the
@@ -80,7 +84,8 @@ struct MultigridOptions {
   /// caller refills them anyway (the viscous solves: the velocity's ghosts
   /// are filled again before anything reads them), saving a full exchange;
   /// x's ghosts are then stale (with read_neighbours_in_place the kernels
-  /// read same-level neighbours in place and leave those ghosts as they were).
+  /// read same-level neighbours in place and leave those ghosts as they were;
+  /// on merged solver blocks none of x's ghosts is written, boundary ones included).
   bool fill_ghosts_on_return = true;
 };
 
@@ -99,14 +104,16 @@ class Multigrid {
   /// directions must say Periodic). merge_blocks: on a uniform forest of
   /// blocks smaller than 16^3, solve on the forest of its families of 8
   /// merged (merged_blocks.hpp: the same cells, half the blocks per
-  /// direction; the caller's fields copied in and out), which the V-cycle
-  /// runs about 3x faster on 8^3 blocks. false: the caller's blocks (for
-  /// comparisons).
+  /// direction; the caller's fields copied in and out), where a V-cycle of
+  /// the 64^3 cavity costs about half what it costs on 8^3 blocks. false: the
+  /// caller's blocks (for comparisons).
   Multigrid(const Forest& forest, const std::array<BcKind, 6>& kinds, bool merge_blocks = true);
 
   /// After the forest has changed (Forest::adapt): the levels for its new
   /// blocks, in the storage of the old ones where it is large enough, and
   /// the coefficients reset (alpha 0, beta 1), as a new Multigrid would have.
+  /// A forest that merges (merge_blocks) gets a new merged forest and solver
+  /// instead, and the levels of the caller's blocks are dropped.
   void rebuild();
 
   /// Coefficients of (1): alpha per cell (nullptr: 0) and beta per face
@@ -121,7 +128,9 @@ class Multigrid {
 
   /// `sweeps` sweeps of the V-cycles' smoother (red-black Gauss-Seidel with
   /// the options' relaxation and kernels) on the finest level, ghosts filled
-  /// as in a V-cycle: the smoother alone, for benchmarks and tests.
+  /// as in a V-cycle: the smoother alone, for benchmarks and tests. On merged
+  /// solver blocks the sweeps run there, with the copies in and out, and x's
+  /// ghosts are left as they were.
   void relax(BlockField& x, const BlockField& rhs, const ScalarBoundary& bc, int sweeps,
              const MultigridOptions& options = {});
 
@@ -130,12 +139,13 @@ class Multigrid {
 
   /// Whether every block of `level` (0: finest), on every rank, runs the
   /// constant-coefficient kernels when MultigridOptions::constant_coefficient_kernels
-  /// is on.
+  /// is on. On merged solver blocks: the merged blocks and their levels (level
+  /// 0 has the same cells; level l has 2b >> l cells per merged block).
   [[nodiscard]] bool constant_coefficients(int level) const {
     if (merged_) return merged_->solver->constant_coefficients(level);
     return levels_[static_cast<std::size_t>(level)].constant_coefficients;
   }
-  /// How many of this rank's blocks of `level` run them.
+  /// How many of this rank's blocks of `level` run them (merged blocks when merged).
   [[nodiscard]] int constant_blocks(int level) const;
 
   /// True when the operator has the constants as null space (alpha = 0, no
@@ -224,11 +234,13 @@ class Multigrid {
   void compute_activity();
   void detect_constant_coefficients();
 
-  /// The caller's fields into the merged solver's (cells; with_x: x too).
+  /// The caller's fields into the merged solver's (cells; x unless null).
   void to_merged(const BlockField* x, const BlockField& rhs);
-  /// The merged solver's x into the caller's, its ghosts filled as
-  /// fill_ghosts(0, x, &bc, false, false) fills them on a uniform forest.
+  /// The merged solver's x into the caller's, with fill_caller_ghosts after it.
   void from_merged(BlockField& x, const ScalarBoundary& bc, bool fill_ghosts) const;
+  /// x's ghosts filled as fill_ghosts(0, x, &bc, false, false) fills them on
+  /// a uniform forest (what solve() returns and residual() leaves).
+  void fill_caller_ghosts(BlockField& x, const ScalarBoundary& bc) const;
 
   const Forest& forest_;
   std::array<BcKind, 6> kinds_;
