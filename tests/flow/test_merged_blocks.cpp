@@ -119,13 +119,11 @@ MultigridReport solve_helmholtz(bool merge, BlockField& x) {
   Multigrid mg(forest, bc.kind, merge);
   EXPECT_EQ(mg.merged(), merge);
   const BlockField alpha = testing::sample(forest, [](const Vec3& p) { return 1.0 + p.x; });
+  // beta on the lower d-face of each cell, taken at that cell's centre (so
+  // the same value where two blocks share a face): faces 0..b, slot b too.
   FaceField beta;
-  for (int d = 0; d < 3; ++d) {
-    beta[static_cast<std::size_t>(d)] =
-        testing::sample(forest, [](const Vec3& p) { return 1.0 + p.y * p.z; });
-    // faces 0..b: slot b too (the next block's face 0 would be, here a
-    // smooth field sampled one cell on)
-    BlockField& f = beta[static_cast<std::size_t>(d)];
+  for (BlockField& f : beta) {
+    f = BlockField(forest.local_blocks(), 8);
     for (int blk = 0; blk < forest.local_blocks(); ++blk)
       for (int k = 0; k <= 8; ++k)
         for (int j = 0; j <= 8; ++j)
