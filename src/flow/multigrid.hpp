@@ -13,9 +13,9 @@
 // Gauss-Seidel smoothing, residual by 8-cell averaging, trilinear
 // prolongation of the correction); the level with one cell per block is the
 // forest's own grid of blocks (the merged ones, below, when merged), gathered
-// on every rank and solved there by
-// conjugate gradients (identical on every rank). Boundary values are applied
-// on the finest level only; corrections carry homogeneous conditions.
+// on every rank and solved there by conjugate gradients (identical on every
+// rank). Boundary values are applied on the finest level only; corrections
+// carry homogeneous conditions.
 // Cells closed on all faces with alpha = 0 (solid cells of a mask) are
 // inactive: no row of the operator reads them and the smoother leaves them,
 // and the prolongation interpolates from active coarse cells only
