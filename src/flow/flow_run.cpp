@@ -190,6 +190,11 @@ FlowRunSummary run_flow_case(const FlowCase& c, const FlowRunOptions& options,
                 : std::string("sanguis ") + kVersion)
         << "\n"
         << describe(c) << "ranks " << forest.ranks() << "\n"
+        << "multigrid blocks " << ns.solver_block_cells() << "^3"
+        << (ns.solver_block_cells() != forest.block_cells()
+                ? " (the grid's blocks merged by families of 8: docs/theory/flow.md)"
+                : "")
+        << "\n"
         << std::flush;
   }
   io::PvdIndex pvd(dir / "flow.pvd");
