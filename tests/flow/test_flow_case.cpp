@@ -215,6 +215,25 @@ TEST(FlowCaseErrors, UnknownKeysNonCubicCellsAndOneSidedPeriodicityAreErrors) {
                      "snapshots");
 }
 
+/// Runs `c` again into `whole`'s folder with "split" for a name, stopped at
+/// `stop_at` and restarted from its checkpoint: it must end with the
+/// uninterrupted run's checkpoint and diagnostics, byte for byte.
+FlowRunOptions expect_restart_bit_for_bit(const FlowCase& c, const FlowRunOptions& whole,
+                                          double stop_at, std::ostream& console) {
+  FlowRunOptions split = whole;
+  split.output_dir = whole.output_dir.parent_path() / "split";
+  split.stop_at = stop_at;
+  run_flow_case(c, split, console);
+  split.stop_at = -1.0;
+  split.restart = true;
+  run_flow_case(c, split, console);
+  EXPECT_EQ(read_bytes(whole.output_dir / "checkpoint.bin"),
+            read_bytes(split.output_dir / "checkpoint.bin"));
+  EXPECT_EQ(read_bytes(whole.output_dir / "diagnostics.csv"),
+            read_bytes(split.output_dir / "diagnostics.csv"));
+  return split;
+}
+
 TEST(FlowRun, WritesFramesDiagnosticsAndRestartsBitForBit) {
   const auto base = std::filesystem::temp_directory_path() / "sanguis_flow_run_test";
   std::filesystem::remove_all(base);
@@ -232,17 +251,7 @@ TEST(FlowRun, WritesFramesDiagnosticsAndRestartsBitForBit) {
   const std::string csv = read_bytes(whole.output_dir / "diagnostics.csv");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 6);  // header + t = 0, 0.01, ..., 0.04
 
-  FlowRunOptions split = whole;
-  split.output_dir = base / "split";
-  split.stop_at = 0.02;
-  run_flow_case(c, split, console);
-  split.stop_at = -1.0;
-  split.restart = true;
-  run_flow_case(c, split, console);
-  EXPECT_EQ(read_bytes(whole.output_dir / "checkpoint.bin"),
-            read_bytes(split.output_dir / "checkpoint.bin"));
-  EXPECT_EQ(read_bytes(whole.output_dir / "diagnostics.csv"),
-            read_bytes(split.output_dir / "diagnostics.csv"));
+  const FlowRunOptions split = expect_restart_bit_for_bit(c, whole, 0.02, console);
   EXPECT_EQ(read_bytes(whole.output_dir / "flow.pvd"), read_bytes(split.output_dir / "flow.pvd"));
   std::filesystem::remove_all(base);
 }
@@ -340,17 +349,7 @@ TEST(FlowRun, RestartsBitForBitWithMergedSolverBlocks) {
   run_flow_case(c, whole, console);
   EXPECT_NE(read_bytes(whole.output_dir / "run.log").find("multigrid blocks 16^3 (the grid's"),
             std::string::npos);
-  FlowRunOptions split = whole;
-  split.output_dir = base / "split";
-  split.stop_at = 0.01;
-  run_flow_case(c, split, console);
-  split.stop_at = -1.0;
-  split.restart = true;
-  run_flow_case(c, split, console);
-  EXPECT_EQ(read_bytes(whole.output_dir / "checkpoint.bin"),
-            read_bytes(split.output_dir / "checkpoint.bin"));
-  EXPECT_EQ(read_bytes(whole.output_dir / "diagnostics.csv"),
-            read_bytes(split.output_dir / "diagnostics.csv"));
+  expect_restart_bit_for_bit(c, whole, 0.01, console);
   std::filesystem::remove_all(base);
 }
 
@@ -414,17 +413,7 @@ viscosity_Pa_s = 2.0
 
   // Stopped half way (after a regrid) and restarted: the checkpoint rebuilds
   // the adapted grid and the run continues bit for bit.
-  FlowRunOptions split = whole;
-  split.output_dir = base / "split";
-  split.stop_at = 0.02;
-  run_flow_case(c, split, console);
-  split.stop_at = -1.0;
-  split.restart = true;
-  run_flow_case(c, split, console);
-  EXPECT_EQ(read_bytes(whole.output_dir / "checkpoint.bin"),
-            read_bytes(split.output_dir / "checkpoint.bin"));
-  EXPECT_EQ(read_bytes(whole.output_dir / "diagnostics.csv"),
-            read_bytes(split.output_dir / "diagnostics.csv"));
+  expect_restart_bit_for_bit(c, whole, 0.02, console);
   std::filesystem::remove_all(base);
 }
 
