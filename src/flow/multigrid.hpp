@@ -156,6 +156,10 @@ class Multigrid {
   /// forest of blocks smaller than 16^3 with at least 2 merged blocks per
   /// direction).
   [[nodiscard]] bool merged() const { return merged_ != nullptr; }
+  /// Cells per edge of the blocks the solves run on (the merged ones when merged).
+  [[nodiscard]] int solver_block_cells() const {
+    return merged_ ? merged_->forest->block_cells() : forest_.block_cells();
+  }
 
  private:
   /// The sweeps, relaxation and kernels of `options`, for what follows.

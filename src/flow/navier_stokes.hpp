@@ -227,9 +227,7 @@ class NavierStokes {
   /// Cells per edge of the blocks the multigrids solve on: the forest's, or
   /// twice that where they merge its families of 8 (uniform forests of
   /// blocks below 16^3, merge_solver_blocks).
-  [[nodiscard]] int solver_block_cells() const {
-    return (pressure_mg_->merged() ? 2 : 1) * forest_.block_cells();
-  }
+  [[nodiscard]] int solver_block_cells() const { return pressure_mg_->solver_block_cells(); }
   /// The last multigrid report of the final projection.
   [[nodiscard]] const MultigridReport& last_pressure_report() const { return pressure_report_; }
 
