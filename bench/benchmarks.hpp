@@ -19,7 +19,8 @@ struct BenchOptions {
   std::int64_t triangles = 5120;     // membrane: triangles per capsule (20 * 4^k)
   std::int64_t capsules = 100;       // membrane: number of capsules
   std::int64_t cells_per_side = 64;  // flow-cavity: cells along each edge (multiple of the block)
-  int block_cells = 8;               // flow-cavity: cells per block edge (a power of two)
+  int block_cells = 0;  // flow-cavity: cells per block edge (a power of two); 0: as a case file
+                        // without block_cells (flow::automatic_block_cells)
   // flow-cavity: multigrid kernels that read the coefficient arrays even where they
   // are constant (MultigridOptions::uniform_coefficient_kernels = false), for A/B runs.
   bool general_kernels = false;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "benchmarks.hpp"
+#include "flow/flow_case.hpp"
 #include "flow/navier_stokes.hpp"
 
 namespace sanguis::bench {
@@ -79,7 +80,12 @@ std::array<flow::FlowBoundary, 6> cavity_boundaries(double lid_velocity) {
   return bcs;
 }
 
-std::string run_flow_cavity(const BenchOptions& o) {
+std::string run_flow_cavity(const BenchOptions& options_in) {
+  BenchOptions o = options_in;
+  if (o.block_cells == 0) {
+    const int n = static_cast<int>(std::min<std::int64_t>(o.cells_per_side, 1 << 20));
+    o.block_cells = flow::automatic_block_cells({n, n, n}, false);
+  }
   const flow::Forest forest(cavity_forest(o.cells_per_side, o.block_cells, o.threads));
   flow::NavierStokesOptions options;
   options.dt_max = 0.01;

@@ -7,10 +7,12 @@
 #   bench/flow_cavity_vs_gerris.sh [--cells-per-side N] [--steps S] [--block-cells B]
 #                                  [--repeat R] [--pairs P] [--unmerged-solver]
 #
-# B: sanguis' cells per block edge (default 8, its case-file default; 16 runs
-# a uniform grid faster per cell, see docs/performance.md). Blocks below 16^3
-# are merged 8 by 8 for the multigrid (Multigrid's merge_blocks);
-# --unmerged-solver solves on the blocks themselves instead (A/B).
+# B: sanguis' cells per block edge (default: what a case file without
+# block_cells gets, 16 where N is a multiple of 16 and at least 32, else 8;
+# docs/performance.md, "Automatic block size"; --block-cells 8 for the
+# adaptive grids' default). Blocks below 16^3 are merged 8 by 8 for the
+# multigrid (Multigrid's merge_blocks); --unmerged-solver solves on the
+# blocks themselves instead (A/B).
 # N must be a power of two for Gerris (2^level); default 64 and 10 steps.
 # Gerris' time is the wall time between its step 0 and its last step (its own
 # log), so its set-up is excluded as for sanguis. A pair is one Gerris run
@@ -33,7 +35,7 @@ sanguis="${SANGUIS:-$root/build/app/sanguis}"
 gerris="${GERRIS:-gerris3D}"
 cells=64
 steps=10
-block=8
+block=0
 repeat=5
 pairs=1
 unmerged=()
@@ -45,7 +47,7 @@ while [[ $# -gt 0 ]]; do
     --repeat) repeat="${2:?--repeat needs a value}"; shift 2 ;;
     --pairs) pairs="${2:?--pairs needs a value}"; shift 2 ;;
     --unmerged-solver) unmerged=(--unmerged-solver); shift ;;
-    -h|--help) sed -n '2,27p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,28p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "flow_cavity_vs_gerris: unknown option $1" >&2; exit 2 ;;
   esac
 done
@@ -76,6 +78,7 @@ run_sanguis() {
     line=$("$sanguis" bench flow-cavity --cells-per-side "$cells" --steps "$steps" --threads 1 --block-cells "$block" "${unmerged[@]}")
     echo "$line"
     rates+=("$(echo "$line" | sed 's/.*"cell_updates_per_s":\([0-9.e+-]*\).*/\1/')")
+    block_used="$(echo "$line" | sed 's/.*"block_cells":\([0-9]*\).*/\1/')"
   done
   sanguis_rate=$(printf '%s\n' "${rates[@]}" | median)
 }
@@ -101,5 +104,5 @@ sanguis_median=$(printf '%s\n' "${sanguis_rates[@]}" | median)
 ratio_median=$(printf '%s\n' "${ratios[@]}" | median)
 ratio_list=$(IFS=,; echo "${ratios[*]}")
 awk -v a="$sanguis_median" -v b="$gerris_median" -v q="$ratio_median" -v list="$ratio_list" \
-  -v n="$cells" -v s="$steps" -v blk="$block" -v r="$repeat" -v np="$pairs" \
+  -v n="$cells" -v s="$steps" -v blk="$block_used" -v r="$repeat" -v np="$pairs" \
   'BEGIN { printf "{\"benchmark\":\"flow-cavity\",\"summary\":true,\"block_cells\":%d,\"cells_per_side\":%d,\"steps\":%d,\"pairs\":%d,\"sanguis_runs_per_pair\":%d,\"gerris_cell_updates_per_s\":%s,\"sanguis_median_cell_updates_per_s\":%s,\"pair_ratios\":[%s],\"ratio_sanguis_over_gerris\":%.3g}\n", blk, n, s, np, r, b, a, list, q }'

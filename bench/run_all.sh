@@ -93,11 +93,12 @@ run membrane-2threads "$sanguis" bench membrane "${membrane[@]}" --threads 2
 if have "${GERRIS:-gerris3D}"; then
   # As many Gerris runs as repeats, alternated with sanguis' (the median of the pairs'
   # ratios counts: the host's load moves the two codes differently).
+  # The default blocks (16^3 at 64^3: the grid does not adapt), then the 8^3 blocks of
+  # adaptive grids (docs/performance.md, "Block size", "Automatic block size").
   run flow-cavity-vs-gerris "$root/bench/flow_cavity_vs_gerris.sh" --cells-per-side "$flow_n" \
     --steps "$((flow_steps / 2 > 0 ? flow_steps / 2 : 1))" --pairs "$repeat"
-  # 16^3 blocks: the fastest on a uniform grid (docs/performance.md, "Block size").
-  run flow-cavity-vs-gerris-b16 "$root/bench/flow_cavity_vs_gerris.sh" --cells-per-side "$flow_n" \
-    --steps "$((flow_steps / 2 > 0 ? flow_steps / 2 : 1))" --block-cells 16 --pairs "$repeat"
+  run flow-cavity-vs-gerris-b8 "$root/bench/flow_cavity_vs_gerris.sh" --cells-per-side "$flow_n" \
+    --steps "$((flow_steps / 2 > 0 ? flow_steps / 2 : 1))" --block-cells 8 --pairs "$repeat"
 else
   echo "== flow-cavity-vs-gerris: skipped (Gerris not installed: scripts/install-deps.sh --bench)"
 fi

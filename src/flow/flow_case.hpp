@@ -38,6 +38,7 @@ struct FlowCase {
   std::filesystem::path source;              ///< the case file
   double end_time = 0.0;                     ///< (s)
   ForestSpec forest;                         ///< brick, block size, periodicity
+  bool block_cells_chosen = false;           ///< block_cells not given: automatic_block_cells()
   std::array<int, 3> cells{};                ///< cells per direction
   std::array<FlowBoundary, 6> boundaries{};  ///< by face_index
   std::array<std::string, 6> boundary_text;  ///< as read, for the log
@@ -70,10 +71,18 @@ FlowCase load_flow_case(const ConfigTable& cfg, const std::filesystem::path& sou
 /// The viscosity at x: the last region holding x, else the fluid's.
 double viscosity_at(const FlowCase& c, const Vec3& x);
 
-/// A line suggesting 16^3 blocks where the grid does not adapt, its cell
-/// counts allow them and the blocks are smaller (they run a uniform grid
-/// about 1.4x faster per cell, the multigrid already solving on 16^3 blocks);
-/// empty otherwise. describe() includes it.
+/// The block size of a grid whose case does not set `block_cells`: 16 where
+/// the grid does not adapt and every cell count is a multiple of 16 and at
+/// least 32 (two blocks or more per direction, for threads and ranks to
+/// share), else 8. Adaptive grids refine and coarsen whole blocks, and 8
+/// keeps refined regions tight; a grid that never adapts gains nothing from
+/// small blocks, and 16^3 ones run it about 1.4x faster per cell
+/// (docs/performance.md, "Block size", "Automatic block size").
+int automatic_block_cells(const std::array<int, 3>& cells, bool adaptive);
+
+/// A line suggesting 16^3 blocks where the case sets smaller ones that
+/// automatic_block_cells() would have made 16; empty otherwise. describe()
+/// includes it.
 std::string block_size_hint(const FlowCase& c);
 
 /// The resolved parameters, one per line (for run.log).

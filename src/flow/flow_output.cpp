@@ -226,6 +226,12 @@ CheckpointCounters load_flow_checkpoint(const std::filesystem::path& path, Navie
     in.read(reinterpret_cast<char*>(&header), sizeof header);
     if (!in || std::memcmp(header.magic, kMagic, sizeof kMagic) != 0) {
       fault = "not a sanguis flow checkpoint (or one of an older version)";
+    } else if (header.block_cells != forest.block_cells()) {
+      // Since 2026-12-03 a case without block_cells may get 16^3 blocks where it got 8^3.
+      fault = "written with blocks of " + std::to_string(header.block_cells) +
+              "^3 cells, this run has " + std::to_string(forest.block_cells()) +
+              "^3 (set [flow.grid] block_cells = " + std::to_string(header.block_cells) +
+              " to restart it)";
     } else if (!same_case_grid(header, forest)) {
       fault =
           "written for another grid or number of ranks (the case's [flow.grid] and the mpirun "

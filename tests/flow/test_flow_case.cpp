@@ -102,21 +102,46 @@ TEST(FlowCase, ValidCaseResolvesGridBoundariesAndFluid) {
   EXPECT_DOUBLE_EQ(c.options.dt_max, 0.005);
 }
 
-TEST(FlowCase, TheLogSuggestsSixteenCellBlocksWhereTheGridDoesNotAdapt) {
-  // The channel (8 x 16 x 8 cells) cannot take 16^3 blocks: no hint.
+TEST(FlowCase, AGridThatDoesNotAdaptGetsSixteenCellBlocksUnlessTheCaseSetsThem) {
+  // The rule: 16 where the grid does not adapt and every count is a multiple
+  // of 16 and at least 32 (two blocks per direction or more), else 8.
+  EXPECT_EQ(automatic_block_cells({32, 64, 48}, false), 16);
+  EXPECT_EQ(automatic_block_cells({32, 64, 48}, true), 8);
+  EXPECT_EQ(automatic_block_cells({16, 32, 32}, false), 8);  // one block along x
+  EXPECT_EQ(automatic_block_cells({40, 32, 32}, false), 8);  // 40 is not a multiple of 16
+  // The channel (8 x 16 x 8 cells) cannot take 16^3 blocks: 8, and no hint.
+  EXPECT_EQ(parse(kChannel).forest.block_cells, 8);
   EXPECT_EQ(block_size_hint(parse(kChannel)), "");
-  // 16 x 16 x 16 cells of the default 8^3 blocks, no adaptivity: the hint, in the log's text.
+  // 32^3 cells without block_cells and without adaptivity: 16^3 blocks, and the log says why.
   std::string text = replaced(kChannel, "size_m = [0.5, 1.0, 0.5]", "size_m = [1.0, 1.0, 1.0]");
-  text = replaced(text, "cells = [8, 16, 8]", "cells = [16, 16, 16]");
-  const FlowCase uniform = parse(text);
-  const std::string hint = block_size_hint(uniform);
+  text = replaced(text, "cells = [8, 16, 8]", "cells = [32, 32, 32]");
+  const FlowCase chosen = parse(text);
+  EXPECT_TRUE(chosen.block_cells_chosen);
+  EXPECT_EQ(chosen.forest.block_cells, 16);
+  EXPECT_EQ(chosen.forest.trees[0] * (16 << chosen.forest.level), 32);
+  EXPECT_EQ(block_size_hint(chosen), "");
+  EXPECT_NE(describe(chosen).find("blocks of 16^3 cells (block_cells not given: 16, as the grid "
+                                  "does not adapt)"),
+            std::string::npos)
+      << describe(chosen);
+  // The same grid adaptive: 8^3 blocks (they keep refined regions tight).
+  const FlowCase adaptive = parse(text + "\n[flow.adapt]\nvelocity_threshold_m_s = 1e-3\n");
+  EXPECT_EQ(adaptive.forest.block_cells, 8);
+  EXPECT_NE(describe(adaptive).find("(block_cells not given: the default 8)"), std::string::npos);
+  EXPECT_EQ(block_size_hint(adaptive), "");
+  // Set by the case: kept as written; below 16 on this grid, the hint says what 16 would give.
+  const std::string eights =
+      replaced(text, "cells = [32, 32, 32]", "cells = [32, 32, 32]\nblock_cells = 8");
+  const FlowCase set = parse(eights);
+  EXPECT_FALSE(set.block_cells_chosen);
+  EXPECT_EQ(set.forest.block_cells, 8);
+  const std::string hint = block_size_hint(set);
   EXPECT_NE(hint.find("block_cells = 16"), std::string::npos) << hint;
-  EXPECT_NE(describe(uniform).find(hint), std::string::npos);
-  // Already 16^3 blocks, or an adaptive grid (8^3 keeps refined regions tight): none.
-  EXPECT_EQ(block_size_hint(parse(
-                replaced(text, "cells = [16, 16, 16]", "cells = [16, 16, 16]\nblock_cells = 16"))),
-            "");
-  EXPECT_EQ(block_size_hint(parse(text + "\n[flow.adapt]\nvelocity_threshold_m_s = 1e-3\n")), "");
+  EXPECT_NE(describe(set).find(hint), std::string::npos);
+  EXPECT_EQ(describe(set).find("block_cells not given"), std::string::npos);
+  EXPECT_EQ(parse(replaced(text, "cells = [32, 32, 32]", "cells = [32, 32, 32]\nblock_cells = 32"))
+                .forest.block_cells,
+            32);
 }
 
 TEST(FlowCase, ParabolicInflowVariesOnlyAcrossTheWalls) {
@@ -334,14 +359,15 @@ std::vector<double> cells_column(const std::string& csv) {
 }
 
 TEST(FlowRun, RestartsBitForBitWithMergedSolverBlocks) {
-  // 32 x 64 x 32 cells in 8^3 blocks: the multigrids solve on merged 16^3
+  // 32 x 64 x 32 cells in 8^3 blocks (set: the grid would take 16^3 ones
+  // without block_cells): the multigrids solve on merged 16^3
   // blocks (Multigrid::merged), and a run stopped at a frame and restarted
   // must still end with the uninterrupted run's checkpoint and diagnostics.
   const auto base = std::filesystem::temp_directory_path() / "sanguis_flow_run_merged_test";
   std::filesystem::remove_all(base);
-  const FlowCase c =
-      parse(replaced(replaced(kChannel, "cells = [8, 16, 8]", "cells = [32, 64, 32]"),
-                     "end_time_s = 0.04", "end_time_s = 0.02"));
+  const FlowCase c = parse(
+      replaced(replaced(kChannel, "cells = [8, 16, 8]", "cells = [32, 64, 32]\nblock_cells = 8"),
+               "end_time_s = 0.04", "end_time_s = 0.02"));
   std::ostringstream console;
   FlowRunOptions whole;
   whole.output_dir = base / "whole";
@@ -350,6 +376,36 @@ TEST(FlowRun, RestartsBitForBitWithMergedSolverBlocks) {
   EXPECT_NE(read_bytes(whole.output_dir / "run.log").find("multigrid blocks 16^3 (the grid's"),
             std::string::npos);
   expect_restart_bit_for_bit(c, whole, 0.01, console);
+  std::filesystem::remove_all(base);
+}
+
+TEST(FlowRun, ACheckpointOfOtherBlocksSaysWhichToSet) {
+  // A run written with 8^3 blocks, restarted from a case whose grid now gets
+  // 16^3 ones without block_cells: the error names both sizes and the key.
+  const auto base = std::filesystem::temp_directory_path() / "sanguis_flow_run_blocks_test";
+  std::filesystem::remove_all(base);
+  std::string text = replaced(kChannel, "size_m = [0.5, 1.0, 0.5]", "size_m = [1.0, 1.0, 1.0]");
+  text = replaced(replaced(text, "end_time_s = 0.04", "end_time_s = 0.01"), "cells = [8, 16, 8]",
+                  "cells = [32, 32, 32]");
+  std::ostringstream console;
+  FlowRunOptions options;
+  options.output_dir = base;
+  options.quiet = true;
+  run_flow_case(
+      parse(replaced(text, "cells = [32, 32, 32]", "cells = [32, 32, 32]\nblock_cells = 8")),
+      options, console);
+  const std::string checkpoint = read_bytes(base / "checkpoint.bin");
+  options.restart = true;
+  try {
+    run_flow_case(parse(text), options, console);
+    ADD_FAILURE() << "restart with other blocks did not fail";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("blocks of 8^3 cells, this run has 16^3 (set [flow.grid] "
+                                         "block_cells = 8"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(read_bytes(base / "checkpoint.bin"), checkpoint);  // nothing lost
   std::filesystem::remove_all(base);
 }
 
