@@ -236,6 +236,19 @@ def two_at_a_time_span(durations):
     return max([now] + running)
 
 
+def paused_minutes(runs_dir):
+    """Minutes that a case's runs spent stopped (SIGSTOP, while benchmarks or
+    CI used the cores) and that their run.log wall times therefore include,
+    as listed by hand in RUNS_DIR/PAUSES.txt ("(12.5 min" or "about 17 min"
+    per pause); None without that file."""
+    path = os.path.join(runs_dir, "PAUSES.txt")
+    if not os.path.exists(path):
+        return None
+    with open(path) as f:
+        text = f.read()
+    return sum(float(m) for m in re.findall(r"(?:\(|about )([0-9]+(?:\.[0-9]+)?) min", text))
+
+
 def write_summary(summary, results_dir, elapsed, quick, ok):
     """Completes a case's summary (run time, date, quick, pass) and writes it as
     RESULTS/<name>.json, the file run_all.py reads for the report."""

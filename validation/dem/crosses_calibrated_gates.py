@@ -43,7 +43,7 @@ import sys
 import matplotlib
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import (continue_or_copy, read_summary, regime_name, wall_time,  # noqa: E402
+from _outputs import (continue_or_copy, paused_minutes, read_summary, regime_name, wall_time,  # noqa: E402
                       write_summary)
 from crosses_dam_break import (CROSSES, GATE_INDEX, RESULTS, ROOT, SEED,  # noqa: E402
                                diagnostics, draw_velocity_bands, gate_runner, lajeunesse,
@@ -377,6 +377,11 @@ def main():
                     "rows": rows}],
         "notes": notes,
     }
+    paused = paused_minutes(RUNS)
+    if paused:
+        notes.append(f"The wall times include {paused:.0f} min in which the runs were stopped "
+                     "(SIGSTOP) while benchmarks and CI used the VM's two cores "
+                     "(listed in results/runs/crosses_calibrated_gates/PAUSES.txt).")
     write_summary(summary, RESULTS, elapsed, args.quick, ok)
     print(f"{'PASS' if ok else 'FAIL'}: {elapsed / 3600:.2f} h")
     return 0 if ok else 1

@@ -165,6 +165,17 @@ class RunSegments(unittest.TestCase):
             self.assertEqual(_outputs.wall_time(tmp), 0)
 
 
+class Pauses(unittest.TestCase):
+    def test_minutes_are_summed_from_the_pause_list(self):
+        with tempfile.TemporaryDirectory() as d:
+            self.assertIsNone(_outputs.paused_minutes(d))
+            write_text(d, "PAUSES.txt",
+                       "- pour (stop 49): about 17 min (CI), before 2 s.\n"
+                       "  09:48:42-10:11:17 (22.6 min, benchmarks), 10:12:12-10:12:53\n"
+                       "  (0.7 min): between 2 s and 2.25 s; restarted at 09:24.\n")
+            self.assertAlmostEqual(_outputs.paused_minutes(d), 40.3)
+
+
 class TwoAtATime(unittest.TestCase):
     def test_span_of_jobs_run_two_at_a_time_oldest_first(self):
         self.assertEqual(_outputs.two_at_a_time_span([]), 0.0)
