@@ -8,7 +8,7 @@
 #                                  [--repeat R] [--pairs P] [--unmerged-solver]
 #
 # B: sanguis' cells per block edge (default: what a case file without
-# block_cells gets, 16 where N is a multiple of 16 and at least 32, else 8;
+# block_cells gets, 16 where N is a multiple of 16 and at least 64, else 8;
 # docs/performance.md, "Automatic block size"; --block-cells 8 for the
 # adaptive grids' default). Blocks below 16^3 are merged 8 by 8 for the
 # multigrid (Multigrid's merge_blocks); --unmerged-solver solves on the

@@ -222,9 +222,9 @@ FlowCase load_flow_case(const ConfigTable& cfg, const std::filesystem::path& sou
     if (!(size[d] > 0.0)) grid.fail("size_m", "every extent must be > 0");
   }
   c.cells = read_cells(grid);
-  c.block_cells_chosen = !grid.has("block_cells");
-  const std::int64_t b = c.block_cells_chosen ? automatic_block_cells(c.cells, flow.has("adapt"))
-                                              : grid.get_int("block_cells", 8);
+  c.block_cells_automatic = !grid.has("block_cells");
+  const std::int64_t b = c.block_cells_automatic ? automatic_block_cells(c.cells, flow.has("adapt"))
+                                                 : grid.get_int("block_cells", 8);
   if (b < 2 || b > 64 || (b & (b - 1)) != 0)
     grid.fail("block_cells", "must be a power of two in 2..64");
   c.forest.block_cells = static_cast<int>(b);
@@ -334,17 +334,37 @@ double viscosity_at(const FlowCase& c, const Vec3& x) {
   return mu;
 }
 
-int automatic_block_cells(const std::array<int, 3>& cells, bool adaptive) {
+namespace {
+
+/// Whether the cell counts allow 16^3 blocks, two or more per direction, 64 or more in all.
+bool sixteen_cell_blocks_fit(const std::array<int, 3>& cells) {
   const bool sixteens =
       std::all_of(cells.begin(), cells.end(), [](int n) { return n % 16 == 0 && n >= 32; });
-  return !adaptive && sixteens ? 16 : 8;
+  std::int64_t blocks = 1;
+  for (const int n : cells) blocks *= n / 16;
+  return sixteens && blocks >= 64;
+}
+
+}  // namespace
+
+int automatic_block_cells(const std::array<int, 3>& cells, bool adaptive) {
+  return !adaptive && sixteen_cell_blocks_fit(cells) ? 16 : 8;
+}
+
+std::string automatic_block_cells_reason(const std::array<int, 3>& cells, bool adaptive) {
+  if (adaptive) return "8, as the grid adapts";
+  if (!sixteen_cell_blocks_fit(cells))
+    return "8, as the cell counts do not make 64 blocks of 16^3 or more, two or more per "
+           "direction";
+  return "16, as the grid does not adapt and is large enough";
 }
 
 std::string block_size_hint(const FlowCase& c) {
   const int b = c.forest.block_cells;
-  const int chosen = automatic_block_cells(c.cells, c.adapt.enabled);
-  if (c.block_cells_chosen || b >= chosen) return {};
-  return "hint: this grid does not adapt, and its cell counts are multiples of 16 (at least 32): "
+  if (c.block_cells_automatic || b >= 16 || automatic_block_cells(c.cells, c.adapt.enabled) != 16) {
+    return {};
+  }
+  return "hint: this grid does not adapt, and its cell counts make 64 blocks of 16^3 or more: "
          "block_cells = 16, or no block_cells at all, runs it about 1.4x faster per cell than " +
          std::to_string(b) +
          " (docs/case-file.md, [flow.grid]; docs/performance.md, \"Block size\")";
@@ -357,9 +377,9 @@ std::string describe(const FlowCase& c) {
   s << "case " << c.name << " (" << c.source.string() << "): flow\n"
     << "grid: " << c.cells[0] << " x " << c.cells[1] << " x " << c.cells[2] << " cells of " << h
     << " m; blocks of " << c.forest.block_cells << "^3 cells"
-    << (!c.block_cells_chosen        ? ""
-        : c.forest.block_cells == 16 ? " (block_cells not given: 16, as the grid does not adapt)"
-                                     : " (block_cells not given: the default 8)")
+    << (c.block_cells_automatic ? " (block_cells not given: " +
+                                      automatic_block_cells_reason(c.cells, c.adapt.enabled) + ")"
+                                : std::string())
     << "; p4est brick " << c.forest.trees[0] << " x " << c.forest.trees[1] << " x "
     << c.forest.trees[2] << " trees at level " << c.forest.level << "; origin ("
     << c.forest.origin.x << ", " << c.forest.origin.y << ", " << c.forest.origin.z << ") m\n"

@@ -34,12 +34,12 @@ struct FlowAdaptivity {
 };
 
 struct FlowCase {
-  std::string name;                          ///< [simulation].name, default the file's stem
-  std::filesystem::path source;              ///< the case file
-  double end_time = 0.0;                     ///< (s)
-  ForestSpec forest;                         ///< brick, block size, periodicity
-  bool block_cells_chosen = false;           ///< block_cells not given: automatic_block_cells()
-  std::array<int, 3> cells{};                ///< cells per direction
+  std::string name;                    ///< [simulation].name, default the file's stem
+  std::filesystem::path source;        ///< the case file
+  double end_time = 0.0;               ///< (s)
+  ForestSpec forest;                   ///< brick, block size, periodicity
+  bool block_cells_automatic = false;  ///< block_cells not given: automatic_block_cells() chose it
+  std::array<int, 3> cells{};          ///< cells per direction
   std::array<FlowBoundary, 6> boundaries{};  ///< by face_index
   std::array<std::string, 6> boundary_text;  ///< as read, for the log
   Fluid fluid;
@@ -72,17 +72,22 @@ FlowCase load_flow_case(const ConfigTable& cfg, const std::filesystem::path& sou
 double viscosity_at(const FlowCase& c, const Vec3& x);
 
 /// The block size of a grid whose case does not set `block_cells`: 16 where
-/// the grid does not adapt and every cell count is a multiple of 16 and at
-/// least 32 (two blocks or more per direction, for threads and ranks to
-/// share), else 8. Adaptive grids refine and coarsen whole blocks, and 8
-/// keeps refined regions tight; a grid that never adapts gains nothing from
-/// small blocks, and 16^3 ones run it about 1.4x faster per cell
-/// (docs/performance.md, "Block size", "Automatic block size").
+/// the grid does not adapt, every cell count is a multiple of 16 and at least
+/// 32, and the grid holds at least 64 such blocks (64^3 cells or more), else
+/// 8. Adaptive grids refine and coarsen whole blocks, and 8 keeps refined
+/// regions tight; a large grid that never adapts gains nothing from small
+/// blocks, and 16^3 ones run it about 1.4x faster per cell; a small one keeps
+/// 8^3 blocks so that threads and ranks have blocks to share (64 blocks of
+/// 16^3 give 16 workers 4 each). The rule does not look at the number of
+/// threads or ranks (docs/performance.md, "Block size", "Automatic block size").
 int automatic_block_cells(const std::array<int, 3>& cells, bool adaptive);
 
-/// A line suggesting 16^3 blocks where the case sets smaller ones that
-/// automatic_block_cells() would have made 16; empty otherwise. describe()
-/// includes it.
+/// Why automatic_block_cells() gives what it gives, for run.log.
+std::string automatic_block_cells_reason(const std::array<int, 3>& cells, bool adaptive);
+
+/// A line suggesting 16^3 blocks where the case sets smaller ones and
+/// automatic_block_cells() would have made them 16; empty otherwise.
+/// describe() includes it.
 std::string block_size_hint(const FlowCase& c);
 
 /// The resolved parameters, one per line (for run.log).

@@ -102,46 +102,59 @@ TEST(FlowCase, ValidCaseResolvesGridBoundariesAndFluid) {
   EXPECT_DOUBLE_EQ(c.options.dt_max, 0.005);
 }
 
-TEST(FlowCase, AGridThatDoesNotAdaptGetsSixteenCellBlocksUnlessTheCaseSetsThem) {
-  // The rule: 16 where the grid does not adapt and every count is a multiple
-  // of 16 and at least 32 (two blocks per direction or more), else 8.
-  EXPECT_EQ(automatic_block_cells({32, 64, 48}, false), 16);
-  EXPECT_EQ(automatic_block_cells({32, 64, 48}, true), 8);
-  EXPECT_EQ(automatic_block_cells({16, 32, 32}, false), 8);  // one block along x
-  EXPECT_EQ(automatic_block_cells({40, 32, 32}, false), 8);  // 40 is not a multiple of 16
+TEST(FlowCase, ALargeGridThatDoesNotAdaptGetsSixteenCellBlocksUnlessTheCaseSetsThem) {
+  // The rule: 16 where the grid does not adapt, every count is a multiple of
+  // 16 and at least 32, and the grid holds 64 such blocks or more; else 8.
+  EXPECT_EQ(automatic_block_cells({64, 64, 64}, false), 16);
+  EXPECT_EQ(automatic_block_cells({32, 64, 128}, false), 16);
+  EXPECT_EQ(automatic_block_cells({64, 64, 64}, true), 8);
+  EXPECT_EQ(automatic_block_cells({32, 32, 32}, false), 8);    // 8 blocks: too few to share
+  EXPECT_EQ(automatic_block_cells({16, 128, 128}, false), 8);  // one block along x
+  EXPECT_EQ(automatic_block_cells({80, 64, 64}, false), 16);   // 5 x 4 x 4 blocks
+  EXPECT_EQ(automatic_block_cells({72, 64, 64}, false), 8);    // 72 is not
   // The channel (8 x 16 x 8 cells) cannot take 16^3 blocks: 8, and no hint.
   EXPECT_EQ(parse(kChannel).forest.block_cells, 8);
   EXPECT_EQ(block_size_hint(parse(kChannel)), "");
-  // 32^3 cells without block_cells and without adaptivity: 16^3 blocks, and the log says why.
+  EXPECT_NE(describe(parse(kChannel)).find("(block_cells not given: 8, as the cell counts do not"),
+            std::string::npos);
+  // 64^3 cells without block_cells and without adaptivity: 16^3 blocks, and the log says why.
   std::string text = replaced(kChannel, "size_m = [0.5, 1.0, 0.5]", "size_m = [1.0, 1.0, 1.0]");
-  text = replaced(text, "cells = [8, 16, 8]", "cells = [32, 32, 32]");
-  const FlowCase chosen = parse(text);
-  EXPECT_TRUE(chosen.block_cells_chosen);
-  EXPECT_EQ(chosen.forest.block_cells, 16);
-  EXPECT_EQ(chosen.forest.trees[0] * (16 << chosen.forest.level), 32);
-  EXPECT_EQ(block_size_hint(chosen), "");
-  EXPECT_NE(describe(chosen).find("blocks of 16^3 cells (block_cells not given: 16, as the grid "
-                                  "does not adapt)"),
+  text = replaced(text, "cells = [8, 16, 8]", "cells = [64, 64, 64]");
+  const FlowCase automatic = parse(text);
+  EXPECT_TRUE(automatic.block_cells_automatic);
+  EXPECT_EQ(automatic.forest.block_cells, 16);
+  EXPECT_EQ(automatic.forest.trees[0] * (16 << automatic.forest.level), 64);
+  EXPECT_EQ(block_size_hint(automatic), "");
+  EXPECT_NE(describe(automatic).find("blocks of 16^3 cells (block_cells not given: 16, as the grid "
+                                     "does not adapt and is large enough)"),
             std::string::npos)
-      << describe(chosen);
-  // The same grid adaptive: 8^3 blocks (they keep refined regions tight).
+      << describe(automatic);
+  // The same grid adaptive: 8^3 blocks (they keep refined regions tight), no hint.
   const FlowCase adaptive = parse(text + "\n[flow.adapt]\nvelocity_threshold_m_s = 1e-3\n");
   EXPECT_EQ(adaptive.forest.block_cells, 8);
-  EXPECT_NE(describe(adaptive).find("(block_cells not given: the default 8)"), std::string::npos);
+  EXPECT_NE(describe(adaptive).find("(block_cells not given: 8, as the grid adapts)"),
+            std::string::npos);
   EXPECT_EQ(block_size_hint(adaptive), "");
   // Set by the case: kept as written; below 16 on this grid, the hint says what 16 would give.
-  const std::string eights =
-      replaced(text, "cells = [32, 32, 32]", "cells = [32, 32, 32]\nblock_cells = 8");
-  const FlowCase set = parse(eights);
-  EXPECT_FALSE(set.block_cells_chosen);
+  const auto with_blocks = [&](const std::string& source, int b) {
+    return parse(replaced(source, "cells = [64, 64, 64]",
+                          "cells = [64, 64, 64]\nblock_cells = " + std::to_string(b)));
+  };
+  const FlowCase set = with_blocks(text, 8);
+  EXPECT_FALSE(set.block_cells_automatic);
   EXPECT_EQ(set.forest.block_cells, 8);
   const std::string hint = block_size_hint(set);
   EXPECT_NE(hint.find("block_cells = 16"), std::string::npos) << hint;
   EXPECT_NE(describe(set).find(hint), std::string::npos);
   EXPECT_EQ(describe(set).find("block_cells not given"), std::string::npos);
-  EXPECT_EQ(parse(replaced(text, "cells = [32, 32, 32]", "cells = [32, 32, 32]\nblock_cells = 32"))
-                .forest.block_cells,
-            32);
+  EXPECT_EQ(with_blocks(text, 32).forest.block_cells, 32);
+  // Small blocks where the rule would give 8 too (adaptive, or small): no hint.
+  EXPECT_EQ(
+      block_size_hint(with_blocks(text + "\n[flow.adapt]\nvelocity_threshold_m_s = 1e-3\n", 4)),
+      "");
+  EXPECT_EQ(block_size_hint(parse(
+                replaced(kChannel, "cells = [8, 16, 8]", "cells = [8, 16, 8]\nblock_cells = 4"))),
+            "");
 }
 
 TEST(FlowCase, ParabolicInflowVariesOnlyAcrossTheWalls) {
@@ -359,8 +372,8 @@ std::vector<double> cells_column(const std::string& csv) {
 }
 
 TEST(FlowRun, RestartsBitForBitWithMergedSolverBlocks) {
-  // 32 x 64 x 32 cells in 8^3 blocks (set: the grid would take 16^3 ones
-  // without block_cells): the multigrids solve on merged 16^3
+  // 32 x 64 x 32 cells in 8^3 blocks (set, though the rule gives 8 here
+  // too): the multigrids solve on merged 16^3
   // blocks (Multigrid::merged), and a run stopped at a frame and restarted
   // must still end with the uninterrupted run's checkpoint and diagnostics.
   const auto base = std::filesystem::temp_directory_path() / "sanguis_flow_run_merged_test";
@@ -385,14 +398,14 @@ TEST(FlowRun, ACheckpointOfOtherBlocksSaysWhichToSet) {
   const auto base = std::filesystem::temp_directory_path() / "sanguis_flow_run_blocks_test";
   std::filesystem::remove_all(base);
   std::string text = replaced(kChannel, "size_m = [0.5, 1.0, 0.5]", "size_m = [1.0, 1.0, 1.0]");
-  text = replaced(replaced(text, "end_time_s = 0.04", "end_time_s = 0.01"), "cells = [8, 16, 8]",
-                  "cells = [32, 32, 32]");
+  text = replaced(replaced(text, "end_time_s = 0.04", "end_time_s = 0.005"), "cells = [8, 16, 8]",
+                  "cells = [64, 64, 64]");
   std::ostringstream console;
   FlowRunOptions options;
   options.output_dir = base;
   options.quiet = true;
   run_flow_case(
-      parse(replaced(text, "cells = [32, 32, 32]", "cells = [32, 32, 32]\nblock_cells = 8")),
+      parse(replaced(text, "cells = [64, 64, 64]", "cells = [64, 64, 64]\nblock_cells = 8")),
       options, console);
   const std::string checkpoint = read_bytes(base / "checkpoint.bin");
   options.restart = true;
