@@ -132,20 +132,20 @@ inline double face_mean(const double* f, int d, std::ptrdiff_t c, const Strides&
 /// compile-time constants, so the loop vectorises (the same operations per
 /// face as the scalar call: the same bits).
 template <int kD, bool kCubic, bool kTransverse>
-void face_means_along_x(double* out, const double* f, const double* a, std::ptrdiff_t c0, int count,
-                        const Strides& s, double dt) {
+void face_means_in_row(double* out, const double* f, const double* a, std::ptrdiff_t c0, int count,
+                       const Strides& s, double dt) {
   for (std::ptrdiff_t c = c0; c < c0 + count; ++c)
     out[c] = face_mean(f, kD, c, s, kCubic, kTransverse) + dt * a[c];
 }
 
 template <int kD>
-void face_means_along_x(double* out, const double* f, const double* a, std::ptrdiff_t c0, int count,
-                        const Strides& s, double dt, bool cubic, bool transverse) {
+void face_means_in_row(double* out, const double* f, const double* a, std::ptrdiff_t c0, int count,
+                       const Strides& s, double dt, bool cubic, bool transverse) {
   if (count <= 0) return;
-  if (cubic && transverse) return face_means_along_x<kD, true, true>(out, f, a, c0, count, s, dt);
-  if (cubic) return face_means_along_x<kD, true, false>(out, f, a, c0, count, s, dt);
-  if (transverse) return face_means_along_x<kD, false, true>(out, f, a, c0, count, s, dt);
-  face_means_along_x<kD, false, false>(out, f, a, c0, count, s, dt);
+  if (cubic && transverse) return face_means_in_row<kD, true, true>(out, f, a, c0, count, s, dt);
+  if (cubic) return face_means_in_row<kD, true, false>(out, f, a, c0, count, s, dt);
+  if (transverse) return face_means_in_row<kD, false, true>(out, f, a, c0, count, s, dt);
+  face_means_in_row<kD, false, false>(out, f, a, c0, count, s, dt);
 }
 
 /// Whether every cell of face_mean's stencil at the d-face below c is fluid
@@ -1262,15 +1262,15 @@ void face_average_rows(int d, int b, const BlockLayout& L, const Strides& s,
         if constexpr (kD == 0) {
           // Faces i = 0..b; the cubic stencil is off within two cells of a prescribed x face.
           const bool lo = normal_at(0), hi = normal_at(b);
-          face_means_along_x<0>(out, u, a, row, 2, s, dt, lo, across_yz);
-          face_means_along_x<0>(out, u, a, row + 2, b - 3, s, dt, true, across_yz);
-          face_means_along_x<0>(out, u, a, row + b - 1, 2, s, dt, hi, across_yz);
+          face_means_in_row<0>(out, u, a, row, 2, s, dt, lo, across_yz);
+          face_means_in_row<0>(out, u, a, row + 2, b - 3, s, dt, true, across_yz);
+          face_means_in_row<0>(out, u, a, row + b - 1, 2, s, dt, hi, across_yz);
         } else {
           // Cells i = 0..b-1; the transverse correction is off beside a prescribed x face.
           const bool cubic = normal_at(n[D(kD)]);
-          face_means_along_x<kD>(out, u, a, row, 1, s, dt, cubic, across_yz && !lo_x);
-          face_means_along_x<kD>(out, u, a, row + 1, b - 2, s, dt, cubic, across_yz);
-          face_means_along_x<kD>(out, u, a, row + b - 1, 1, s, dt, cubic, across_yz && !hi_x);
+          face_means_in_row<kD>(out, u, a, row, 1, s, dt, cubic, across_yz && !lo_x);
+          face_means_in_row<kD>(out, u, a, row + 1, b - 2, s, dt, cubic, across_yz);
+          face_means_in_row<kD>(out, u, a, row + b - 1, 1, s, dt, cubic, across_yz && !hi_x);
         }
       }
   };
