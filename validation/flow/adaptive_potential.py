@@ -29,8 +29,8 @@ Fields (blocks of 8^3 cells, as in the flow cases):
     --output validation/flow/results/runs/cavity-re100-64` (about 10 min on one core);
   * the same at 96^3: `... --set "flow.grid.cells=[96, 96, 96]" --set output.interval_s=5
     --output validation/flow/results/runs/cavity-re100-96` (16^3 blocks, chosen as the grid
-    does not adapt; about an hour on one core beside other work), to see how the bound
-    grows as the grid refines;
+    does not adapt; 18 min on one core beside other work), and at 128^3 (`cavity-re100-128`),
+    to see how the bound grows as the grid refines;
   * the steady Re = 100 2D cavity at 128^2 (a periodic slab 32 cells thick):
     the uniform run of validation/flow/cavity_adaptive.py (run it first).
 
@@ -183,6 +183,7 @@ def main():
             ("cavity Re 1000 (64^3)", cavity_field(), "validation/flow/cavity_re1000.py --sizes 64"),
             ("cavity Re 100 (64^3)", cavity_field("cavity-re100-64"), "see this script's docstring"),
             ("cavity Re 100 (96^3)", cavity_field("cavity-re100-96", 96), "see this script's docstring"),
+            ("cavity Re 100 (128^3)", cavity_field("cavity-re100-128", 128), "see this script's docstring"),
             ("2D cavity Re 100 (128^2 x 32)", cavity_2d, "validation/flow/cavity_adaptive.py")):
         if field is not None:
             cases[name] = field
@@ -229,7 +230,8 @@ def main():
         print(f"2D cavity, measured at zeta = {adaptive['zeta_over_U']:g} U: {run['cells_end']} cells at "
               f"t = 15 against the estimate {estimate} ({run['cells_end'] / estimate - 1:+.0%})")
     order = ["vortex (128^2 x 32)", "Taylor-Green (64^3)", "cavity Re 1000 (64^3)",
-             "cavity Re 100 (64^3)", "cavity Re 100 (96^3)", "2D cavity Re 100 (128^2 x 32)"]
+             "cavity Re 100 (64^3)", "cavity Re 100 (96^3)", "cavity Re 100 (128^3)",
+             "2D cavity Re 100 (128^2 x 32)"]
     results = {name: results[name] for name in sorted(results, key=order.index)}
     RESULTS.mkdir(parents=True, exist_ok=True)
     (RESULTS / "adaptive_potential.json").write_text(json.dumps(results, indent=1))
