@@ -224,7 +224,7 @@ FlowCase load_flow_case(const ConfigTable& cfg, const std::filesystem::path& sou
   c.cells = read_cells(grid);
   c.block_cells_automatic = !grid.has("block_cells");
   const std::int64_t b = c.block_cells_automatic ? automatic_block_cells(c.cells, flow.has("adapt"))
-                                                 : grid.get_int("block_cells", 8);
+                                                 : grid.get_int("block_cells");
   if (b < 2 || b > 64 || (b & (b - 1)) != 0)
     grid.fail("block_cells", "must be a power of two in 2..64");
   c.forest.block_cells = static_cast<int>(b);
