@@ -96,3 +96,16 @@ def draw_speed_and_blocks(fig, ax, lo, hi, speed, block, label, fraction, linewi
         a, c = lo[sel].min(axis=0), hi[sel].max(axis=0)
         outlines.append([(a[0], a[1]), (c[0], a[1]), (c[0], c[1]), (a[0], c[1])])
     ax.add_collection(PolyCollection(outlines, facecolors="none", edgecolors="w", linewidths=linewidth))
+
+
+def draw_centre_lines(ax, profiles, centres, styled_names, title, u_line="", v_line=""):
+    """u(y) (against y) and v(x) (x against it) of each named run in its line style,
+    on one axes; u_line, v_line: where the lines run, for the legend."""
+    for name, style in styled_names:
+        ax.plot(profiles[name]["u"], centres, style, label=f"{name}, u(y){u_line}")
+        ax.plot(centres, profiles[name]["v"], style, label=f"{name}, v(x){v_line}")
+    ax.set_xlabel("u / U (against y / L);  x / L (v / U against it)")
+    ax.set_ylabel("y / L;  v / U")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=6)
+    ax.set_title(title, fontsize=9)

@@ -70,7 +70,7 @@ import matplotlib
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _cavity_common import cell_boxes, draw_speed_and_blocks, read_rows, read_vtu  # noqa: E402
+from _cavity_common import cell_boxes, draw_centre_lines, draw_speed_and_blocks, read_rows, read_vtu  # noqa: E402
 from cavity import GHIA_U, GHIA_V  # noqa: E402
 
 matplotlib.use("Agg")
@@ -364,14 +364,8 @@ def main():
     ax2 = fig.add_subplot(2, 3, 3)
     ax2.plot(GHIA_U[:, 1], GHIA_U[:, 0], "ko", mfc="none", label="Ghia et al. 1982, u(y)")
     ax2.plot(GHIA_V[:, 0], GHIA_V[:, 1], "ks", mfc="none", label="Ghia et al. 1982, v(x)")
-    for name, style in zip(("uniform", *shown), ("-", "--", "-.", ":")):
-        ax2.plot(profiles[name]["u"], centres, style, label=f"{name}, u(y)")
-        ax2.plot(centres, profiles[name]["v"], style, label=f"{name}, v(x)")
-    ax2.set_xlabel("u / U (against y / L);  x / L (v / U against it)")
-    ax2.set_ylabel("y / L;  v / U")
-    ax2.grid(alpha=0.3)
-    ax2.legend(fontsize=6)
-    ax2.set_title("centre lines, Re = 100", fontsize=9)
+    draw_centre_lines(ax2, profiles, centres, zip(("uniform", *shown), ("-", "--", "-.", ":")),
+                      "centre lines, Re = 100")
     ax3 = fig.add_subplot(2, 3, 4)
     for name in shown:
         for c, line in (("u", "x"), ("v", "y")):

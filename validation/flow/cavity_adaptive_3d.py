@@ -65,7 +65,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _cavity_common import cell_boxes, read_rows, read_vtu  # noqa: E402
+from _cavity_common import cell_boxes, draw_centre_lines, draw_speed_and_blocks, read_rows, read_vtu  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 CASE = ROOT / "cases" / "flow" / "cavity-re100.toml"
@@ -280,8 +280,6 @@ def bound_grid_sampling(grid, profiles, coarsen_levels, zetas):
 def draw_plane(fig, ax, arrays, values, label, title):
     """The cells cut by the plane z = 0.5 + h/2 (h: the finest cell) coloured by
     `values` (one per cell), with the blocks outlined."""
-    from _cavity_common import draw_speed_and_blocks
-
     lo, hi = cell_boxes(arrays)
     z = 0.5 + 0.5 / N
     cut = (lo[:, 2] <= z) & (hi[:, 2] > z)
@@ -309,14 +307,8 @@ def draw(frames, profiles, centres, rows, diffs, cells_uniform):
         draw_plane(fig, fig.add_subplot(2, 4, 5 + k), arrays, diffs[name],
                    f"|u - mean of uniform {N}$^3$ over the cell| / U", f"{name} against the uniform run, mid-plane")
     ax = fig.add_subplot(2, 4, 3)
-    for name, style in zip(("uniform", *ADAPTIVE), ("-", "--", ":")):
-        ax.plot(profiles[name]["u"], centres, style, label=f"{name}, u(y) on x = z = 0.5")
-        ax.plot(centres, profiles[name]["v"], style, label=f"{name}, v(x) on y = z = 0.5")
-    ax.set_xlabel("u / U (against y / L);  x / L (v / U against it)")
-    ax.set_ylabel("y / L;  v / U")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=6)
-    ax.set_title("centre lines of the mid-plane, Re = 100", fontsize=9)
+    draw_centre_lines(ax, profiles, centres, zip(("uniform", *ADAPTIVE), ("-", "--", ":")),
+                      "centre lines of the mid-plane, Re = 100", " on x = z = 0.5", " on y = z = 0.5")
     ax = fig.add_subplot(2, 4, 7)
     for name, colour in zip(ADAPTIVE, ("C0", "C1")):
         through = profiles[f"uniform averaged onto the cells of {name}"]
