@@ -30,7 +30,9 @@ Fields (blocks of 8^3 cells, as in the flow cases):
   * the same at 96^3: `... --set "flow.grid.cells=[96, 96, 96]" --set output.interval_s=5
     --output validation/flow/results/runs/cavity-re100-96` (16^3 blocks, chosen as the grid
     does not adapt; 18 min on one core beside other work), and at 128^3 (`cavity-re100-128`),
-    to see how the bound grows as the grid refines;
+    to see how the bound grows as the grid refines; the cells of the adaptive runs of
+    validation/flow/cavity_adaptive_3d.py, when its JSON is there, are set against the
+    estimate with the same cap on the coarsening;
   * the steady Re = 100 2D cavity at 128^2 (a periodic slab 32 cells thick):
     the uniform run of validation/flow/cavity_adaptive.py (run it first).
 
@@ -192,8 +194,9 @@ def main():
             print(f"{name}: its uniform run is not on disk ({how}); rows kept from the earlier JSON")
         else:
             print(f"{name}: its uniform run is not on disk ({how}); skipped")
+    levels_of = {}
     for name, (components, periodic, h, speed) in cases.items():
-        levels = level_estimates(components, periodic)
+        levels = levels_of[name] = level_estimates(components, periodic)
         uniform = components[0].size
         rows = []
         for fraction in FRACTIONS:
@@ -229,6 +232,21 @@ def main():
             "zeta": adaptive["zeta_over_U"], "cells_end": run["cells_end"], "estimate": estimate}
         print(f"2D cavity, measured at zeta = {adaptive['zeta_over_U']:g} U: {run['cells_end']} cells at "
               f"t = 15 against the estimate {estimate} ({run['cells_end'] / estimate - 1:+.0%})")
+    # The measured adaptive 3D cavity runs (cells at t = 15.5) against the estimate with the
+    # same cap on the coarsening (validation/flow/cavity_adaptive_3d.py).
+    cavity_3d = "cavity Re 100 (128^3)"
+    cavity_3d_json = RESULTS / "cavity_adaptive_3d.json"
+    if cavity_3d in levels_of and cavity_3d_json.exists():
+        uniform = results[cavity_3d]["uniform_cells"]
+        results[cavity_3d]["measured"] = []
+        for run_name, run in json.loads(cavity_3d_json.read_text())["runs"].items():
+            estimate, _ = fewest_cells(levels_of[cavity_3d][:run["coarsen_levels"] + 1], run["zeta"])
+            results[cavity_3d]["measured"].append(
+                {"run": run_name, "zeta": run["zeta"], "coarsen_levels": run["coarsen_levels"],
+                 "cells_end": run["cells_end"], "estimate": estimate, "ratio_end": uniform / run["cells_end"]})
+            print(f"3D cavity 128^3, {run_name}, measured at zeta = {run['zeta']:g} U, at most "
+                  f"{run['coarsen_levels']} level(s) coarser: {run['cells_end']} cells against the estimate "
+                  f"{estimate} ({run['cells_end'] / estimate - 1:+.0%})")
     order = ["vortex (128^2 x 32)", "Taylor-Green (64^3)", "cavity Re 1000 (64^3)",
              "cavity Re 100 (64^3)", "cavity Re 100 (96^3)", "cavity Re 100 (128^3)",
              "2D cavity Re 100 (128^2 x 32)"]
@@ -246,6 +264,9 @@ def main():
     if measured:
         ax.semilogx([m["zeta"] / 0.5 for m in measured], [m["ratio_end"] for m in measured], "k*", ms=9,
                     label="vortex, measured adaptive runs (end)")
+    for m in results.get("cavity Re 100 (128^3)", {}).get("measured", []):
+        ax.semilogx([m["zeta"]], [m["ratio_end"]], "k^" if m["coarsen_levels"] > 1 else "kv", ms=8,
+                    label=f"3D cavity 128$^3$, measured ({m['run']}, at most {2 ** m['coarsen_levels']} h)")
     ax.axhline(5.0, color="r", ls="--", lw=0.8, label="5x fewer (issue #7)")
     ax.set_xlabel(r"$\zeta$ / reference speed")
     ax.set_ylabel("uniform cells / fewest settled cells (estimate)")
