@@ -8,9 +8,10 @@ changes by 3e-4 of itself from t = 10 to 15) with `sanguis run`:
   velocity every 10 steps, zeta = 2e-2 U, cells down to two levels coarser
   (4h, h = 1/128);
 * adaptive_2h: the same with zeta = 5e-2 U and cells at most one level coarser
-  (2h). Added after the first run: it passed the cell and whole-grid checks but
-  missed the centre-line one by 3 %, all of it from sampling the 4h cells on
-  the line (below). The checks were not changed;
+  (2h). Added after the first run, which passed the cell and whole-grid checks
+  but missed the centre-line one by 3 %, all of it from sampling the 4h cells
+  on the line (below). The checks were not changed; the first run's verdict
+  stays in the JSON (pass_of_the_run_fixed_first: false);
 * uniform: the same case without [flow.adapt], 128^3 cells (16^3 blocks, the
   size a grid that does not adapt gets). This is the run that
   validation/flow/adaptive_potential.py reads (runs/cavity-re100-128); when it
@@ -24,11 +25,17 @@ steps before t = 15 were shortened differently. The frames at t = 15.5 are
 compared.
 
 Why these zeta: validation/flow/adaptive_potential.py bounds the cells a
-settled grid can have from the uniform field: 5.5x fewer at 1e-2 U, 8.7x at
-2.2e-2 U (two levels coarser at most). A settled grid holds more than the
-bound (a family merges only below 2/3 of zeta; the vortex runs held up to 2x
-the bound), so 1e-2 U would leave less than 5x. With one level at most, the
-bound is 5.1x at 2e-2 U and 5.8x at 5e-2 U.
+settled grid can have from the uniform field (blocks as coarse as the
+criterion allows, any number of levels): 5.5x fewer at 1e-2 U, 8.7x at
+2.2e-2 U. A settled grid holds more than the bound (a family merges only
+below 2/3 of zeta; the vortex runs held up to 2x the bound), so 1e-2 U would
+likely have left less than 5x; 2e-2 U was taken for the first run. For the
+second, the bound capped at one coarser level and its centre lines were
+computed from the uniform field first (what bound_grid_sampling now reports):
+5.1x at 2e-2 U, 5.8x from 5e-2 U, lines 0.0011 U off with the uniform field
+averaged onto that grid; 5e-2 U was taken for the cells. (Capped at two
+levels, as the first run was, the bound is 8.5x at 2e-2 U, computed
+afterwards.)
 
 Checks for each adaptive run, fixed before the first (the 2D cavity's at 256^2,
 which passed with 6x and 10x margins at zeta = 1e-2 U):
@@ -42,8 +49,10 @@ which passed with 6x and 10x margins at zeta = 1e-2 U):
 Reported, not graded: the uniform run's own field averaged onto each adaptive
 grid's cells and sampled on the lines the same way (what the cells alone do
 to the line check), the same for the fewest-cells grids of the bound at
-several zeta, cells at the end and on average, and the wall time of each run
-to t = 15 (time to solution; all on one thread, see --threads).
+several zeta, the cells at the end, where the lines differ most, and the wall
+time of each run to t = 15 (time to solution; all on one thread, see
+--threads; the uniform run on disk wrote three frames of 486 MB in its time,
+a uniform run made here writes none before t = 15).
 
 Writes validation/flow/results/cavity_adaptive_3d.json (runs under
 validation/flow/results/runs/cavity_adaptive_3d/) and
@@ -65,7 +74,9 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _cavity_common import cell_boxes, draw_centre_lines, draw_speed_and_blocks, read_rows, read_vtu  # noqa: E402
+import adaptive_potential  # noqa: E402
+from _cavity_common import (cell_boxes, draw_centre_lines, draw_speed_and_blocks, last_frame, read_rows,  # noqa: E402
+                            read_vtu, with_walls)
 
 ROOT = Path(__file__).resolve().parents[2]
 CASE = ROOT / "cases" / "flow" / "cavity-re100.toml"
@@ -80,11 +91,14 @@ SETTLE_END = 15.5
 FIXED_STEP = 0.005
 # The adaptive runs: zeta of eq. 4.11 over the lid speed U = 1 m/s, and how many
 # levels coarser than the finest the cells may become.
-ADAPTIVE = {"adaptive": {"zeta": 2e-2, "coarsen_levels": 2},
-            "adaptive_2h": {"zeta": 5e-2, "coarsen_levels": 1}}
+ADAPTIVE = {"adaptive": {"zeta": 2e-2, "coarsen_levels": 2,
+                         "chosen": "fixed before any run, with the checks"},
+            "adaptive_2h": {"zeta": 5e-2, "coarsen_levels": 1,
+                            "chosen": "added after 'adaptive' failed the centre-line check; checks unchanged"}}
 CELL_RATIO = 5.0
 LINE_TOLERANCE = 5e-3
 FIELD_TOLERANCE = 1e-2
+CENTRES = (np.arange(N) + 0.5) / N  # where the centre lines are compared: the uniform cells'
 
 
 def case_text(name):
@@ -126,7 +140,8 @@ def run_to_end(exe, name, threads):
     out = RUNS / name
     seconds_file = RUNS / f"{name}_seconds.json"
     if reached(out, END):
-        return json.loads(seconds_file.read_text())["seconds_to_end"]
+        check_settings(name, out)
+        return run_seconds(name)["seconds_to_end"]
     if name == "uniform" and reached(UNIFORM_ON_DISK, END) and not out.exists():
         out.mkdir()
         for f in ("checkpoint.bin", "diagnostics.csv", "run.log"):
@@ -145,11 +160,37 @@ def run_to_end(exe, name, threads):
     return seconds
 
 
-def log_seconds(path):
-    """Wall seconds of a run from its run.log 'done:' lines (summed over restarts)."""
+def check_settings(name, out):
+    """Stops when an adaptive run on disk was made with other [flow.adapt] settings than
+    ADAPTIVE gives it (run.log's 'adaptive grid:' line), rather than label it wrongly."""
+    adaptive = ADAPTIVE.get(name)
+    if not adaptive:
+        return
+    expected = (f"threshold {adaptive['zeta']:g} m/s",
+                f"{2 ** adaptive['coarsen_levels']}x coarser")
+    line = next((l for l in (out / "run.log").read_text().splitlines() if l.startswith("adaptive grid:")), "")
+    if not all(e in line for e in expected):
+        raise SystemExit(f"{out}: made with other [flow.adapt] settings ({line!r}); remove the folder to rerun it")
+
+
+def run_seconds(name):
+    """The wall seconds to END and the threads of a run, as run_to_end recorded them;
+    from its run.log (threads unknown) when that record is missing."""
+    path = RUNS / f"{name}_seconds.json"
+    if path.exists():
+        return json.loads(path.read_text())
+    return {"seconds_to_end": log_seconds(RUNS / name / "run.log", END), "threads": None}
+
+
+def log_seconds(path, until=float("inf")):
+    """Wall seconds of a run from its run.log 'done:' lines up to time `until`
+    (summed over restarts). A segment killed before its 'done:' line is not
+    counted."""
     total = 0.0
     for line in path.read_text().splitlines():
         if line.startswith("done:") and " in " in line:
+            if float(line.split("t = ")[1].split(" ")[0]) > until + 1e-9:
+                continue
             text = line.split(" in ")[1].split(" ")[0]
             hours = minutes = 0.0
             if "h" in text:
@@ -173,8 +214,8 @@ def settle(exe, name, threads):
             "--set", f"output.interval_s={SETTLE_END - END!r}")
 
 
-def last_frame(name):
-    return read_vtu(sorted((RUNS / name / "flow").glob("flow_*.vtu"))[-1])[1]
+def final_frame(name):
+    return read_vtu(last_frame(RUNS, name))[1]
 
 
 def line_profile(arrays, along, across, component, at):
@@ -193,8 +234,7 @@ def line_profile(arrays, along, across, component, at):
             touching = side_a & side_z
             keys = np.round(centre[touching, along], 12)
             order = np.argsort(keys)
-            xs = np.concatenate(([0.0], keys[order], [1.0]))
-            ys = np.concatenate(([0.0], arrays["velocity"][touching, component][order], [lid]))
+            xs, ys = with_walls(keys[order], arrays["velocity"][touching, component][order], lid)
             quadrants.append(np.interp(at, xs, ys))
     return np.mean(quadrants, axis=0)
 
@@ -224,23 +264,25 @@ def cell_means(grid, arrays):
     return means
 
 
-
 def boxes_frame(lo, hi, grid):
     """Arrays of a frame whose cells are the boxes (lo, hi), with the uniform
     run's means over them as velocity (what line_profile and cell_means read)."""
     n = len(lo)
-    connectivity = np.concatenate([np.tile(np.arange(n)[:, None], 4), np.tile(np.arange(n, 2 * n)[:, None], 4)],
-                                  axis=1).ravel()
+    low, high = np.arange(n)[:, None], np.arange(n, 2 * n)[:, None]
+    connectivity = np.concatenate([np.tile(low, 4), np.tile(high, 4)], axis=1).ravel()
     arrays = {"Points": np.concatenate([lo, hi]), "connectivity": connectivity}
     arrays["velocity"] = cell_means(grid, arrays)
     return arrays
 
 
-def line_difference(arrays, profiles):
-    """Largest difference of the two centre lines sampled on `arrays` from `profiles`."""
-    centres = (np.arange(N) + 0.5) / N
-    return float(max(np.abs(line_profile(arrays, 1, 0, 0, centres) - profiles["u"]).max(),
-                     np.abs(line_profile(arrays, 0, 1, 1, centres) - profiles["v"]).max()))
+def centre_lines(arrays):
+    """u(y) on x = z = 0.5 and v(x) on y = z = 0.5 at CENTRES."""
+    return {"u": line_profile(arrays, 1, 0, 0, CENTRES), "v": line_profile(arrays, 0, 1, 1, CENTRES)}
+
+
+def line_difference(lines, reference):
+    """Largest difference between two sets of centre lines."""
+    return float(max(np.abs(lines[c] - reference[c]).max() for c in ("u", "v")))
 
 
 def bound_grid_sampling(grid, profiles, coarsen_levels, zetas):
@@ -249,8 +291,6 @@ def bound_grid_sampling(grid, profiles, coarsen_levels, zetas):
     and how far the uniform field averaged onto it, sampled on the centre lines,
     lies from the uniform lines. What the centre-line check measures of the cells
     alone, whatever the solution on them."""
-    import adaptive_potential
-
     B = adaptive_potential.B
     components = [grid[..., d] for d in range(3)]
     levels = adaptive_potential.level_estimates(components, (False, False, False))[:coarsen_levels + 1]
@@ -271,13 +311,14 @@ def bound_grid_sampling(grid, profiles, coarsen_levels, zetas):
                 open_blocks = np.repeat(np.repeat(np.repeat(rest, 2, 0), 2, 1), 2, 2)
         arrays = boxes_frame(np.concatenate(lo), np.concatenate(hi), grid)
         cells = len(arrays["velocity"])
+        difference = line_difference(centre_lines(arrays), profiles)
         rows.append({"coarsen_levels": coarsen_levels, "zeta_over_U": zeta, "cells": cells,
                      "cell_ratio": round(N ** 3 / cells, 2),
-                     "centre_line_difference_of_the_averaged_uniform_field": round(line_difference(arrays, profiles), 5)})
-        print(f"  bound grid, {coarsen_levels} level(s) coarser at most, zeta = {zeta:g} U: {N ** 3 / cells:.2f}x fewer "
-              f"cells, lines of the averaged uniform field {rows[-1]['centre_line_difference_of_the_averaged_uniform_field']:.5f} U",
-              flush=True)
+                     "centre_line_difference_of_the_averaged_uniform_field": round(difference, 5)})
+        print(f"  bound grid, {coarsen_levels} level(s) coarser at most, zeta = {zeta:g} U: "
+              f"{N ** 3 / cells:.2f}x fewer cells, lines of the averaged uniform field {difference:.5f} U", flush=True)
     return rows
+
 
 def draw_plane(fig, ax, arrays, values, label, title):
     """The cells cut by the plane z = 0.5 + h/2 (h: the finest cell) coloured by
@@ -294,7 +335,8 @@ def draw_plane(fig, ax, arrays, values, label, title):
     ax.set_title(title, fontsize=9)
 
 
-def draw(frames, profiles, centres, rows, diffs, cells_uniform):
+def draw(frames, profiles, averaged, rows, diffs, cells_uniform):
+    """The figure; averaged[name]: the uniform run's centre lines through the cells of run name."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -309,16 +351,15 @@ def draw(frames, profiles, centres, rows, diffs, cells_uniform):
         draw_plane(fig, fig.add_subplot(2, 4, 5 + k), arrays, diffs[name],
                    f"|u - mean of uniform {N}$^3$ over the cell| / U", f"{name} against the uniform run, mid-plane")
     ax = fig.add_subplot(2, 4, 3)
-    draw_centre_lines(ax, profiles, centres, zip(("uniform", *ADAPTIVE), ("-", "--", ":")),
+    draw_centre_lines(ax, profiles, CENTRES, zip(("uniform", *ADAPTIVE), ("-", "--", ":")),
                       "centre lines of the mid-plane, Re = 100", " on x = z = 0.5", " on y = z = 0.5")
     ax = fig.add_subplot(2, 4, 7)
     for name, colour in zip(ADAPTIVE, ("C0", "C1")):
-        through = profiles[f"uniform averaged onto the cells of {name}"]
         for c, line, style in (("u", "x", "-"), ("v", "y", "--")):
-            ax.semilogy(centres, np.abs(profiles[name][c] - profiles["uniform"][c]) + 1e-7, style, color=colour,
+            ax.semilogy(CENTRES, np.abs(profiles[name][c] - profiles["uniform"][c]) + 1e-7, style, color=colour,
                         lw=1, label=f"{name}: |Δ{c}| on {line} = z = 0.5")
-            ax.semilogy(centres, np.abs(through[c] - profiles["uniform"][c]) + 1e-7, ":", color=colour, lw=1.5,
-                        label=f"uniform averaged onto its cells: |Δ{c}|" if c == "v" else None)
+            ax.semilogy(CENTRES, np.abs(averaged[name][c] - profiles["uniform"][c]) + 1e-7, ":", color=colour,
+                        lw=1.5, label=f"uniform averaged onto the cells of {name}: |Δu|, |Δv|" if c == "v" else None)
     ax.axhline(LINE_TOLERANCE, color="r", ls="--", lw=0.8, label="tolerance")
     ax.set_xlabel("position along the line / L")
     ax.set_ylabel(f"difference from uniform {N}$^3$ / U")
@@ -354,27 +395,23 @@ def draw(frames, profiles, centres, rows, diffs, cells_uniform):
 
 
 def evaluate(name, arrays, rows, grid, profiles, cells_uniform, seconds):
-    """The checks of one adaptive run against the uniform one; returns its
-    summary entry and the difference of each cell from the uniform means."""
-    line_diff = max(np.abs(profiles[name][c] - profiles["uniform"][c]).max() for c in ("u", "v"))
+    """The checks of one adaptive run against the uniform one. Returns its summary
+    entry, the difference of each cell from the uniform means, and the uniform
+    run's centre lines through this run's cells (its field averaged onto them,
+    sampled the same way: what the cells alone do to the line check)."""
+    line_diff = line_difference(profiles[name], profiles["uniform"])
     means = cell_means(grid, arrays)
     diff = np.abs(arrays["velocity"] - means).max(axis=1)
     field_diff = float(diff.max())
-    # The uniform run's own field averaged onto these cells, sampled the same way:
-    # how much of the centre-line difference the cells alone make.
-    through = dict(arrays, velocity=means)
-    centres = (np.arange(N) + 0.5) / N
-    profiles[f"uniform averaged onto the cells of {name}"] = {"u": line_profile(through, 1, 0, 0, centres),
-                                                              "v": line_profile(through, 0, 1, 1, centres)}
-    seen_through = line_difference(through, profiles["uniform"])
+    averaged = centre_lines(dict(arrays, velocity=means))
+    seen_through = line_difference(averaged, profiles["uniform"])
     cells_end = int(rows[-1]["cells"])
-    cells_mean = float(np.mean([r["cells"] for r in rows[1:]]))
     checks = [
         {"quantity": f"uniform finest cells / adaptive cells at t = {SETTLE_END:g}",
          "measured": round(cells_uniform / cells_end, 2), "reference": f"{cells_uniform} / {cells_end}",
          "tolerance": f">= {CELL_RATIO:g}", "pass": bool(cells_uniform / cells_end >= CELL_RATIO)},
         {"quantity": "mid-plane centre lines: max |u_adaptive - u_uniform| (u on x = z = 0.5, v on y = z = 0.5) / U",
-         "measured": round(float(line_diff), 5), "reference": f"uniform {N}^3",
+         "measured": round(line_diff, 5), "reference": f"uniform {N}^3",
          "tolerance": f"<= {LINE_TOLERANCE:g}", "pass": bool(line_diff <= LINE_TOLERANCE)},
         {"quantity": "whole grid: max over adaptive cells |u - mean of the uniform run over the cell| / U",
          "measured": round(field_diff, 5), "reference": f"uniform {N}^3",
@@ -384,25 +421,32 @@ def evaluate(name, arrays, rows, grid, profiles, cells_uniform, seconds):
     lo, hi = cell_boxes(arrays)
     level = arrays["level"]
     entry = {
-        **ADAPTIVE[name], "cells_end": cells_end, "cells_mean": round(cells_mean),
-        "cell_ratio_end": round(cells_uniform / cells_end, 2), "cell_ratio_mean": round(cells_uniform / cells_mean, 2),
+        **ADAPTIVE[name], "cells_end": cells_end, "cell_ratio_end": round(cells_uniform / cells_end, 2),
         "cells_per_level": {int(k): int((level == k).sum()) for k in np.unique(level)},
-        "wall_seconds_to_end": round(seconds, 1),
+        "wall_seconds_to_end": round(seconds["seconds_to_end"], 1), "threads": seconds["threads"],
         "max_divergence_1_s": rows[-1]["max_divergence_1_s"], "kinetic_energy_J": rows[-1]["kinetic_energy_J"],
         "worst_cell": {"min_m": [round(float(x), 5) for x in lo[worst]],
                        "max_m": [round(float(x), 5) for x in hi[worst]], "difference": round(field_diff, 5)},
         "cells_beyond_half_the_field_tolerance": int((diff > 0.5 * FIELD_TOLERANCE).sum()),
         "centre_line_difference_of_the_uniform_field_averaged_onto_these_cells": round(seen_through, 5),
+        "where_the_centre_lines_differ_most": where_lines_differ(profiles[name], profiles["uniform"]),
         "checks": checks, "pass": all(c["pass"] for c in checks)}
-    print(f"{name} (zeta {entry['zeta']:g} U, at most {entry['coarsen_levels']} level(s) coarser): {cells_end} cells "
-          f"at t = {SETTLE_END:g} ({cells_uniform / cells_end:.2f}x fewer than {cells_uniform}), {cells_mean:.0f} on "
-          f"average; wall time to t = {END:g}: {seconds:.0f} s")
+    print(f"{name} (zeta {entry['zeta']:g} U, at most {entry['coarsen_levels']} level(s) coarser; "
+          f"{entry['chosen']}): {cells_end} cells at t = {SETTLE_END:g} ({cells_uniform / cells_end:.2f}x fewer than "
+          f"{cells_uniform}); wall time to t = {END:g}: {seconds['seconds_to_end']:.0f} s")
     for c in checks:
         print(f"  {'PASS' if c['pass'] else 'FAIL'}  {c['quantity']}: {c['measured']} "
               f"(reference {c['reference']}, {c['tolerance']})")
     print(f"  the uniform run's field averaged onto these cells, sampled the same way: {seen_through:.5f} U "
           "from its own centre lines (reported, not graded)")
-    return entry, diff
+    return entry, diff, averaged
+
+
+def where_lines_differ(lines, reference):
+    """The line and the position along it where two sets of centre lines differ most."""
+    c = max(("u", "v"), key=lambda c: np.abs(lines[c] - reference[c]).max())
+    at = float(CENTRES[int(np.argmax(np.abs(lines[c] - reference[c])))])
+    return f"{c} at {'y' if c == 'u' else 'x'} = {at:.3f}"
 
 
 def main():
@@ -414,41 +458,45 @@ def main():
     args = ap.parse_args()
     exe = (ROOT / args.build / "app" / "sanguis").resolve()
     names = ("uniform", *ADAPTIVE)
-    if args.replot:
-        seconds = {name: json.loads((RUNS / f"{name}_seconds.json").read_text())["seconds_to_end"] for name in names}
-    else:
-        seconds = {name: run_to_end(exe, name, args.threads) for name in names}
+    if not args.replot:
+        for name in names:
+            run_to_end(exe, name, args.threads)
         for name in names:
             settle(exe, name, args.threads)
+    seconds = {name: run_seconds(name) for name in names}
 
     rows = {name: read_rows(RUNS / name / "diagnostics.csv") for name in names}
-    frames = {name: last_frame(name) for name in names}
-    centres = (np.arange(N) + 0.5) / N
-    profiles = {name: {"u": line_profile(a, 1, 0, 0, centres), "v": line_profile(a, 0, 1, 1, centres)}
-                for name, a in frames.items()}
+    frames = {name: final_frame(name) for name in names}
+    profiles = {name: centre_lines(a) for name, a in frames.items()}
     grid = uniform_array(frames["uniform"])
     cells_uniform = int(rows["uniform"][-1]["cells"])
     summary = {
         "case": str(CASE.relative_to(ROOT)), "finest": f"{N}^3", "end_time_s": END, "compared_at_s": SETTLE_END,
-        "fixed_step_from_end": FIXED_STEP, "cells_uniform": cells_uniform, "threads": args.threads,
-        "uniform": {"wall_seconds_to_end": round(seconds["uniform"], 1),
+        "fixed_step_from_end": FIXED_STEP, "cells_uniform": cells_uniform,
+        "uniform": {"wall_seconds_to_end": round(seconds["uniform"]["seconds_to_end"], 1),
+                    "threads": seconds["uniform"]["threads"],
                     "max_divergence_1_s": rows["uniform"][-1]["max_divergence_1_s"],
                     "kinetic_energy_J": rows["uniform"][-1]["kinetic_energy_J"]},
         "runs": {}}
-    diffs = {}
+    diffs, averaged = {}, {}
     for name in ADAPTIVE:
-        summary["runs"][name], diffs[name] = evaluate(name, frames[name], rows[name], grid, profiles,
-                                                      cells_uniform, seconds[name])
-    print(f"uniform: wall time to t = {END:g}: {seconds['uniform']:.0f} s")
+        summary["runs"][name], diffs[name], averaged[name] = evaluate(
+            name, frames[name], rows[name], grid, profiles, cells_uniform, seconds[name])
+    print(f"uniform: wall time to t = {END:g}: {seconds['uniform']['seconds_to_end']:.0f} s")
     print("the cells alone, whatever the solution on them (reported, not graded):", flush=True)
     summary["bound_grids"] = [row for levels in (2, 1) for row in
                               bound_grid_sampling(grid, profiles["uniform"], levels, (5e-3, 1e-2, 1.5e-2, 2e-2, 5e-2))]
-    passed = any(run["pass"] for run in summary["runs"].values())
-    summary["pass"] = passed
+    # The run fixed before any was made decides alone whether the checks as first
+    # set were met; the script passes when some run meets every check.
+    first = next(iter(ADAPTIVE))
+    summary["pass_of_the_run_fixed_first"] = summary["runs"][first]["pass"]
+    summary["pass"] = any(run["pass"] for run in summary["runs"].values())
     SUMMARY.write_text(json.dumps(summary, indent=1) + "\n")
     print(f"wrote {SUMMARY.relative_to(ROOT)}")
-    draw(frames, profiles, centres, rows, diffs, cells_uniform)
-    return 0 if passed else 1
+    print(f"{'PASS' if summary['pass'] else 'FAIL'} (some adaptive run passes every check); the run fixed first, "
+          f"{first}: {'PASS' if summary['pass_of_the_run_fixed_first'] else 'FAIL'}")
+    draw(frames, profiles, averaged, rows, diffs, cells_uniform)
+    return 0 if summary["pass"] else 1
 
 
 if __name__ == "__main__":

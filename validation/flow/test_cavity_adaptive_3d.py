@@ -14,7 +14,7 @@ import cavity_adaptive_3d as cavity3d  # noqa: E402
 
 def frame(lo, hi, field):
     """Arrays as read from a frame: every cell's 8 corners (4 at lo, 4 at hi: only
-    their min and max matter) and the velocity field(centre)."""
+    their min and max matter) and the velocity field(centres) of the cell centres."""
     lo, hi = np.asarray(lo, float), np.asarray(hi, float)
     n = len(lo)
     connectivity = np.array([[k] * 4 + [k + n] * 4 for k in range(n)]).ravel()
@@ -70,6 +70,50 @@ class CellMeans(unittest.TestCase):
         for (a, b), m in zip(boxes, means):
             ys = (np.arange(round(a[1] * 16), round(b[1] * 16)) + 0.5) / 16
             np.testing.assert_allclose(m, [(a[0] + b[0]) / 2, np.mean(ys ** 2), (a[2] + b[2]) / 2])
+
+
+class WallSeconds(unittest.TestCase):
+    def test_done_lines_are_summed_up_to_a_time(self):
+        import tempfile
+        from pathlib import Path
+
+        with tempfile.TemporaryDirectory() as tmp:
+            log = Path(tmp) / "run.log"
+            log.write_text("grid: ...\n"
+                           "done: t = 15 s, 2331 steps in 57m56s (1.406e+06 cell-updates/s)\n"
+                           "--- restart from checkpoint at t = 15 s\n"
+                           "done: t = 15.5 s, 100 steps in 37s (1.6e+06 cell-updates/s)\n"
+                           "done: t = 20 s, 900 steps in 1h02m03s (1.6e+06 cell-updates/s)\n")
+            self.assertEqual(cavity3d.log_seconds(log), 3476 + 37 + 3723)
+            self.assertEqual(cavity3d.log_seconds(log, 15.0), 3476)
+
+
+class BoundGrids(unittest.TestCase):
+    def test_the_sampled_grids_have_the_cells_of_the_bound(self):
+        # A 32^3 field with a sharp layer near y = 1: the bound keeps fine blocks
+        # there and coarsens the rest.
+        saved = cavity3d.N, cavity3d.CENTRES
+        cavity3d.N = 32
+        cavity3d.CENTRES = (np.arange(32) + 0.5) / 32
+        try:
+            lo, hi = uniform_cells(32)
+            field = lambda c: np.stack([np.exp(-20 * (1 - c[:, 1])), np.sin(3 * c[:, 0]), 0 * c[:, 2]], axis=1)
+            grid = cavity3d.uniform_array(frame(lo, hi, field))
+            lines = cavity3d.centre_lines(cavity3d.boxes_frame(lo, hi, grid))
+            components = [grid[..., d] for d in range(3)]
+            levels = cavity3d.adaptive_potential.level_estimates(components, (False, False, False))
+            # zeta 1e-3 coarsens nothing; 1e-2 and 3e-2 coarsen the blocks away from the layer.
+            for coarsen, zeta, coarsened in ((1, 1e-2, True), (2, 3e-2, True), (2, 1e-3, False)):
+                row = cavity3d.bound_grid_sampling(grid, lines, coarsen, [zeta])[0]
+                expected, _ = cavity3d.adaptive_potential.fewest_cells(levels[:coarsen + 1], zeta)
+                self.assertEqual(row["cells"], expected)
+                self.assertEqual(row["cells"] < 32 ** 3, coarsened)
+            # The uniform grid itself (nothing coarsened) samples its own lines exactly.
+            row = cavity3d.bound_grid_sampling(grid, lines, 0, [1e-3])[0]
+            self.assertEqual(row["cells"], 32 ** 3)
+            self.assertEqual(row["centre_line_difference_of_the_averaged_uniform_field"], 0.0)
+        finally:
+            cavity3d.N, cavity3d.CENTRES = saved
 
 
 if __name__ == "__main__":
