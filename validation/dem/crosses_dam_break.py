@@ -61,9 +61,11 @@ CROSSES = {4: 1300, 8: 2000, 12: 3000, 20: 5000, 30: 7000}
 GATE_INDEX = 5    # [[obstacle]] number of the gate in the case
 SETTLE_S = 1.5    # first check after the last cross is due (the 4 cm column was at rest 0.5 s after)
 COLLAPSE_S = 3.0  # §3.2: 3 s after the opening
-# [output] checkpoint_interval_s of every run (the case has 0.25): a killed run loses at
-# most this much (about 10 min of a 2000-cross collapse on 2 cores); checkpoints do not
-# change the bits of a run.
+# [output] checkpoint_interval_s of every run gate_runner starts (here and in
+# crosses_calibrated_gates.py; the case has 0.25): a killed run loses at most this much
+# (about 3-10 min of a 2000-cross collapse on 2 cores). Checkpoints do not change the bits
+# of a run (checked on 2026-12-03: 300 crosses to 0.2 s with 20 checkpoints and with none
+# gave identical diagnostics and frames).
 CHECKPOINT_S = 0.05
 SEED = 3
 
