@@ -5,6 +5,8 @@
 
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string>
 
@@ -95,7 +97,7 @@ TEST(Pouring, APourThatStartsEmptyTakesItsThreadsAndMatchesOneThread) {
   c.setup.threads = 2;
   DemSimulation threaded(c.setup);
   EXPECT_EQ(threaded.threads(), 1);  // empty
-  serial.run_until(0.06);  // about 70 particles by then
+  serial.run_until(0.06);            // about 70 particles by then
   threaded.run_until(0.06);
   EXPECT_EQ(threaded.threads(), 2);
   const auto& a = serial.particles().position;
@@ -119,6 +121,45 @@ TEST(Pouring, RestartInTheMiddleOfThePourIsBitForBit) {
   const auto& b = resumed.particles().position;
   EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(Vec3)), 0);
   std::filesystem::remove(file);
+}
+
+// Checkpoints written along the way leave a run's results unchanged (the dam-break
+// validations checkpoint every 0.05 s so that a killed run loses little): the last frame
+// of a run with a checkpoint every 5 ms is the same file as that of a run with none.
+TEST(Pouring, CheckpointsAlongTheWayLeaveTheRunUnchanged) {
+  std::string frames[2];
+  const double intervals[2] = {0.005, 0.0};
+  for (int k = 0; k < 2; ++k) {
+    const auto dir = std::filesystem::temp_directory_path() /
+                     ("sanguis_test_pour_checkpoints_" + std::to_string(k));
+    std::filesystem::remove_all(dir);
+    DemCase c = pour_case();
+    c.stop.end_time = 0.05;
+    c.output.interval = 0.025;
+    c.output.checkpoint_interval = intervals[k];
+    RunOptions options;
+    options.output_dir = dir;
+    options.quiet = true;
+    std::ostringstream console;
+    run_dem_case(c, options, console);
+    const auto particles = io::read_pvd(dir / "particles.pvd");
+    ASSERT_FALSE(particles.empty());
+    std::ifstream in(particles.back().dataset, std::ios::binary);
+    frames[k].assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    // run.log notes each checkpoint written along the way: several, then none.
+    std::ifstream log(dir / "run.log");
+    int checkpoints = 0;
+    for (std::string line; std::getline(log, line);)
+      checkpoints += line.rfind("checkpoint:", 0) == 0;
+    if (k == 0) {
+      EXPECT_GE(checkpoints, 5);
+    } else {
+      EXPECT_EQ(checkpoints, 0);
+    }
+    std::filesystem::remove_all(dir);
+  }
+  EXPECT_FALSE(frames[0].empty());
+  EXPECT_EQ(frames[0], frames[1]);
 }
 
 // The bodies poured during a run have their surfaces in every frame, from the first
