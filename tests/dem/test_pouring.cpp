@@ -123,6 +123,25 @@ TEST(Pouring, RestartInTheMiddleOfThePourIsBitForBit) {
   std::filesystem::remove(file);
 }
 
+// Runs the pour case to 0.05 s through run_dem_case (quiet) into a fresh folder `name` of
+// the temporary directory, frames every frame_interval, checkpoints every
+// checkpoint_interval (0: only at the end); returns the folder.
+std::filesystem::path run_pour_case(const std::string& name, double frame_interval,
+                                    double checkpoint_interval) {
+  const auto dir = std::filesystem::temp_directory_path() / name;
+  std::filesystem::remove_all(dir);
+  DemCase c = pour_case();
+  c.stop.end_time = 0.05;
+  c.output.interval = frame_interval;
+  c.output.checkpoint_interval = checkpoint_interval;
+  RunOptions options;
+  options.output_dir = dir;
+  options.quiet = true;
+  std::ostringstream console;
+  run_dem_case(c, options, console);
+  return dir;
+}
+
 // Checkpoints written along the way leave a run's results unchanged (the dam-break
 // validations checkpoint every 0.05 s so that a killed run loses little): the last frame
 // of a run with a checkpoint every 5 ms is the same file as that of a run with none.
@@ -130,18 +149,8 @@ TEST(Pouring, CheckpointsAlongTheWayLeaveTheRunUnchanged) {
   std::string frames[2];
   const double intervals[2] = {0.005, 0.0};
   for (int k = 0; k < 2; ++k) {
-    const auto dir = std::filesystem::temp_directory_path() /
-                     ("sanguis_test_pour_checkpoints_" + std::to_string(k));
-    std::filesystem::remove_all(dir);
-    DemCase c = pour_case();
-    c.stop.end_time = 0.05;
-    c.output.interval = 0.025;
-    c.output.checkpoint_interval = intervals[k];
-    RunOptions options;
-    options.output_dir = dir;
-    options.quiet = true;
-    std::ostringstream console;
-    run_dem_case(c, options, console);
+    const auto dir =
+        run_pour_case("sanguis_test_pour_checkpoints_" + std::to_string(k), 0.025, intervals[k]);
     const auto particles = io::read_pvd(dir / "particles.pvd");
     ASSERT_FALSE(particles.empty());
     std::ifstream in(particles.back().dataset, std::ios::binary);
@@ -165,16 +174,7 @@ TEST(Pouring, CheckpointsAlongTheWayLeaveTheRunUnchanged) {
 // The bodies poured during a run have their surfaces in every frame, from the first
 // (empty) one on, so that the frames of bodies.pvd match those of particles.pvd.
 TEST(Pouring, RunWritesBodySurfacesFromTheFirstFrame) {
-  const auto dir = std::filesystem::temp_directory_path() / "sanguis_test_pour_bodies";
-  std::filesystem::remove_all(dir);
-  DemCase c = pour_case();
-  c.stop.end_time = 0.05;
-  c.output.interval = 0.01;
-  RunOptions options;
-  options.output_dir = dir;
-  options.quiet = true;
-  std::ostringstream console;
-  run_dem_case(c, options, console);
+  const auto dir = run_pour_case("sanguis_test_pour_bodies", 0.01, 0.0);
   const auto particles = io::read_pvd(dir / "particles.pvd");
   const auto bodies = io::read_pvd(dir / "bodies.pvd");
   ASSERT_EQ(bodies.size(), particles.size());

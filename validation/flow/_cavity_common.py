@@ -109,3 +109,17 @@ def draw_centre_lines(ax, profiles, centres, styled_names, title, u_line="", v_l
     ax.grid(alpha=0.3)
     ax.legend(fontsize=6)
     ax.set_title(title, fontsize=9)
+
+
+def draw_plane_cut(fig, ax, arrays, values, z, label, title, linewidth):
+    """The cells cut by the plane at height z coloured by `values` (one per cell),
+    with the blocks outlined, in the unit square."""
+    lo, hi = cell_boxes(arrays)
+    cut = (lo[:, 2] <= z) & (hi[:, 2] > z)
+    draw_speed_and_blocks(fig, ax, lo[cut], hi[cut], values[cut], arrays["block"][cut], label, 0.045, linewidth)
+    ax.set_xlim(0, 1)
+    ax.set_ylim(0, 1)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x / L")
+    ax.set_ylabel("y / L")
+    ax.set_title(title, fontsize=9)

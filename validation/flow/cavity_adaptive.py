@@ -70,7 +70,7 @@ import matplotlib
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _cavity_common import cell_boxes, draw_centre_lines, draw_speed_and_blocks, read_rows, read_vtu  # noqa: E402
+from _cavity_common import cell_boxes, draw_centre_lines, draw_plane_cut, read_rows, read_vtu  # noqa: E402
 from cavity import GHIA_U, GHIA_V  # noqa: E402
 
 matplotlib.use("Agg")
@@ -239,17 +239,8 @@ def where_cells_differ(arrays, means, threshold):
 def draw_grid(fig, ax, arrays, title, values=None, label="|u| / U"):
     """The cells cut by the plane z = h/2 coloured by speed (or by `values`,
     one per cell), with the blocks outlined."""
-    h = 1.0 / N
-    lo, hi = cell_boxes(arrays)
-    cut = (lo[:, 2] <= 0.5 * h) & (hi[:, 2] > 0.5 * h)
     shown = np.linalg.norm(arrays["velocity"], axis=1) if values is None else values
-    draw_speed_and_blocks(fig, ax, lo[cut], hi[cut], shown[cut], arrays["block"][cut], label, 0.045, 0.5)
-    ax.set_xlim(0, 1)
-    ax.set_ylim(0, 1)
-    ax.set_aspect("equal")
-    ax.set_xlabel("x / L")
-    ax.set_ylabel("y / L")
-    ax.set_title(title, fontsize=9)
+    draw_plane_cut(fig, ax, arrays, shown, 0.5 / N, label, title, 0.5)
 
 
 def tolerance_axes(ax, tolerance, xlabel, ylabel, title):

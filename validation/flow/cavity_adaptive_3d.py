@@ -75,7 +75,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import adaptive_potential  # noqa: E402
-from _cavity_common import (cell_boxes, draw_centre_lines, draw_speed_and_blocks, last_frame, read_rows,  # noqa: E402
+from _cavity_common import (cell_boxes, draw_centre_lines, draw_plane_cut, last_frame, read_rows,  # noqa: E402
                             read_vtu, with_walls)
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -323,16 +323,7 @@ def bound_grid_sampling(grid, profiles, coarsen_levels, zetas):
 def draw_plane(fig, ax, arrays, values, label, title):
     """The cells cut by the plane z = 0.5 + h/2 (h: the finest cell) coloured by
     `values` (one per cell), with the blocks outlined."""
-    lo, hi = cell_boxes(arrays)
-    z = 0.5 + 0.5 / N
-    cut = (lo[:, 2] <= z) & (hi[:, 2] > z)
-    draw_speed_and_blocks(fig, ax, lo[cut], hi[cut], values[cut], arrays["block"][cut], label, 0.045, 0.4)
-    ax.set_xlim(0, 1)
-    ax.set_ylim(0, 1)
-    ax.set_aspect("equal")
-    ax.set_xlabel("x / L")
-    ax.set_ylabel("y / L")
-    ax.set_title(title, fontsize=9)
+    draw_plane_cut(fig, ax, arrays, values, 0.5 + 0.5 / N, label, title, 0.4)
 
 
 def draw(frames, profiles, averaged, rows, diffs, cells_uniform):
