@@ -103,22 +103,27 @@ def level_estimates(components, periodic):
     return levels  # levels[0]: finest blocks
 
 
-def fewest_cells(levels, zeta):
-    """The fewest cells of any grid the criterion can settle on: every block
-    coarser than the finest must have an estimate <= zeta (else it is
-    refined), so taking, top-down, every block whose estimate allows it as a
-    leaf gives the minimum. Returns the cells and the leaf blocks per level
-    (finest first)."""
+def fewest_leaves(levels, zeta):
+    """The leaf blocks of the grid with the fewest cells the criterion can settle on:
+    every block coarser than the finest must have an estimate <= zeta (else it is
+    refined), so taking, top-down, every block whose estimate allows it as a leaf
+    gives the minimum. Returns one boolean array per level (finest first): which
+    blocks of that level are leaves."""
     top = len(levels) - 1
-    counts = [0] * len(levels)
+    leaves = [None] * len(levels)
     # open[k]: blocks of level k not covered by a coarser leaf.
     open_blocks = np.ones_like(levels[top], dtype=bool)
     for k in range(top, -1, -1):
-        leaf = open_blocks if k == 0 else open_blocks & (levels[k] <= zeta)
-        counts[k] = int(leaf.sum())
+        leaves[k] = open_blocks if k == 0 else open_blocks & (levels[k] <= zeta)
         if k > 0:
-            rest = open_blocks & ~leaf
+            rest = open_blocks & ~leaves[k]
             open_blocks = np.repeat(np.repeat(np.repeat(rest, 2, 0), 2, 1), 2, 2)
+    return leaves
+
+
+def fewest_cells(levels, zeta):
+    """The cells of fewest_leaves' grid and its leaf blocks per level (finest first)."""
+    counts = [int(leaf.sum()) for leaf in fewest_leaves(levels, zeta)]
     return sum(counts) * B ** 3, counts
 
 
