@@ -258,6 +258,11 @@ int main(int argc, char** argv) {
                       "flow-cavity: multigrids on the flow's blocks, not on their families of 8 "
                       "merged into one block (A/B)");
   bench_cmd
+      ->add_option("--prefetch", bo.prefetch,
+                   "flow-cavity: when the multigrid prefetches the next block's cells "
+                   "(\"out-of-cache\", the default, \"always\" or \"never\"; A/B)")
+      ->check(CLI::IsMember({"out-of-cache", "always", "never"}));
+  bench_cmd
       ->add_option("--relaxation", bo.relaxation,
                    "flow-cavity: over-relaxation of the multigrid smoother in the pressure "
                    "and viscous solves (default: the solver's, 1.25 and 1.15)")

@@ -27,6 +27,9 @@ struct BenchOptions {
   // flow-cavity: the multigrids on the flow's own blocks instead of their families of 8
   // merged (NavierStokesOptions::merge_solver_blocks = false), for A/B runs.
   bool unmerged_solver = false;
+  // flow-cavity: when the multigrid prefetches the next block ("out-of-cache", "always",
+  // "never"; MultigridOptions::prefetch), for A/B runs.
+  std::string prefetch = "out-of-cache";
   // flow-cavity: over-relaxation of the red-black smoother in the pressure and viscous
   // solves (0: the solver's, NavierStokesOptions), for A/B runs.
   double relaxation = 0.0;

@@ -93,7 +93,12 @@ std::string run_flow_cavity(const BenchOptions& options_in) {
   options.viscous.tolerance = 1e-3;
   options.pressure.constant_coefficient_kernels = !o.general_kernels;
   options.viscous.constant_coefficient_kernels = !o.general_kernels;
+  const flow::NextBlockPrefetch prefetch = o.prefetch == "always" ? flow::NextBlockPrefetch::Always
+                                           : o.prefetch == "never"
+                                               ? flow::NextBlockPrefetch::Never
+                                               : flow::NextBlockPrefetch::OutOfCache;
   for (flow::MultigridOptions* mg : {&options.pressure, &options.viscous}) {
+    mg->prefetch = prefetch;
     if (o.relaxation > 0.0) mg->relaxation = o.relaxation;
     if (o.sweeps > 0) mg->pre_sweeps = mg->post_sweeps = o.sweeps;
   }
@@ -188,7 +193,7 @@ std::string run_flow_cavity(const BenchOptions& options_in) {
        << ",\"multigrid_kernels\":\"" << (constant ? "constant" : "general") << "\""
        << ",\"relaxation\":" << mg_options.relaxation
        << ",\"viscous_relaxation\":" << options.viscous.relaxation
-       << ",\"sweeps\":" << mg_options.pre_sweeps;
+       << ",\"sweeps\":" << mg_options.pre_sweeps << ",\"prefetch\":\"" << o.prefetch << "\"";
   const double triad = stream_triad_bytes_per_s();
   const double effective = vcycle_bytes_per_cell(!constant, mg_options.pre_sweeps) *
                            static_cast<double>(mg_report.cycles) * cells / mg_seconds;

@@ -1,5 +1,7 @@
 #include "flow/multigrid.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -454,6 +456,51 @@ template <int kB, typename DiagonalOf>
   set(kB - 1, closure_implicit({kB - 1, j, k}, kB, faces, constant, constant));
 }
 
+/// The blocks a half-sweep relaxes next, whose rows relax_constant_rows
+/// asks the memory for while it works on the current block (null: none).
+/// Out of cache a block's x and right-hand side arrive row by row as the
+/// kernel first reads them, and the hardware's stream prefetchers start
+/// afresh at every 4 KB page of the block's rows (docs/performance.md,
+/// "Prefetching the next block in the smoother").
+struct NextBlock {
+  const double* x = nullptr;
+  const double* rhs = nullptr;
+};
+
+/// Prefetch row q (in (j, k) order) of `next`: the row's cells and its
+/// ghosts along x, x for writing (it is stored back), the right-hand side
+/// for reading, into the caches nearest the core.
+[[gnu::always_inline]] inline void prefetch_row(const NextBlock& next, const BlockLayout& L,
+                                                int q) {
+  if (next.x == nullptr) return;
+  const int b = L.cells;
+  const std::ptrdiff_t start = L.index(-L.ghost, q % b, q / b);
+  const std::ptrdiff_t length = b + 2 * L.ghost;
+  constexpr std::ptrdiff_t kLine = 64 / sizeof(double);
+  for (std::ptrdiff_t at = 0; at < length + kLine - 1; at += kLine) {
+    const std::ptrdiff_t c = start + std::min(at, length - 1);
+    __builtin_prefetch(next.x + c, 1, 1);
+    __builtin_prefetch(next.rhs + c, 0, 1);
+  }
+}
+
+/// Whether a half-sweep over x and rhs should prefetch the next block: when
+/// the two fields hold more than half the last-level cache (sysconf; 32 MiB
+/// where it does not tell), so the blocks come from memory. In cache the
+/// prefetches only add instructions (about 10 % of the smoother's time on
+/// the 64³ cavity; docs/performance.md, "Prefetching the next block in the
+/// smoother").
+bool prefetch_worthwhile(NextBlockPrefetch mode, const BlockField& x, const BlockField& rhs) {
+  if (mode != NextBlockPrefetch::OutOfCache) return mode == NextBlockPrefetch::Always;
+  static const double cache_bytes = [] {
+    const long reported = sysconf(_SC_LEVEL3_CACHE_SIZE);
+    return reported > 0 ? static_cast<double>(reported) : 32.0 * 1024 * 1024;
+  }();
+  const double bytes = sizeof(double) * (static_cast<double>(x.raw().size()) +
+                                         static_cast<double>(rhs.raw().size()));
+  return bytes > 0.5 * cache_bytes;
+}
+
 /// relax_constant with kB cells per edge, every row through relax_row_whole
 /// (docs/performance.md, "Whole rows in the smoother"). `closed`: the faces
 /// of `faces` that close on the cells beside them; `diagonal_of(implicit)`:
@@ -462,7 +509,7 @@ template <int kB, bool kAnyClosed, typename DiagonalOf>
 void relax_constant_rows(double* x, const double* rhs, const BlockLayout& L, int first, double beta,
                          double inv_h2, double omega, const ClosedFaces& faces,
                          const std::array<bool, 6>& closed, DiagonalOf diagonal_of,
-                         const AcrossFaces& across) {
+                         const AcrossFaces& across, const NextBlock& next) {
   RowDiagonal open;
   open.interior = diagonal_of(0.0);
   const bool matched =
@@ -481,9 +528,11 @@ void relax_constant_rows(double* x, const double* rhs, const BlockLayout& L, int
   // row's store (whole, its unchanged lanes too), a chain through the
   // division's latency from row to row. Any order gives the same bits: in a
   // half-sweep no cell reads one of its own colour.
+  int fetched = 0;  // rows of the next block asked for: one per row relaxed
   for (int kind = 0; kind < 2; ++kind)
     for (int k = 0; k < kB; ++k)
       for (int j = (k + kind) & 1; j < kB; j += 2) {
+        prefetch_row(next, L, fetched++);
         double* row = x + L.index(0, j, k);
         const double* f = rhs + L.index(0, j, k);
         const int i_first = (k + j + first) & 1;
@@ -517,7 +566,8 @@ void relax_constant_rows(double* x, const double* rhs, const BlockLayout& L, int
 /// (the smoother is memory-bound).
 inline void relax_constant(double* x, const double* rhs, const BlockLayout& L, int first,
                            double alpha, double beta, double inv_h2, double omega,
-                           const ClosedFaces& faces, const AcrossFaces& across) {
+                           const ClosedFaces& faces, const AcrossFaces& across,
+                           const NextBlock& next = {}) {
   const int b = L.cells;
   auto diagonal = [&](double implicit) {
     double den = alpha + implicit * inv_h2;
@@ -533,10 +583,10 @@ inline void relax_constant(double* x, const double* rhs, const BlockLayout& L, i
   const auto rows = [&]<int kB>() {
     if (any_closed) {
       relax_constant_rows<kB, true>(x, rhs, L, first, beta, inv_h2, omega, faces, closed, diagonal,
-                                    across);
+                                    across, next);
     } else {
       relax_constant_rows<kB, false>(x, rhs, L, first, beta, inv_h2, omega, faces, closed, diagonal,
-                                     across);
+                                     across, next);
     }
   };
   switch (b) {
@@ -587,12 +637,13 @@ inline void relax_constant(double* x, const double* rhs, const BlockLayout& L, i
 /// then vectorises without the ordered sum).
 template <bool kSquares>
 inline double residual_constant(double* x, const double* rhs, double* r, const BlockLayout& L,
-                                double alpha, double beta, double inv_h2,
-                                const AcrossFaces& across) {
+                                double alpha, double beta, double inv_h2, const AcrossFaces& across,
+                                const NextBlock& next) {
   const int b = L.cells;
   double squares = 0.0;
   for (int k = 0; k < b; ++k)
     for (int j = 0; j < b; ++j) {
+      prefetch_row(next, L, k * b + j);
       const std::ptrdiff_t row = L.index(0, j, k);
       double* xr = x + row;
       // The neighbouring rows and the row's ghosts along x as in
@@ -1077,7 +1128,8 @@ void Multigrid::fill_block_ghosts(int blk, BlockField& x, const ScalarBoundary* 
 }
 
 void Multigrid::relax_block(int level, int blk, BlockField& x, const BlockField& rhs,
-                            const ScalarBoundary* bc, int colour, bool in_place) const {
+                            const ScalarBoundary* bc, int colour, bool in_place,
+                            int next_blk) const {
   const Level& lv = levels_[D(level)];
   const BlockLayout L = x.layout();
   const int b = L.cells;
@@ -1125,8 +1177,10 @@ void Multigrid::relax_block(int level, int blk, BlockField& x, const BlockField&
   const AcrossFaces across =
       in_place ? same_level_neighbours(forest_, x, blk, bc ? bc->kind : kinds_) : AcrossFaces{};
   if (constant_kernels_ && lv.block_constant[at]) {
+    const NextBlock next =
+        next_blk >= 0 ? NextBlock{x.block(next_blk), rhs.block(next_blk)} : NextBlock{};
     relax_constant(xb, rb, L, first, lv.block_alpha[at], lv.block_beta[at], inv_h2, omega_, faces,
-                   across);
+                   across, next);
     return;
   }
   // The general kernel, by rows, reading same-level neighbours as relax_constant does.
@@ -1169,10 +1223,17 @@ void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const Sc
       } else {
         fill_ghosts(level, x, bc, true);  // the 7-point stencil reads face ghosts only
       }
+      // The block each half-sweep takes next on this thread (the first
+      // colour runs forwards, the second backwards), or on the thread beside
+      // at the end of a share: its rows are prefetched meanwhile, when the
+      // fields do not fit in the cache.
+      const int blocks = prefetch_worthwhile(prefetch_, x, rhs) ? x.blocks() : 0;
       const auto relax = [&](int blk) {
         const bool in_place = fused && in_place_;
         if (fused) fill_block_ghosts(blk, x, bc, 1 - colour, in_place);
-        relax_block(level, blk, x, rhs, bc, colour, in_place);
+        const int next = colour == 0 ? blk + 1 : blk - 1;
+        relax_block(level, blk, x, rhs, bc, colour, in_place,
+                    next >= 0 && next < blocks ? next : -1);
       };
       // In a half-sweep each block writes only its own cells and ghosts, and
       // reads other blocks only through ghosts copied from, or in place in,
@@ -1198,6 +1259,7 @@ void Multigrid::compute_residual(int level, BlockField& x, const BlockField& rhs
   const std::array<std::ptrdiff_t, 3> s{L.stride(0), L.stride(1), L.stride(2)};
   fill_ghosts_between_blocks_apart(level, x);  // the rest block by block, as in smooth()
   block_squares_.resize(static_cast<std::size_t>(forest_.local_blocks()));
+  const int blocks = prefetch_worthwhile(prefetch_, x, rhs) ? x.blocks() : 0;  // as in smooth()
   forest_.for_each_block([&](int blk) {
     const auto at = static_cast<std::size_t>(blk);
     // Same-level neighbours of this process are read in place, unless the
@@ -1216,11 +1278,13 @@ void Multigrid::compute_residual(int level, BlockField& x, const BlockField& rhs
     const AcrossFaces across =
         in_place ? same_level_neighbours(forest_, x, blk, bc ? bc->kind : kinds_) : AcrossFaces{};
     if (constant_kernels_ && lv.block_constant[at]) {
+      const NextBlock next =
+          blk + 1 < blocks ? NextBlock{x.block(blk + 1), rhs.block(blk + 1)} : NextBlock{};
       block_squares_[at] = squares_wanted
                                ? residual_constant<true>(xb, fb, rb, L, lv.block_alpha[at],
-                                                         lv.block_beta[at], inv_h2, across)
+                                                         lv.block_beta[at], inv_h2, across, next)
                                : residual_constant<false>(xb, fb, rb, L, lv.block_alpha[at],
-                                                          lv.block_beta[at], inv_h2, across);
+                                                          lv.block_beta[at], inv_h2, across, next);
     } else {
       double squares = 0.0;
       for (int kk = 0; kk < b; ++kk)
@@ -1437,6 +1501,7 @@ void Multigrid::take_options(const MultigridOptions& options) {
   omega_ = options.relaxation;
   constant_kernels_ = options.constant_coefficient_kernels;
   in_place_ = options.read_neighbours_in_place;
+  prefetch_ = options.prefetch;
 }
 
 void Multigrid::relax(BlockField& x, const BlockField& rhs, const ScalarBoundary& bc, int sweeps,

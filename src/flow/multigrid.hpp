@@ -58,6 +58,13 @@
 
 namespace sanguis::flow {
 
+/// When the smoother and the residual prefetch the next block's cells while
+/// they work on one (docs/performance.md, "Prefetching the next block in the
+/// smoother"): only when x and the right-hand side outgrow half the
+/// last-level cache (in cache the prefetches only cost), always, or never.
+/// A hint to the memory, so every choice gives the same bits.
+enum class NextBlockPrefetch { OutOfCache, Always, Never };
+
 struct MultigridOptions {
   double tolerance = 1e-8;  ///< stop when |r|_2 <= tolerance |rhs|_2 (RMS norms)
   int max_cycles = 50;      ///< V-cycles at most
@@ -80,6 +87,8 @@ struct MultigridOptions {
   /// layer first: the same values, so the same bits, without the copies.
   /// false: copy (for tests and comparisons).
   bool read_neighbours_in_place = true;
+  /// Prefetching of the next block's cells (for tests and comparisons).
+  NextBlockPrefetch prefetch = NextBlockPrefetch::OutOfCache;
   /// Fill x's ghosts (neighbours and bc) before returning. false where the
   /// caller refills them anyway (the viscous solves: the velocity's ghosts
   /// are filled again before anything reads them), saving a full exchange;
@@ -204,8 +213,11 @@ class Multigrid {
   /// with `in_place` the block reads the cells of its same-level neighbours
   /// of this rank, and its own cells beyond Neumann boundary faces, in place
   /// (those ghosts not filled).
+  /// `next_blk` (or -1): the block relaxed after this one, whose cells are
+  /// prefetched meanwhile (constant-coefficient blocks).
   void relax_block(int level, int blk, BlockField& x, const BlockField& rhs,
-                   const ScalarBoundary* bc, int colour, bool in_place = false) const;
+                   const ScalarBoundary* bc, int colour, bool in_place = false,
+                   int next_blk = -1) const;
   /// r = rhs - A x on `level`, and each block's sum of r^2 into
   /// block_squares_ (one pass: summed as r is written; root_mean_square()),
   /// unless !squares_wanted (the V-cycle's residual, only restricted): then
@@ -285,6 +297,7 @@ class Multigrid {
   double omega_ = 1.0;
   bool constant_kernels_ = true;  ///< MultigridOptions::constant_coefficient_kernels of the solve
   bool in_place_ = true;          ///< MultigridOptions::read_neighbours_in_place of the solve
+  NextBlockPrefetch prefetch_ = NextBlockPrefetch::OutOfCache;  ///< MultigridOptions::prefetch
 };
 
 }  // namespace sanguis::flow
