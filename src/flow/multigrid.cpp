@@ -412,6 +412,86 @@ template <int kB, bool kClosure>
         row, f, beside, x_ghosts, at, at + kLanes == kB, i_first, beta, inv_h2, diagonal, omega);
 }
 
+/// relax_row_whole for rows of a multiple of 16 cells: each 16 cells as two
+/// vectors of 8, from which the 8 cells of the half-sweep's colour are
+/// gathered into one vector (centre, x neighbours, right-hand side, the four
+/// neighbouring rows, and with kClosure the implicit parts and diagonals),
+/// relaxed there with one division, and put back between the other colour's
+/// unchanged values for the same whole store. The same operations in the
+/// same order per cell as relax_row_lanes (a lane permutation does not
+/// change a value), so the same bits, with half the arithmetic and divisions
+/// (docs/performance.md, "One colour per vector in the smoother").
+template <int kB, bool kClosure>
+[[gnu::always_inline]] inline void relax_row_colour(double* row, const double* f,
+                                                    const std::array<const double*, 4>& beside,
+                                                    const std::array<const double*, 2>& x_ghosts,
+                                                    int i_first, double beta, double inv_h2,
+                                                    const RowDiagonal& diagonal, double omega) {
+  static_assert(kB % 16 == 0);
+  const Lanes8 own =
+      i_first == 0 ? Lanes8{0, 2, 4, 6, 8, 10, 12, 14} : Lanes8{1, 3, 5, 7, 9, 11, 13, 15};
+  const auto gather = [&own](const double* p, int at) {
+    Doubles8 low, high;
+    std::memcpy(&low, p + at, sizeof low);
+    std::memcpy(&high, p + at + 8, sizeof high);
+    return __builtin_shuffle(low, high, own);
+  };
+  for (int at = 0; at < kB; at += 16) {
+    Doubles8 low, high;  // the row's 16 cells, both colours
+    std::memcpy(&low, row + at, sizeof low);
+    std::memcpy(&high, row + at + 8, sizeof high);
+    const Doubles8 centre = __builtin_shuffle(low, high, own);
+    Doubles8 num;
+    if constexpr (kClosure) {
+      num = gather(f, at) + gather(diagonal.implicit, at) * inv_h2 * centre;
+    } else {
+      const double implicit = 0.0;
+      num = gather(f, at) + implicit * inv_h2 * centre;
+    }
+    Doubles8 left = gather(row - 1, at), right = gather(row + 1, at);
+    // Row ends read in place in a neighbour: cell 0's left (colour 0) and
+    // cell kB - 1's right (colour 1).
+    if (at == 0 && i_first == 0 && x_ghosts[0]) left[0] = *x_ghosts[0];
+    if (at + 16 == kB && i_first == 1 && x_ghosts[1]) right[7] = *x_ghosts[1];
+    num += inv_h2 * (beta * left + beta * right);
+    num += inv_h2 * (beta * gather(beside[0], at) + beta * gather(beside[1], at));
+    num += inv_h2 * (beta * gather(beside[2], at) + beta * gather(beside[3], at));
+    Doubles8 relaxed;
+    if constexpr (kClosure) {
+      relaxed = centre + omega * (num / gather(diagonal.den, at) - centre);
+    } else {
+      relaxed = centre + omega * (num / diagonal.interior - centre);
+    }
+    // Back between the other colour's values (`relaxed` is lanes 8..15 of each shuffle).
+    Doubles8 out_low, out_high;
+    if (i_first == 0) {
+      out_low = __builtin_shuffle(low, relaxed, Lanes8{8, 1, 9, 3, 10, 5, 11, 7});
+      out_high = __builtin_shuffle(high, relaxed, Lanes8{12, 1, 13, 3, 14, 5, 15, 7});
+    } else {
+      out_low = __builtin_shuffle(low, relaxed, Lanes8{0, 8, 2, 9, 4, 10, 6, 11});
+      out_high = __builtin_shuffle(high, relaxed, Lanes8{0, 12, 2, 13, 4, 14, 6, 15});
+    }
+    std::memcpy(row + at, &out_low, sizeof out_low);
+    std::memcpy(row + at + 8, &out_high, sizeof out_high);
+  }
+}
+
+/// One row of a half-sweep: relax_row_colour where the row is a multiple of
+/// 16 cells, else relax_row_whole.
+template <int kB, bool kClosure>
+[[gnu::always_inline]] inline void relax_row(double* row, const double* f,
+                                             const std::array<const double*, 4>& beside,
+                                             const std::array<const double*, 2>& x_ghosts,
+                                             int i_first, double beta, double inv_h2,
+                                             const RowDiagonal& diagonal, double omega) {
+  if constexpr (kB % 16 == 0) {
+    relax_row_colour<kB, kClosure>(row, f, beside, x_ghosts, i_first, beta, inv_h2, diagonal,
+                                   omega);
+  } else {
+    relax_row_whole<kB, kClosure>(row, f, beside, x_ghosts, i_first, beta, inv_h2, diagonal, omega);
+  }
+}
+
 /// The implicit parts and diagonals of the kB cells of row (j, k) beside a
 /// closed face (the other colour's are formed and dropped with its values).
 /// Out of line: the open rows' loop stays small.
@@ -539,7 +619,7 @@ void relax_constant_rows(double* x, const double* rhs, const BlockLayout& L, int
         const auto beside = neighbour_rows(row, L, across, j, k);
         const auto x_ghosts = row_x_ghosts_of_colour(L, across, j, k, i_first);
         if (!kAnyClosed || !row_beside_closed_face(closed, kB, j, k)) {
-          relax_row_whole<kB, false>(row, f, beside, x_ghosts, i_first, beta, inv_h2, open, omega);
+          relax_row<kB, false>(row, f, beside, x_ghosts, i_first, beta, inv_h2, open, omega);
           continue;
         }
         const ClosureRow<kB>* closure = &own;
@@ -554,8 +634,8 @@ void relax_constant_rows(double* x, const double* rhs, const BlockLayout& L, int
             formed[kind_of_row] = true;
           }
         }
-        relax_row_whole<kB, true>(row, f, beside, x_ghosts, i_first, beta, inv_h2,
-                                  closure->diagonal(), omega);
+        relax_row<kB, true>(row, f, beside, x_ghosts, i_first, beta, inv_h2, closure->diagonal(),
+                            omega);
       }
 }
 
