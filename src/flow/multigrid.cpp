@@ -312,9 +312,11 @@ AcrossFaces same_level_neighbours(const Forest& forest, const BlockField& x, int
 
 // GCC/Clang vector types of 4 and 8 doubles, and their lane masks. The
 // helpers below pass them by value between inlined functions of this file
-// only; on a build without AVX (SANGUIS_NATIVE off) GCC notes that such a
-// return changes the ABI (-Wpsabi), which concerns no interface here.
-#if defined(__GNUC__) && !defined(__clang__)
+// only; on a build without AVX (SANGUIS_NATIVE off) GCC and Clang note that
+// such a return changes the ABI (-Wpsabi), which concerns no interface here.
+#if defined(__clang__)
+#pragma clang diagnostic ignored "-Wpsabi"
+#elif defined(__GNUC__)
 #pragma GCC diagnostic ignored "-Wpsabi"
 #endif
 typedef double Doubles4 __attribute__((vector_size(32)));
@@ -412,35 +414,59 @@ template <int kB, bool kClosure>
         row, f, beside, x_ghosts, at, at + kLanes == kB, i_first, beta, inv_h2, diagonal, omega);
 }
 
-/// relax_row_whole for rows of a multiple of 16 cells: each 16 cells as two
-/// vectors of 8, from which the 8 cells of the half-sweep's colour are
-/// gathered into one vector (centre, x neighbours, right-hand side, the four
-/// neighbouring rows, and with kClosure the implicit parts and diagonals),
-/// relaxed there with one division, and put back between the other colour's
-/// unchanged values for the same whole store. The same operations in the
-/// same order per cell as relax_row_lanes (a lane permutation does not
-/// change a value), so the same bits, with half the arithmetic and divisions
-/// (docs/performance.md, "One colour per vector in the smoother").
-template <int kB, bool kClosure>
+/// The 8 cells of colour kFirst (the even cells for 0, the odd ones for 1)
+/// among the 16 cells of `low` and `high`, in order.
+template <int kFirst>
+[[gnu::always_inline]] inline Doubles8 colour_cells(Doubles8 low, Doubles8 high) {
+  if constexpr (kFirst == 0) {
+    return __builtin_shufflevector(low, high, 0, 2, 4, 6, 8, 10, 12, 14);
+  } else {
+    return __builtin_shufflevector(low, high, 1, 3, 5, 7, 9, 11, 13, 15);
+  }
+}
+
+/// `cells` (8 values of a row) with its cells of colour kFirst replaced by
+/// `relaxed` from lane `from` on (0 for the first 8 cells of 16, 4 for the
+/// last 8).
+template <int kFirst, int kFrom>
+[[gnu::always_inline]] inline Doubles8 with_colour_cells(Doubles8 cells, Doubles8 relaxed) {
+  constexpr int r = 8 + kFrom;  // lane kFrom of `relaxed` in the shuffle's numbering
+  if constexpr (kFirst == 0) {
+    return __builtin_shufflevector(cells, relaxed, r, 1, r + 1, 3, r + 2, 5, r + 3, 7);
+  } else {
+    return __builtin_shufflevector(cells, relaxed, 0, r, 2, r + 1, 4, r + 2, 6, r + 3);
+  }
+}
+
+/// relax_row_whole for rows of a multiple of 16 cells, half-sweep colour
+/// kFirst (the i_first of the others): each 16 cells as two vectors of 8,
+/// from which the 8 cells of the colour are gathered into one vector (centre,
+/// x neighbours, right-hand side, the four neighbouring rows, and with
+/// kClosure the implicit parts and diagonals), relaxed there with one
+/// division, and put back between the other colour's unchanged values for
+/// the same whole store. The same operations in the same order per cell as
+/// relax_row_lanes (a lane permutation does not change a value), so the same
+/// bits, with half the arithmetic and divisions (docs/performance.md, "One
+/// colour per vector in the smoother"). Fixed shuffles: with AVX-512 each is
+/// one instruction; relax_row uses this kernel only there.
+template <int kB, bool kClosure, int kFirst>
 [[gnu::always_inline]] inline void relax_row_colour(double* row, const double* f,
                                                     const std::array<const double*, 4>& beside,
                                                     const std::array<const double*, 2>& x_ghosts,
-                                                    int i_first, double beta, double inv_h2,
+                                                    double beta, double inv_h2,
                                                     const RowDiagonal& diagonal, double omega) {
   static_assert(kB % 16 == 0);
-  const Lanes8 own =
-      i_first == 0 ? Lanes8{0, 2, 4, 6, 8, 10, 12, 14} : Lanes8{1, 3, 5, 7, 9, 11, 13, 15};
-  const auto gather = [&own](const double* p, int at) {
+  const auto gather = [](const double* p, int at) {
     Doubles8 low, high;
     std::memcpy(&low, p + at, sizeof low);
     std::memcpy(&high, p + at + 8, sizeof high);
-    return __builtin_shuffle(low, high, own);
+    return colour_cells<kFirst>(low, high);
   };
   for (int at = 0; at < kB; at += 16) {
     Doubles8 low, high;  // the row's 16 cells, both colours
     std::memcpy(&low, row + at, sizeof low);
     std::memcpy(&high, row + at + 8, sizeof high);
-    const Doubles8 centre = __builtin_shuffle(low, high, own);
+    const Doubles8 centre = colour_cells<kFirst>(low, high);
     Doubles8 num;
     if constexpr (kClosure) {
       num = gather(f, at) + gather(diagonal.implicit, at) * inv_h2 * centre;
@@ -451,8 +477,8 @@ template <int kB, bool kClosure>
     Doubles8 left = gather(row - 1, at), right = gather(row + 1, at);
     // Row ends read in place in a neighbour: cell 0's left (colour 0) and
     // cell kB - 1's right (colour 1).
-    if (at == 0 && i_first == 0 && x_ghosts[0]) left[0] = *x_ghosts[0];
-    if (at + 16 == kB && i_first == 1 && x_ghosts[1]) right[7] = *x_ghosts[1];
+    if (kFirst == 0 && at == 0 && x_ghosts[0]) left[0] = *x_ghosts[0];
+    if (kFirst == 1 && at + 16 == kB && x_ghosts[1]) right[7] = *x_ghosts[1];
     num += inv_h2 * (beta * left + beta * right);
     num += inv_h2 * (beta * gather(beside[0], at) + beta * gather(beside[1], at));
     num += inv_h2 * (beta * gather(beside[2], at) + beta * gather(beside[3], at));
@@ -462,38 +488,39 @@ template <int kB, bool kClosure>
     } else {
       relaxed = centre + omega * (num / diagonal.interior - centre);
     }
-    // Back between the other colour's values (`relaxed` is lanes 8..15 of each shuffle).
-    Doubles8 out_low, out_high;
-    if (i_first == 0) {
-      out_low = __builtin_shuffle(low, relaxed, Lanes8{8, 1, 9, 3, 10, 5, 11, 7});
-      out_high = __builtin_shuffle(high, relaxed, Lanes8{12, 1, 13, 3, 14, 5, 15, 7});
-    } else {
-      out_low = __builtin_shuffle(low, relaxed, Lanes8{0, 8, 2, 9, 4, 10, 6, 11});
-      out_high = __builtin_shuffle(high, relaxed, Lanes8{0, 12, 2, 13, 4, 14, 6, 15});
-    }
+    const Doubles8 out_low = with_colour_cells<kFirst, 0>(low, relaxed);
+    const Doubles8 out_high = with_colour_cells<kFirst, 4>(high, relaxed);
     std::memcpy(row + at, &out_low, sizeof out_low);
     std::memcpy(row + at + 8, &out_high, sizeof out_high);
   }
 }
 
 /// One row of a half-sweep: relax_row_colour where the row is a multiple of
-/// 16 cells, else relax_row_whole.
+/// 16 cells and the build has AVX-512 (its shuffles are single instructions
+/// there; without it the gathers cost more than the arithmetic they save),
+/// else relax_row_whole. Either gives the same bits.
 template <int kB, bool kClosure>
 [[gnu::always_inline]] inline void relax_row(double* row, const double* f,
                                              const std::array<const double*, 4>& beside,
                                              const std::array<const double*, 2>& x_ghosts,
                                              int i_first, double beta, double inv_h2,
                                              const RowDiagonal& diagonal, double omega) {
+#if defined(__AVX512F__)
   if constexpr (kB % 16 == 0) {
-    relax_row_colour<kB, kClosure>(row, f, beside, x_ghosts, i_first, beta, inv_h2, diagonal,
-                                   omega);
-  } else {
-    relax_row_whole<kB, kClosure>(row, f, beside, x_ghosts, i_first, beta, inv_h2, diagonal, omega);
+    if (i_first == 0) {
+      relax_row_colour<kB, kClosure, 0>(row, f, beside, x_ghosts, beta, inv_h2, diagonal, omega);
+    } else {
+      relax_row_colour<kB, kClosure, 1>(row, f, beside, x_ghosts, beta, inv_h2, diagonal, omega);
+    }
+    return;
   }
+#endif
+  relax_row_whole<kB, kClosure>(row, f, beside, x_ghosts, i_first, beta, inv_h2, diagonal, omega);
 }
 
 /// The implicit parts and diagonals of the kB cells of row (j, k) beside a
-/// closed face (the other colour's are formed and dropped with its values).
+/// closed face (all kB: relax_row_whole forms the other colour's values too
+/// and drops them; relax_row_colour reads only the colour's).
 /// Out of line: the open rows' loop stays small.
 template <int kB>
 struct ClosureRow {
@@ -549,7 +576,9 @@ struct NextBlock {
 
 /// Prefetch row q (in (j, k) order) of `next`: the row's cells and its
 /// ghosts along x, x for writing (it is stored back), the right-hand side
-/// for reading, into the caches nearest the core.
+/// for reading, with low temporal locality (on x86 prefetcht2 for the
+/// right-hand side, prefetchw for x): the next block needs it within a block's
+/// work.
 [[gnu::always_inline]] inline void prefetch_row(const NextBlock& next, const BlockLayout& L,
                                                 int q) {
   if (next.x == nullptr) return;
@@ -573,7 +602,10 @@ struct NextBlock {
 bool prefetch_worthwhile(NextBlockPrefetch mode, const BlockField& x, const BlockField& rhs) {
   if (mode != NextBlockPrefetch::OutOfCache) return mode == NextBlockPrefetch::Always;
   static const double cache_bytes = [] {
-    const long reported = sysconf(_SC_LEVEL3_CACHE_SIZE);
+    long reported = 0;
+#ifdef _SC_LEVEL3_CACHE_SIZE  // glibc's; elsewhere the default below
+    reported = sysconf(_SC_LEVEL3_CACHE_SIZE);
+#endif
     return reported > 0 ? static_cast<double>(reported) : 32.0 * 1024 * 1024;
   }();
   const double bytes = sizeof(double) * (static_cast<double>(x.raw().size()) +
@@ -581,8 +613,9 @@ bool prefetch_worthwhile(NextBlockPrefetch mode, const BlockField& x, const Bloc
   return bytes > 0.5 * cache_bytes;
 }
 
-/// relax_constant with kB cells per edge, every row through relax_row_whole
-/// (docs/performance.md, "Whole rows in the smoother"). `closed`: the faces
+/// relax_constant with kB cells per edge, every row through relax_row
+/// (docs/performance.md, "Whole rows in the smoother" and "One colour per
+/// vector in the smoother"). `closed`: the faces
 /// of `faces` that close on the cells beside them; `diagonal_of(implicit)`:
 /// the diagonal with that implicit part.
 template <int kB, bool kAnyClosed, typename DiagonalOf>
