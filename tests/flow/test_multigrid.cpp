@@ -296,13 +296,14 @@ TEST(FlowMultigrid, KernelsReadingNeighboursInPlaceGiveTheSameBits) {
 }
 
 TEST(FlowMultigrid, WholeRowSmootherGivesTheSameBitsAtEveryBlockSize) {
-  // The constant-coefficient smoother relaxes rows of 4, 8, 16 and 32 cells
-  // as whole vectors (4 or 8 lanes, the other colour's lanes formed and
-  // dropped) and other sizes cell by cell; rows beside Dirichlet walls take
-  // their closure lane by lane. Blocks of 2 to 32 cells (so each finest
-  // level, and the in-block levels below it, take each path), walls of each
-  // kind on x and y (closed rows at the row ends and whole closed rows),
-  // periodic z: every variant must give the general kernels' bits.
+  // The constant-coefficient smoother relaxes rows of 4 and 8 cells as whole
+  // vectors (4 or 8 lanes, the other colour's lanes formed and dropped), rows
+  // of 16 and 32 cells with AVX-512 one colour per vector (the colour's 8 of
+  // each 16 cells gathered) and else as whole vectors, and other sizes cell
+  // by cell; rows beside Dirichlet walls take their closure lane by lane. Blocks of 2 to 32 cells
+  // (so each finest level, and the in-block levels below it, take each path), walls of each kind on
+  // x and y (closed rows at the row ends and whole closed rows), periodic z: every variant must
+  // give the general kernels' bits.
   for (const int b : {2, 4, 16, 32}) {
     for (const BcKind wall : {BcKind::Dirichlet, BcKind::Neumann}) {
       ForestSpec spec;
