@@ -497,8 +497,8 @@ template <int kB, bool kClosure, int kFirst>
 
 /// One row of a half-sweep: relax_row_colour where the row is a multiple of
 /// 16 cells and the build has AVX-512 (its shuffles are single instructions
-/// there; without it the gathers cost more than the arithmetic they save),
-/// else relax_row_whole. Either gives the same bits.
+/// there, and its gain was measured there only; AVX2 would split each into
+/// several), else relax_row_whole. Either gives the same bits.
 template <int kB, bool kClosure>
 [[gnu::always_inline]] inline void relax_row(double* row, const double* f,
                                              const std::array<const double*, 4>& beside,
