@@ -563,8 +563,8 @@ template <int kB, typename DiagonalOf>
   set(kB - 1, closure_implicit({kB - 1, j, k}, kB, faces, constant, constant));
 }
 
-/// The blocks a half-sweep relaxes next, whose rows relax_constant_rows
-/// asks the memory for while it works on the current block (null: none).
+/// The block a half-sweep relaxes next, whose rows relax_constant_rows asks
+/// the memory for while it works on the current block (null: none).
 /// Out of cache a block's x and right-hand side arrive row by row as the
 /// kernel first reads them, and the hardware's stream prefetchers start
 /// afresh at every 4 KB page of the block's rows (docs/performance.md,
@@ -596,9 +596,9 @@ struct NextBlock {
 /// Whether a half-sweep over x and rhs should prefetch the next block: when
 /// the two fields hold more than half the last-level cache (sysconf; 32 MiB
 /// where it does not tell), so the blocks come from memory. In cache the
-/// prefetches only add instructions (about 10 % of the smoother's time on
-/// the 64³ cavity; docs/performance.md, "Prefetching the next block in the
-/// smoother").
+/// prefetches only add instructions (forced on, 11-15 % of the smoother's
+/// time on the 64³ cavity; docs/performance.md, "Prefetching the next block
+/// in the smoother").
 bool prefetch_worthwhile(NextBlockPrefetch mode, const BlockField& x, const BlockField& rhs) {
   if (mode != NextBlockPrefetch::OutOfCache) return mode == NextBlockPrefetch::Always;
   static const double cache_bytes = [] {
