@@ -574,6 +574,11 @@ struct NextBlock {
   const double* rhs = nullptr;
 };
 
+/// Block `blk` of x and rhs as the next block, or none where blk < 0.
+inline NextBlock next_block(const BlockField& x, const BlockField& rhs, int blk) {
+  return blk >= 0 ? NextBlock{x.block(blk), rhs.block(blk)} : NextBlock{};
+}
+
 /// Prefetch row q (in (j, k) order) of `next`: the row's cells and its
 /// ghosts along x, x for writing (it is stored back), the right-hand side
 /// for reading, with low temporal locality (on x86 prefetcht2 for the
@@ -1290,10 +1295,8 @@ void Multigrid::relax_block(int level, int blk, BlockField& x, const BlockField&
   const AcrossFaces across =
       in_place ? same_level_neighbours(forest_, x, blk, bc ? bc->kind : kinds_) : AcrossFaces{};
   if (constant_kernels_ && lv.block_constant[at]) {
-    const NextBlock next =
-        next_blk >= 0 ? NextBlock{x.block(next_blk), rhs.block(next_blk)} : NextBlock{};
     relax_constant(xb, rb, L, first, lv.block_alpha[at], lv.block_beta[at], inv_h2, omega_, faces,
-                   across, next);
+                   across, next_block(x, rhs, next_blk));
     return;
   }
   // The general kernel, by rows, reading same-level neighbours as relax_constant does.
@@ -1329,6 +1332,11 @@ void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const Sc
   // read_neighbours_in_place it reads the same-level neighbours in place
   // instead of copying them (relax_constant and the general kernel alike).
   const bool fused = b % 2 == 0;
+  // The block each half-sweep takes next on this thread (the first colour
+  // runs forwards, the second backwards), or on the thread beside at the end
+  // of a share: its rows are prefetched meanwhile, when the fields do not fit
+  // in the cache (blocks 0: no prefetching).
+  const int blocks = prefetch_worthwhile(prefetch_, x, rhs) ? x.blocks() : 0;
   for (int sweep = 0; sweep < sweeps; ++sweep) {
     for (int colour = 0; colour < 2; ++colour) {
       if (fused) {
@@ -1336,11 +1344,6 @@ void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const Sc
       } else {
         fill_ghosts(level, x, bc, true);  // the 7-point stencil reads face ghosts only
       }
-      // The block each half-sweep takes next on this thread (the first
-      // colour runs forwards, the second backwards), or on the thread beside
-      // at the end of a share: its rows are prefetched meanwhile, when the
-      // fields do not fit in the cache.
-      const int blocks = prefetch_worthwhile(prefetch_, x, rhs) ? x.blocks() : 0;
       const auto relax = [&](int blk) {
         const bool in_place = fused && in_place_;
         if (fused) fill_block_ghosts(blk, x, bc, 1 - colour, in_place);
@@ -1391,8 +1394,7 @@ void Multigrid::compute_residual(int level, BlockField& x, const BlockField& rhs
     const AcrossFaces across =
         in_place ? same_level_neighbours(forest_, x, blk, bc ? bc->kind : kinds_) : AcrossFaces{};
     if (constant_kernels_ && lv.block_constant[at]) {
-      const NextBlock next =
-          blk + 1 < blocks ? NextBlock{x.block(blk + 1), rhs.block(blk + 1)} : NextBlock{};
+      const NextBlock next = next_block(x, rhs, blk + 1 < blocks ? blk + 1 : -1);
       block_squares_[at] = squares_wanted
                                ? residual_constant<true>(xb, fb, rb, L, lv.block_alpha[at],
                                                          lv.block_beta[at], inv_h2, across, next)
