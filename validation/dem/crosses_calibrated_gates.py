@@ -367,7 +367,10 @@ def main():
             "fitted on the 4 cm gate's run-out) tested on the wider gates of §3.2.1: the "
             "column poured with the gate in place as in crosses_dam_break, the gate removed "
             "at once, the collapse followed until the pile is at rest."),
-        "command": "/usr/bin/python3 validation/dem/crosses_calibrated_gates.py --build BUILD",
+        "command": "/usr/bin/python3 validation/dem/crosses_calibrated_gates.py --build BUILD"
+                   + ("" if args.gates == [8] else " --gates " + " ".join(map(str, args.gates)))
+                   + ("" if args.seeds == list(SEEDS)
+                      else " --seeds " + " ".join(map(str, args.seeds))),
         "figures": ["docs/validation/figures/crosses_calibrated_gates.png"],
         "checks": checks,
         "tables": [{"caption": "Per gate (`sanguis analyze`); wall times on the 2-core VM.",
