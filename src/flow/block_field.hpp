@@ -12,7 +12,13 @@
 #include <cstddef>
 #include <vector>
 
+#include "core/huge_page_allocator.hpp"
+
 namespace sanguis::flow {
+
+/// The values of a field: a flat array on huge pages where it is large
+/// (core/huge_page_allocator.hpp).
+using FieldStorage = std::vector<double, HugePageAllocator<double>>;
 
 /// Width of the ghost layer around every block (BCG advection needs two).
 inline constexpr int kGhost = 2;
@@ -83,13 +89,13 @@ class BlockField {
     blocks_ = blocks;
     data_.assign(static_cast<std::size_t>(blocks * layout_.size()), 0.0);
   }
-  [[nodiscard]] std::vector<double>& raw() { return data_; }
-  [[nodiscard]] const std::vector<double>& raw() const { return data_; }
+  [[nodiscard]] FieldStorage& raw() { return data_; }
+  [[nodiscard]] const FieldStorage& raw() const { return data_; }
 
  private:
   BlockLayout layout_{};
   int blocks_ = 0;
-  std::vector<double> data_;
+  FieldStorage data_;
 };
 
 /// Three cell-centred components (velocity, pressure gradient, ...).

@@ -240,7 +240,7 @@ TEST(FlowNavierStokes, OpenMpThreadsOverBlocksGiveTheSameResultBitForBit) {
     NavierStokes ns(forest, bcs, Fluid{1.0, 0.01});
     ns.set_velocity([](const Vec3&) { return Vec3{}; });
     for (int s = 0; s < 5; ++s) ns.step(0.02);
-    return std::array<std::vector<double>, 2>{ns.velocity()[0].raw(), ns.pressure().raw()};
+    return std::array<FieldStorage, 2>{ns.velocity()[0].raw(), ns.pressure().raw()};
   };
   const auto one = run(1), two = run(2);
   EXPECT_EQ(one[0], two[0]);
