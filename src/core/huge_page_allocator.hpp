@@ -1,17 +1,21 @@
 #pragma once
 // An allocator for large arrays that asks Linux for transparent huge pages (2 MiB) where
 // the system leaves them to the program (`/sys/kernel/mm/transparent_hugepage/enabled`
-// set to `madvise`, Debian's default). A sweep over fields of tens of megabytes touches
-// a new 4 KiB page every 512 doubles, and a kernel that reads the neighbours of a block
-// in place touches several pages at once; with 4 KiB pages their translations do not
-// fit the TLB (2048 entries cover 8 MiB), with 2 MiB pages they do. The advice is given
-// before the first touch (the container zero-fills after allocate), so the pages are
-// faulted in as huge pages. Small arrays (below kThreshold) come from the usual
-// allocator; where the advice is refused or unknown, the memory is the same as without
-// it. SANGUIS_HUGE_PAGES=0 in the environment withholds the advice (same alignment), for
-// comparisons. docs/performance.md, "Huge pages for the flow fields".
+// set to `madvise`, Debian's default). What it buys, measured: memory the process gets
+// fresh from the system is faulted in 2 MiB at a time instead of 4 KiB, so a regrid of
+// the adaptive flow, which grows fields and builds multigrid levels, spends about a
+// quarter less time (docs/performance.md, "Huge pages for the flow fields"); the
+// kernels themselves ran no faster (the address translations were not what held them).
+// Arrays from kThreshold on are aligned to 2 MiB and advised before the container
+// touches them. Limits: memory glibc hands back from its own heap (after a large block
+// is freed it raises its mmap threshold, up to 32 MiB) may have been touched already
+// and stays on small pages; with `defrag = madvise` a fault in advised memory may wait
+// for the kernel to compact memory; where the advice is refused or unknown (another
+// kernel, another system) the memory is the same as without it. SANGUIS_HUGE_PAGES=0 in
+// the environment withholds the advice (same alignment), for comparisons.
 #include <cstddef>
 #include <cstdlib>
+#include <limits>
 #include <memory>
 #include <new>
 #include <string_view>
@@ -44,6 +48,9 @@ struct HugePageAllocator {
   constexpr HugePageAllocator(const HugePageAllocator<U>& /*unused*/) noexcept {}
 
   [[nodiscard]] T* allocate(std::size_t n) {
+    if (n > std::numeric_limits<std::size_t>::max() / sizeof(T) - kHugePage) {
+      throw std::bad_array_new_length();
+    }
     const std::size_t bytes = n * sizeof(T);
     if (bytes < kThreshold) return std::allocator<T>{}.allocate(n);
     const std::size_t rounded = (bytes + kHugePage - 1) / kHugePage * kHugePage;

@@ -10,7 +10,7 @@ date of the run. Exits 1 if any script fails. `make validate-dem` calls it; on t
 report): the dam breaks of crosses (crosses_dam_break ~7 h, crosses_calibrated_gates
 ~5 h, crosses_recalibrated ~3 h), the hopper sweep (~75 min), the cross columns (memory
 pair with its pour ~7 min, tangential map ~14 min, three more pours ~15 min, the gate
-lifted or removed on them ~30 min), the
+lifted or removed on those pours ~11 min more), the
 friction calibration (~4 min), the run-out scaling (~3 min) and the settling runs
 (~4.5 min); `--quick` runs reduced
 variants where a script has one. `--only NAME` reruns one case.

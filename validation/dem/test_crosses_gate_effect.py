@@ -28,7 +28,8 @@ class Lift(unittest.TestCase):
         gate = case["obstacle"][ge.GATE_INDEX]
         self.assertEqual(gate["name"], "gate")
         self.assertEqual(gate["remove_at_s"], ge.GATE_TIME)
-        self.assertEqual(gate["max_m"][2], ge.DOMAIN_TOP)
+        self.assertEqual(gate["min_m"][2], 0.0)  # the lower edge that must clear the domain
+        self.assertEqual(gate["max_m"][0], ge.GATE_FACE_X)
         self.assertEqual(case["domain"]["max_m"][2], ge.DOMAIN_TOP)
         self.assertAlmostEqual(case["simulation"]["end_time_s"], ge.END_S, places=12)
 
