@@ -48,7 +48,8 @@ struct HugePageAllocator {
   constexpr HugePageAllocator(const HugePageAllocator<U>& /*unused*/) noexcept {}
 
   [[nodiscard]] T* allocate(std::size_t n) {
-    if (n > std::numeric_limits<std::size_t>::max() / sizeof(T) - kHugePage) {
+    // Room for the rounding up to whole huge pages below.
+    if (n > (std::numeric_limits<std::size_t>::max() - kHugePage) / sizeof(T)) {
       throw std::bad_array_new_length();
     }
     const std::size_t bytes = n * sizeof(T);
