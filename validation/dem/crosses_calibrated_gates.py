@@ -46,9 +46,10 @@ import matplotlib
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from _outputs import (continue_or_copy, paused_minutes, read_summary, regime_name, wall_time,  # noqa: E402
                       write_summary)
-from crosses_dam_break import (CROSSES, GATE_INDEX, RESULTS, ROOT, SEED,  # noqa: E402
-                               diagnostics, draw_velocity_bands, gate_runner, lajeunesse,
-                               pour_gate, velocity_curve)
+from crosses_dam_break import (COLLAPSE_S, CROSSES, GATE_INDEX, RESULTS, ROOT,  # noqa: E402
+                               SEED, at_rest_settings, diagnostics,
+                               draw_velocity_bands, gate_runner, lajeunesse, pour_gate,
+                               stopped, velocity_curve)
 from crosses_tangential_map import tangential_settings  # noqa: E402
 
 matplotlib.use("Agg")
@@ -62,8 +63,6 @@ KT, GAMMA_T = 1e2, 1.91e3
 # Its run at these values on the 4 cm gate (the point the exponent is taken against).
 CALIBRATION_RUN = os.path.join(RESULTS, "runs", "crosses_calibration", "calibrated")
 SPHERES_K = 1.2  # Lajeunesse et al. (2005), a below about 3
-COLLAPSE_MAX_S = 3.0
-AT_REST_AFTER_S = 1.5
 # The pours of the report: the case's seed, then one more.
 SEEDS = (SEED, 4)
 
@@ -115,27 +114,10 @@ def collapse(exe, gate, pour, out, opening, threads, tangential=(KT, GAMMA_T), s
     advance = gate_runner(exe, gate, out, threads,
                           extra=seed_settings(seed)
                           + (tangential_settings(*tangential) if tangential else [])
-                          + ["--set", "stop.mean_velocity_below_m_s=1e-3",
-                             "--set", f"stop.check_after_s={opening + AT_REST_AFTER_S}"])
-    advance(opening + COLLAPSE_MAX_S, ["--set", f"obstacle[{GATE_INDEX}].remove_at_s={opening}"])
+                          + at_rest_settings(opening))
+    advance(opening + COLLAPSE_S, ["--set", f"obstacle[{GATE_INDEX}].remove_at_s={opening}"])
     with open(os.path.join(out, "calibrated.txt"), "w") as f:
         f.write(completion_mark(tangential, opening) + "\n")
-
-
-def stopped(run, opening):
-    """When a collapse ended, in words (the at-rest test starts AT_REST_AFTER_S after the
-    opening, so an end there means at rest by then)."""
-    last = diagnostics(run)[-1]
-    after = last["time_s"] - opening
-    if after <= AT_REST_AFTER_S + 1e-6:
-        return f"was at rest at the first check, {AT_REST_AFTER_S:g} s after the opening"
-    if after >= COLLAPSE_MAX_S - 1e-6:
-        speed = last["mean_velocity_m_s"]
-        if speed >= 1e-3:
-            return (f"ran the full {COLLAPSE_MAX_S:g} s and was still moving (mean speed "
-                    f"{speed:.2g} m/s at the end, so its run-out is a lower bound)")
-        return f"ran the full {COLLAPSE_MAX_S:g} s"
-    return f"came to rest {after:.2f} s after the opening"
 
 
 def run_row(label, crosses, s, pour, collapse_s):
