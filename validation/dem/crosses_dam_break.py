@@ -388,8 +388,9 @@ def main():
         "thesis": "§3.2-3.3, Table 3.1, Fig. 3.7-3.9, Table B.1",
         "description": (
             "cases/dem/dam-break-crosses.toml: box 64 x 30 x 20 cm, Table 3.1 crosses poured "
-            "behind the gate, settled, gate removed at once, the collapse followed until at rest "
-            f"(tested from {AT_REST_AFTER_S:g} s after the opening) or for {COLLAPSE_S:g} s; gates "
+            "behind the gate, settled, gate removed at once, the collapse followed until at "
+            f"rest (tested from {AT_REST_AFTER_S:g} s after the opening) or for "
+            f"{COLLAPSE_S:g} s; gates "
             + ", ".join(f"{g} cm" for g in args.gates)
             + " of the five of §3.2.1"
             + (f" (the others: `--gates {' '.join(map(str, others))}`, hours each)" if others else "")

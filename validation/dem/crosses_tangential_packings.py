@@ -59,9 +59,12 @@ def run_two_at_a_time(jobs):
 
 
 def span(values, fmt):
-    """'a-b' for the smallest and largest of the values, or 'a' when they print alike."""
+    """'a-b' for the smallest and largest of the values ('a to b' when a is negative, which
+    a dash would garble), or 'a' when they print alike."""
     low, high = format(min(values), fmt), format(max(values), fmt)
-    return low if low == high else f"{low}-{high}"
+    if low == high:
+        return low
+    return f"{low} to {high}" if min(values) < 0 else f"{low}-{high}"
 
 
 def main():
