@@ -31,7 +31,7 @@ from the case's seed only.
 Writes validation/dem/results/crosses_calibrated_gates.json and
 docs/validation/figures/crosses_calibrated_gates.png. `--reuse`: analyse the runs on disk;
 `--without-table31`: leave out the Table 3.1 collapse (a reported comparison, no check).
-A pour stopped on the way is continued; a collapse stopped on the way is run again.
+A pour or a collapse stopped on the way is continued from its last checkpoint.
 Usage: /usr/bin/python3 validation/dem/crosses_calibrated_gates.py [--build build]
            [--gates 8 ...] [--seeds 3 ...] [--threads T] [--reuse] [--without-table31]
 """
