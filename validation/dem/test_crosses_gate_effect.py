@@ -44,5 +44,25 @@ class Lift(unittest.TestCase):
                          f"obstacle[{ge.GATE_INDEX}].remove_at_s={ge.GATE_TIME + ge.REMOVE_AFTER_S}")
 
 
+class Notes(unittest.TestCase):
+    """The notes' counts come from the runs: two packings, one lifted run peaking at the
+    first frame and one later."""
+    RESULTS = {(1, "at once"): {"height_loss": 0.02, "runout_ratio": 1.0, "peak_t": 1.5},
+               (1, "lifted"): {"height_loss": 0.07, "runout_ratio": 2.0, "peak_t": 0.37},
+               (2, "at once"): {"height_loss": 0.16, "runout_ratio": 4.3, "peak_t": 4.8},
+               (2, "lifted"): {"height_loss": 0.15, "runout_ratio": 4.6, "peak_t": 3.66}}
+
+    def test_packings_where_the_lift_adds(self):
+        self.assertEqual(ge.more_when_lifted(self.RESULTS, [1, 2], "height_loss"), 1)
+        self.assertEqual(ge.more_when_lifted(self.RESULTS, [1, 2], "runout_ratio"), 2)
+
+    def test_where_the_lifted_runs_peak(self):
+        both = ge.peak_sentence(self.RESULTS, [1, 2])
+        self.assertIn("first output frame after the opening (0.05 s, 0.37 τc) on seeds 1:", both)
+        self.assertIn("later on seeds 2, at 3.7 τc", both)
+        self.assertNotIn("later", ge.peak_sentence(self.RESULTS, [1]))
+        self.assertNotIn("first output frame", ge.peak_sentence(self.RESULTS, [2]))
+
+
 if __name__ == "__main__":
     unittest.main()
