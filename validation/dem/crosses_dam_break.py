@@ -330,15 +330,15 @@ def main():
         notes.append(f"Gate {gate} cm (a = {s['aspect_ratio_H0_over_L0']:.2f}): the pile's "
                      f"height fell by {100 * (1 - 1 / s['height_ratio_H0_over_Hinf']):.1f} % "
                      f"of H0 and {s['particles_touching_obstacles_fraction'] * 100:.0f} % of "
-                     "the crosses touched a wall at the opening; the mean speed peaked at "
+                     "the crosses touched a wall, the floor or the gate at the opening; the "
+                     "mean speed peaked at "
                      f"{100 * s['peak_mean_speed_over_sqrt_gH0']:.1f} % of √(g H0) at "
                      f"{s['peak_time_over_tau_c']:.1f} τc, against the thesis' 18-39 % (Fig. "
                      "3.9a, other boxes); the centre of mass moved "
                      f"{s['com_displacement_x_over_L0']:.3f} L0.")
     notes.append("The thesis' gate is lifted at 43 m/s², the gate here vanishes at once (as in "
                  "the thesis' own simulations of Fig. 3.7-3.9). crosses_gate_effect measures "
-                 "what the lift changes on the 300-cross column of the same parameters: more "
-                 "height lost and a longer run-out on every packing.")
+                 "what the lift changes, on the 300-cross column of the same parameters.")
     if 30 not in args.gates:
         notes.append(POINT_MODEL_30CM)
     paused = paused_minutes(RUNS)
