@@ -325,11 +325,9 @@ def main():
                      "(`done:` lines of run.log; a segment stopped and restarted is not counted), "
                      f"of which the collapse took {wall_time(out, opening) / 3600:.2f} h "
                      "(segments on the checkpoint grid, so a stopped one is run again whole)."
-                     + copied_from(out))
-    for gate, s, out in points:
-        notes.append(f"Gate {gate} cm (a = {s['aspect_ratio_H0_over_L0']:.2f}): the pile's "
-                     f"height fell by {100 * (1 - 1 / s['height_ratio_H0_over_Hinf']):.1f} % "
-                     f"of H0 and {s['particles_touching_obstacles_fraction'] * 100:.0f} % of "
+                     + copied_from(out)
+                     + " The pile's height fell by "
+                     f"{100 * (1 - 1 / s['height_ratio_H0_over_Hinf']):.1f} % of H0 and {s['particles_touching_obstacles_fraction'] * 100:.0f} % of "
                      "the crosses touched a wall, the floor or the gate at the opening; the "
                      "mean speed peaked at "
                      f"{100 * s['peak_mean_speed_over_sqrt_gH0']:.1f} % of √(g H0) at "
