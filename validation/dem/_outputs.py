@@ -63,6 +63,15 @@ def regime_name(summary):
     return ("stable", "fractured", "collapsed")[int(summary["regime"])]
 
 
+def speed_landmarks(t, v, line=0.05):
+    """Of a mean-speed curve (t / tau_c, speed / sqrt(g H0)): the peak, its time and the
+    first time after it that the speed is below `line` (inf if never): the three figures
+    the thesis gives for each curve of Fig. 3.9a."""
+    peak = max(range(len(v)), key=lambda i: v[i])
+    below = next((t[i] for i in range(peak, len(v)) if v[i] < line), float("inf"))
+    return v[peak], t[peak], below
+
+
 def read_summary(run_dir):
     """The one row of RUN/analysis/summary.csv (written by `sanguis analyze`) as floats."""
     with open(os.path.join(run_dir, "analysis", "summary.csv"), newline="") as f:

@@ -47,7 +47,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from _outputs import (continue_or_copy, paused_minutes, read_summary, regime_name, wall_time,  # noqa: E402
                       write_summary)
 from crosses_dam_break import (COLLAPSE_S, CROSSES, GATE_INDEX, RESULTS, ROOT,  # noqa: E402
-                               SEED, at_rest_settings, diagnostics,
+                               SEED, at_rest_settings, column, diagnostics,
                                draw_velocity_bands, gate_runner, lajeunesse, pour_gate,
                                stopped, velocity_curve)
 from crosses_tangential_map import tangential_settings  # noqa: E402
@@ -103,18 +103,20 @@ def finished(out, tangential, opening):
                                                                                   opening)
 
 
-def collapse(exe, gate, pour, out, opening, threads, tangential=(KT, GAMMA_T), seed=SEED):
-    """The collapse from the pour's state with the tangential (kt, gamma_t) given (None:
-    the case's Table 3.1), stopped at rest. A collapse stopped on the way (a killed call,
-    an ended session) goes on from its checkpoint when its start record shows the same
-    settings; otherwise the folder is made again from the pour."""
+def collapse(exe, col, pour, out, opening, threads, tangential=(KT, GAMMA_T), seed=SEED,
+             extra=()):
+    """The collapse of the column `col` from the pour's state with the tangential (kt,
+    gamma_t) given (None: the case's Table 3.1), stopped at rest; `extra`: more
+    overrides. A collapse stopped on the way (a killed call, an ended session) goes on from
+    its checkpoint when its start record shows the same settings; otherwise the folder is
+    made again from the pour."""
     if finished(out, tangential, opening):
         return
     continue_or_copy(out, pour, completion_mark(tangential, opening))
-    advance = gate_runner(exe, gate, out, threads,
+    advance = gate_runner(exe, col, out, threads,
                           extra=seed_settings(seed)
                           + (tangential_settings(*tangential) if tangential else [])
-                          + at_rest_settings(opening))
+                          + at_rest_settings(opening) + list(extra))
     advance(opening + COLLAPSE_S, ["--set", f"obstacle[{GATE_INDEX}].remove_at_s={opening}"])
     with open(os.path.join(out, "calibrated.txt"), "w") as f:
         f.write(completion_mark(tangential, opening) + "\n")
@@ -137,10 +139,10 @@ def run_gate_seed(exe, gate, seed, threads, reuse, table31_wanted=True):
     pour, out, table31 = folders(gate, seed)
     table31 = table31 if table31_wanted else None
     if not reuse:
-        opening = pour_gate(exe, gate, pour, threads, extra=seed_settings(seed))
-        collapse(exe, gate, pour, out, opening, threads, seed=seed)
+        opening = pour_gate(exe, column(gate), pour, threads, extra=seed_settings(seed))
+        collapse(exe, column(gate), pour, out, opening, threads, seed=seed)
         if table31:
-            collapse(exe, gate, pour, table31, opening, threads, tangential=None)
+            collapse(exe, column(gate), pour, table31, opening, threads, tangential=None)
     opening = diagnostics(pour)[-1]["time_s"]
     for run, tangential in ((out, (KT, GAMMA_T)), (table31, None)):
         if run and not finished(run, tangential, opening):

@@ -43,6 +43,7 @@ import re
 import subprocess
 import sys
 import time
+from typing import NamedTuple
 
 import matplotlib
 
@@ -61,6 +62,7 @@ FIGURE = os.path.join(ROOT, "docs", "validation", "figures", "crosses_dam_break.
 # gate position [cm] -> crosses (§3.2.3: 1300 to 7000); the column is about 16-21 cm tall
 CROSSES = {4: 1300, 8: 2000, 12: 3000, 20: 5000, 30: 7000}
 GATE_INDEX = 5    # [[obstacle]] number of the gate in the case
+SIDE_WALL_INDEX = 4  # [[obstacle]] number of the back side wall (y = 0.20 m)
 SETTLE_S = 1.5    # first check after the last cross is due (the 4 cm column was at rest 0.5 s after)
 COLLAPSE_S = 3.0  # §3.2: 3 s after the opening, at most
 # The collapse stops once at rest (mean speed below 1 mm/s), tested from this long after
@@ -87,22 +89,43 @@ POINT_MODEL_30CM = (
     "(L∞−L0)/L0 = 2.93 against Lajeunesse's 5.88.")
 
 
-def pour_rate(gate_cm):
+class Column(NamedTuple):
+    """A column poured behind the gate: the gate's position [cm], the crosses, the box's
+    depth [m] (the back side wall; the case's box is 20 cm deep) and the bottom of the pour
+    region [m] (the case's 0.28, above the tallest column of the five gates)."""
+    gate_cm: float
+    count: int
+    depth_m: float = 0.20
+    pour_bottom_m: float = 0.28
+
+
+def column(gate_cm):
+    """One of the five columns of §3.2.1 in the case's box."""
+    return Column(gate_cm, CROSSES[gate_cm])
+
+
+def pour_rate(col):
     """Crosses per second asked of the pour (the region's free room grows with its
-    length; pour_gate waits for the pour to end whatever rate is reached)."""
-    return 150.0 * gate_cm
+    length and depth; pour_gate waits for the pour to end whatever rate is reached)."""
+    return 150.0 * col.gate_cm * col.depth_m / 0.20
 
 
-def overrides(gate_cm):
-    """The gate's position, the pour and its region; the gate stays until released."""
-    l0 = gate_cm / 100.0
-    rate = pour_rate(gate_cm)
-    return [f"obstacle[{GATE_INDEX}].min_m=[{l0}, -0.01, 0.0]",
-            f"obstacle[{GATE_INDEX}].max_m=[{l0 + 0.005:.4f}, 0.21, 0.72]",
-            f"obstacle[{GATE_INDEX}].remove_at_s=1e6",
-            f"particles[0].count={CROSSES[gate_cm]}",
-            f"particles[0].rate_per_s={rate}",
-            f"particles[0].region_max_m=[{l0}, 0.20, 0.72]"]
+def overrides(col):
+    """The gate's position, the pour and its region; the gate stays until released. The
+    box's depth and the region's bottom are set only where they differ from the case's."""
+    l0 = round(col.gate_cm / 100.0, 6)
+    rate = pour_rate(col)
+    settings = [f"obstacle[{GATE_INDEX}].min_m=[{l0}, -0.01, 0.0]",
+                f"obstacle[{GATE_INDEX}].max_m=[{l0 + 0.005:.4f}, 0.21, 0.72]",
+                f"obstacle[{GATE_INDEX}].remove_at_s=1e6",
+                f"particles[0].count={col.count}",
+                f"particles[0].rate_per_s={rate}",
+                f"particles[0].region_max_m=[{l0}, {col.depth_m:.2f}, 0.72]"]
+    if col.depth_m != 0.20:
+        settings.append(f"obstacle[{SIDE_WALL_INDEX}].point_m=[0.0, {col.depth_m}, 0.0]")
+    if col.pour_bottom_m != 0.28:
+        settings.append(f"particles[0].region_min_m=[0.0, 0.0, {col.pour_bottom_m}]")
+    return settings
 
 
 def poured_and_at_rest(run, count):
@@ -122,12 +145,12 @@ def wait_while(hold_file):
             time.sleep(5)
 
 
-def gate_runner(exe, gate, out, threads, hold_file=None, extra=()):
-    """advance(end, more): runs the gate's case in `out` up to `end` (continued from its
-    checkpoint when there is one), with the gate's overrides, `extra` and `more`."""
+def gate_runner(exe, col, out, threads, hold_file=None, extra=()):
+    """advance(end, more): runs the column's case in `out` up to `end` (continued from
+    its checkpoint when there is one), with the column's overrides, `extra` and `more`."""
     base = [exe, "run", CASE, "--output", out, "--quiet", "--threads", str(threads),
             "--set", f"output.checkpoint_interval_s={CHECKPOINT_S}"]
-    for o in overrides(gate):
+    for o in overrides(col):
         base += ["--set", o]
     base += list(extra)
     checkpoint = os.path.join(out, "checkpoint.bin")
@@ -141,22 +164,22 @@ def gate_runner(exe, gate, out, threads, hold_file=None, extra=()):
     return advance
 
 
-def pour_gate(exe, gate, out, threads, hold_file=None, extra=()):
+def pour_gate(exe, col, out, threads, hold_file=None, extra=()):
     """Pour and settle with the gate in place, extending by 0.5 s until every cross is in
     and at rest (the pour rate is bounded by the free room of the region). A folder with
     a checkpoint of a pour stopped on the way is continued; `extra` are more overrides
     (another seed). Returns the time reached, when the gate can go."""
-    advance = gate_runner(exe, gate, out, threads, hold_file, extra)
+    advance = gate_runner(exe, col, out, threads, hold_file, extra)
     checkpoint = os.path.join(out, "checkpoint.bin")
-    t = math.ceil(10 * (CROSSES[gate] / pour_rate(gate) + SETTLE_S)) / 10
+    t = math.ceil(10 * (col.count / pour_rate(col) + SETTLE_S)) / 10
     reached = diagnostics(out)[-1]["time_s"] if os.path.exists(checkpoint) else 0.0
     if reached > t + 1e-9:  # stopped in an extension of the pour: on the 0.5 s grid beyond t
         t = round(t + 0.5 * math.ceil((reached - t) / 0.5 - 1e-9), 1)
     if reached < t - 1e-9:  # a fresh run, or stopped in the pour: go on to t
         advance(t)
-    while not poured_and_at_rest(out, CROSSES[gate]):
+    while not poured_and_at_rest(out, col.count):
         if t > 20.0:
-            sys.exit(f"gate {gate} cm: the pour has not come to rest by {t} s")
+            sys.exit(f"gate {col.gate_cm:g} cm: the pour has not come to rest by {t} s")
         t = round(t + 0.5, 1)
         advance(t)
     return t
@@ -195,7 +218,7 @@ def run_gate(exe, gate, out, threads, hold_file=None):
     """pour_gate, then remove the gate and follow the collapse until at rest (at most
     COLLAPSE_S). A folder with a checkpoint (a run stopped on the way) is continued from
     it. Returns the opening time."""
-    advance = gate_runner(exe, gate, out, threads, hold_file)
+    advance = gate_runner(exe, column(gate), out, threads, hold_file)
     checkpoint = os.path.join(out, "checkpoint.bin")
 
     def collapse(t):
@@ -213,7 +236,7 @@ def run_gate(exe, gate, out, threads, hold_file=None):
     if os.path.exists(checkpoint) and opening_time(out) < 1e5:  # stopped in the collapse
         t = opening_time(out)
     else:
-        t = pour_gate(exe, gate, out, threads, hold_file)
+        t = pour_gate(exe, column(gate), out, threads, hold_file)
     collapse(t)
     return t
 

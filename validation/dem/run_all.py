@@ -6,9 +6,9 @@ another, then reads the JSON summary each writes to validation/dem/results/NAME.
 and writes docs/validation/dem.md: per case its figures, the measured numbers next to
 the thesis' numbers with the tolerance and PASS/FAIL, the run time, and the hardware and
 date of the run. Exits 1 if any script fails. `make validate-dem` calls it; on the
-2-core development machine it takes about 17 hours (run times of the last runs, in the
+2-core development machine it takes about a day (run times of the last runs, in the
 report): the dam breaks of crosses (crosses_dam_break ~7 h, crosses_calibrated_gates
-~5 h, crosses_recalibrated ~3 h), the hopper sweep (~75 min), the cross columns (memory
+~5 h, crosses_recalibrated ~3 h, crosses_column_width several hours), the hopper sweep (~75 min), the cross columns (memory
 pair with its pour ~7 min, tangential map ~14 min, three more pours ~15 min, the gate
 lifted or removed on those pours ~11 min more), the
 friction calibration (~4 min), the run-out scaling (~3 min) and the settling runs

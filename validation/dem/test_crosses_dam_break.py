@@ -3,6 +3,7 @@ ValidationScripts.DemHelpers)."""
 import os
 import sys
 import tempfile
+import tomllib
 import unittest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -49,6 +50,34 @@ class EndOfCollapse(unittest.TestCase):
             self.assertIn("came to rest 2.00 s", db.stopped(d, opening))
             fake_run(d, [], [(3.2, 0.0), (opening + db.COLLAPSE_S, 5e-3)])
             self.assertIn("still moving", db.stopped(d, opening))
+
+
+class Columns(unittest.TestCase):
+    def test_the_experiments_columns_set_no_depth_nor_pour_bottom(self):
+        settings = db.overrides(db.column(8))
+        self.assertEqual(settings, ["obstacle[5].min_m=[0.08, -0.01, 0.0]",
+                                    "obstacle[5].max_m=[0.0850, 0.21, 0.72]",
+                                    "obstacle[5].remove_at_s=1e6",
+                                    "particles[0].count=2000",
+                                    "particles[0].rate_per_s=1200.0",
+                                    "particles[0].region_max_m=[0.08, 0.20, 0.72]"])
+
+    def test_the_indices_and_defaults_are_the_cases(self):
+        with open(db.CASE, "rb") as f:
+            case = tomllib.load(f)
+        self.assertEqual(case["obstacle"][db.GATE_INDEX]["name"], "gate")
+        wall = case["obstacle"][db.SIDE_WALL_INDEX]
+        self.assertEqual((wall["name"], wall["point_m"][1]), ("side wall, back", 0.20))
+        self.assertEqual(case["particles"][0]["region_min_m"][2], db.Column(4, 1).pour_bottom_m)
+        self.assertEqual(case["domain"]["max_m"][1], db.Column(4, 1).depth_m)
+
+    def test_another_depth_moves_the_side_wall_and_the_pour(self):
+        settings = db.overrides(db.Column(5.2, 1000, 0.15, 0.33))
+        self.assertIn("obstacle[5].min_m=[0.052, -0.01, 0.0]", settings)
+        self.assertIn("particles[0].region_max_m=[0.052, 0.15, 0.72]", settings)
+        self.assertIn(f"obstacle[{db.SIDE_WALL_INDEX}].point_m=[0.0, 0.15, 0.0]", settings)
+        self.assertIn("particles[0].region_min_m=[0.0, 0.0, 0.33]", settings)
+        self.assertAlmostEqual(db.pour_rate(db.Column(4, 1300, 0.15)), 0.75 * 600.0)
 
 
 if __name__ == "__main__":

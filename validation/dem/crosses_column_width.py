@@ -1,0 +1,330 @@
+#!/usr/bin/python3
+"""Narrow and wide columns of crosses at a = 3.2: the collapse of thesis Fig. 3.9 (§3.3.2).
+
+The thesis compares the mean speed of collapsing columns of aspect ratio a = H0/L0 = 3.2:
+spheres (3200 and 15000; dam_break_scaling checks them) and crosses, a small system of
+1000 and a large one of 3000, three packings each. Its small columns of crosses are
+"narrow enough - less than the size of two particles - for the whole column to bend
+forward" and peak at 34-39 % of sqrt(g H0), "delayed by two to four" tau_c against the
+spheres' peak at tau_c; its large ones, "of width greater than the size of three
+particles", do not bend: they peak at 18-22 % near 2.5 tau_c and fall below 5 % at about
+10 tau_c, where the spheres (and, two to four tau_c later, the small crosses) do at 4 tau_c.
+
+The box. The thesis gives neither box; the width it names is the column's length L0 along
+the flow (its Fig. 3.9b-c). This case keeps the experiments' box of crosses_dam_break
+(cases/dem/dam-break-crosses.toml) with the back side wall moved to a depth of 15 cm, the
+one choice that meets both statements at a = 3.2: with the bulk volume of a poured cross
+in this box (1.29 cm^3: the 4 cm gate's 3.9 x 21.5 x 20 cm over 1300 crosses), 1000
+crosses stand 5.2 cm long (under two cross lengths, 5.4 cm) and 3000 crosses 9.0 cm (over
+three, 8.1 cm); a 20 cm box would give 4.5 and 7.8 cm, the latter under three lengths,
+and any depth from 13.6 to 18.1 cm meets both. The gate goes at the L0 of that estimate;
+the measured a of each pour is reported.
+
+The parameters. With Table 3.1 the crosses of this model stand at a = 1.9-5.5
+(crosses_dam_break: K = 0.25-0.34, peak speeds 0.5-2 % of sqrt(g H0)), so this case runs
+the collapse with the calibration of crosses_recalibrated (kt 1e2 N/m, gamma_t 1.91e3 1/s,
+fitted to the 4 cm gate's run-out) from packings poured with Table 3.1, as
+crosses_calibrated_gates does: the test is whether the crosses fitted to one run-out also
+move as the thesis' crosses move. Each pour (seeds 1-3) is followed with the gate removed
+at once until at rest (mean speed below 1 mm/s, checked from 1.5 s after the opening) or
+for 3 s, with frames every 0.02 s (0.12-0.15 tau_c).
+
+Checks (tolerances fixed before running, those of dam_break_scaling's sphere column: the
+peak within 20 % of the thesis' range, its time within 0.5 tau_c of it, the 5 % crossing
+within 1 tau_c of it), for each of the six runs:
+- small (1000): peak in [0.272, 0.468]; its time in [2.5, 5.5] tau_c (thesis 3-5: the
+  spheres' tau_c delayed by 2-4); below 5 % from [5, 9] tau_c (the spheres' 4, delayed);
+- large (3000): peak in [0.144, 0.264]; its time in [2.0, 3.0] tau_c; below 5 % from
+  [9, 11] tau_c;
+and, over the three packings of each size, the thesis' contrast: the large columns' mean
+peak lower, their mean 5 % crossing later, and at t = 3 tau_c their highest point nearer
+the back wall (x of the five highest crosses over L0) than the small columns'.
+
+Writes validation/dem/results/crosses_column_width.json and
+docs/validation/figures/crosses_column_width.png. The runs go two at a time, one thread
+each (hours: a pour and a collapse of 1000 crosses about 2 h, of 3000 crosses several);
+a run stopped on the way is continued from its checkpoint by the same command, so the
+six runs may span several sessions. `--sizes small` runs and reports the small columns
+only; `--reuse` analyses the finished runs on disk.
+Usage: /usr/bin/python3 validation/dem/crosses_column_width.py [--build build]
+           [--sizes small large] [--seeds 1 2 3] [--reuse]
+"""
+import argparse
+import math
+import os
+import subprocess
+import sys
+from concurrent.futures import ThreadPoolExecutor
+
+import matplotlib
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from _outputs import (paused_minutes, read_arrays, read_pvd, read_summary,  # noqa: E402
+                      regime_name, speed_landmarks, two_at_a_time_span, wall_time,
+                      write_summary)
+from crosses_calibrated_gates import (GAMMA_T, KT, collapse, finished,  # noqa: E402
+                                      seed_settings)
+from crosses_dam_break import (RESULTS, ROOT, Column, diagnostics, draw_velocity_bands,  # noqa: E402
+                               pour_gate, stopped, velocity_curve)
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+RUNS = os.path.join(RESULTS, "runs", "crosses_column_width")
+FIGURE = os.path.join(ROOT, "docs", "validation", "figures", "crosses_column_width.png")
+SPHERES = os.path.join(RESULTS, "runs", "dam_break_scaling", "L0_4.1cm")  # Fig. 3.9 spheres
+
+ASPECT = 3.2             # Fig. 3.9
+DEPTH_M = 0.15           # the back side wall (see the module's docstring)
+CROSS_VOLUME_M3 = 1.29e-6  # bulk volume of a poured cross, the 4 cm gate of crosses_dam_break
+CROSS_LENGTH_M = 0.027   # Table 3.1
+FRAME_S = 0.02           # frames during the collapse
+SEEDS = (1, 2, 3)
+G = 9.81
+
+
+class Size:
+    """One system of Fig. 3.9a: the crosses and the thesis' figures for its mean speed."""
+
+    def __init__(self, name, count, peak, peak_time, rest_time):
+        self.name, self.count = name, count
+        self.peak, self.peak_time, self.rest_time = peak, peak_time, rest_time
+
+    def column(self):
+        """The column in the 15 cm deep box: gate at the L0 of a = 3.2, pour region above
+        the estimated H0."""
+        l0 = math.sqrt(self.count * CROSS_VOLUME_M3 / (DEPTH_M * ASPECT))
+        return Column(round(100 * l0, 1), self.count, DEPTH_M,
+                      max(0.28, round(ASPECT * l0 + 0.04, 2)))
+
+    def checks(self, label, peak, peak_t, below):
+        """The three checks of one run (tolerances in the module's docstring)."""
+        lo, hi = 0.8 * self.peak[0], 1.2 * self.peak[1]
+        t_lo, t_hi = self.peak_time[0] - 0.5, self.peak_time[1] + 0.5
+        r_lo, r_hi = self.rest_time[0] - 1.0, self.rest_time[1] + 1.0
+        return [
+            {"quantity": f"{label}: peak mean speed / √(g H0)", "measured": round(peak, 3),
+             "thesis": span(self.peak), "tolerance": f"[{lo:.3g}, {hi:.3g}] (±20 %)",
+             "pass": lo <= peak <= hi},
+            {"quantity": f"{label}: time of the peak / τc", "measured": round(peak_t, 2),
+             "thesis": span(self.peak_time), "tolerance": f"[{t_lo:g}, {t_hi:g}]",
+             "pass": t_lo <= peak_t <= t_hi},
+            {"quantity": f"{label}: speed below 5 % from t / τc",
+             "measured": round(below, 2) if math.isfinite(below) else "never",
+             "thesis": span(self.rest_time), "tolerance": f"[{r_lo:g}, {r_hi:g}]",
+             "pass": r_lo <= below <= r_hi}]
+
+
+def span(pair):
+    return f"{pair[0]:g}" if pair[0] == pair[1] else f"{pair[0]:g}-{pair[1]:g}"
+
+
+# Fig. 3.9a (§3.3.2): the small crosses follow the spheres (peak at tau_c, 5 % at 4 tau_c)
+# two to four tau_c late.
+SIZES = {"small": Size("small", 1000, (0.34, 0.39), (3.0, 5.0), (6.0, 8.0)),
+         "large": Size("large", 3000, (0.18, 0.22), (2.5, 2.5), (10.0, 10.0))}
+
+
+def folders(size, seed):
+    """The pour and the calibrated collapse of one size and seed."""
+    tag = f"{size}_seed{seed}"
+    return (os.path.join(RUNS, f"{tag}_pour"),
+            os.path.join(RUNS, f"{tag}_kt{KT:g}_gamma{GAMMA_T:g}"))
+
+
+def run_one(exe, size, seed):
+    """Pour (Table 3.1, gate in place, at rest), then the calibrated collapse; one thread.
+    Either goes on from its checkpoint when stopped on the way."""
+    col = SIZES[size].column()
+    pour, out = folders(size, seed)
+    opening = pour_gate(exe, col, pour, 1, extra=seed_settings(seed))
+    collapse(exe, col, pour, out, opening, 1, seed=seed,
+             extra=["--set", f"output.interval_s={FRAME_S}"])
+
+
+def highest_point(run, opening, h0, l0, count=5):
+    """At t = 3 tau_c after the opening (the frame nearest it): the mean x of the `count`
+    highest crosses over L0 (0: the back wall, 1: the gate's face), as Fig. 3.9b-c
+    locate the top of the column."""
+    tau_c = math.sqrt(h0 / G)
+    frames = read_pvd(os.path.join(run, "particles.pvd"))
+    time_s, path = min(frames, key=lambda f: abs(f[0] - (opening + 3 * tau_c)))
+    points = read_arrays(path)["Points"]
+    top = np.argsort(points[:, 2])[-count:]
+    return float(points[top, 0].mean() / l0), (time_s - opening) / tau_c
+
+
+def measure(exe, size, seed):
+    """The analysed figures of one finished run."""
+    pour, out = folders(size, seed)
+    opening = diagnostics(pour)[-1]["time_s"]
+    if not finished(out, (KT, GAMMA_T), opening):
+        sys.exit(f"{out}: not finished; run without --reuse to finish it")
+    subprocess.run([exe, "analyze", out], check=True, stdout=subprocess.DEVNULL)
+    s = read_summary(out)
+    t, v = velocity_curve(out)
+    peak, peak_t, below = speed_landmarks(t, v)
+    x_top, at = highest_point(out, opening, s["H0_m"], s["L0_m"])
+    return {"summary": s, "curve": (t, v), "peak": peak, "peak_t": peak_t, "below": below,
+            "x_top": x_top, "x_top_at": at, "opening": opening, "pour_s": wall_time(pour),
+            "collapse_s": wall_time(out, opening), "stopped": stopped(out, opening),
+            "mean_speed_at_opening": diagnostics(pour)[-1]["mean_velocity_m_s"]}
+
+
+def contrast_checks(results, seeds):
+    """The thesis' contrast between the sizes, on the means over the packings."""
+    def mean(size, key):
+        values = [results[(size, x)][key] for x in seeds]
+        return sum(values) / len(values)
+
+    small = {k: mean("small", k) for k in ("peak", "below", "x_top")}
+    large = {k: mean("large", k) for k in ("peak", "below", "x_top")}
+    return [
+        {"quantity": "mean peak speed, large columns against small", "measured":
+         f"{large['peak']:.3f} against {small['peak']:.3f}",
+         "thesis": "lower (18-22 % against 34-39 %)", "tolerance": "large < small",
+         "pass": large["peak"] < small["peak"]},
+        {"quantity": "mean time below 5 % / τc, large columns against small", "measured":
+         f"{large['below']:.2f} against {small['below']:.2f}",
+         "thesis": "later (≈ 10 against 6-8)", "tolerance": "large > small",
+         "pass": large["below"] > small["below"]},
+        {"quantity": "highest point at 3 τc, x / L0 (0: back wall), large columns against small",
+         "measured": f"{large['x_top']:.2f} against {small['x_top']:.2f}",
+         "thesis": "near the back wall against near the gate (Fig. 3.9b-c)",
+         "tolerance": "large < small", "pass": large["x_top"] < small["x_top"]}]
+
+
+def sphere_curves():
+    """The Fig. 3.9 sphere column of dam_break_scaling (a = 3.2), if its runs are here."""
+    curves = []
+    for k in range(1, 4):
+        path = os.path.join(SPHERES, f"seed_{k}")
+        if os.path.exists(os.path.join(path, "analysis", "velocity.csv")):
+            curves.append(velocity_curve(path))
+    return curves
+
+
+def snapshot(ax, size, seed, result):
+    """Side view (x, z) of a run at the frame nearest 3 tau_c, coloured by speed."""
+    _, out = folders(size, seed)
+    s = result["summary"]
+    tau_c = math.sqrt(s["H0_m"] / G)
+    frames = read_pvd(os.path.join(out, "particles.pvd"))
+    _, path = min(frames, key=lambda f: abs(f[0] - (result["opening"] + 3 * tau_c)))
+    arrays = read_arrays(path)
+    speed = np.linalg.norm(arrays["velocity"], axis=1)
+    p = arrays["Points"]
+    ax.scatter(100 * p[:, 0], 100 * p[:, 2], c=speed, s=4, cmap="jet")
+    ax.axvline(100 * s["L0_m"], color="k", lw=0.8, ls=":")
+    ax.set_aspect("equal")
+    ax.set_xlim(0, 100 * max(4 * s["L0_m"], s["Linf_m"] + 0.02))
+    ax.set_ylim(0, 100 * 1.1 * s["H0_m"])
+    ax.set_xlabel("x [cm]")
+    ax.set_ylabel("z [cm]")
+    ax.set_title(f"{size}, seed {seed}, t = {result['x_top_at']:.1f} τc "
+                 f"(top at x = {result['x_top']:.2f} L0)", fontsize=8)
+
+
+def draw(results, sizes, seeds):
+    fig = plt.figure(figsize=(12, 4.4))
+    ax = fig.add_subplot(1, 2, 1)
+    for k, (t, v) in enumerate(sphere_curves()):
+        ax.plot(t, v, color="0.6", lw=0.8, label="spheres, a = 3.2 (dam_break_scaling)"
+                if k == 0 else None)
+    colours = {"small": "tab:blue", "large": "tab:red"}
+    styles = ["-", "--", ":"]
+    for size in sizes:
+        for k, seed in enumerate(seeds):
+            t, v = results[(size, seed)]["curve"]
+            ax.plot(t, v, color=colours[size], ls=styles[k % 3],
+                    label=f"{SIZES[size].count} crosses, seed {seed}")
+    draw_velocity_bands(ax)
+    ax.set_xlim(0, 16)
+    ax.set_title(f"a = {ASPECT}, kt {KT:g} N/m, γt {GAMMA_T:g} 1/s", fontsize=9)
+    for k, size in enumerate(sizes):
+        snapshot(fig.add_subplot(2, 2, 2 * (k + 1)), size, seeds[0], results[(size, seeds[0])])
+    fig.tight_layout()
+    os.makedirs(os.path.dirname(FIGURE), exist_ok=True)
+    fig.savefig(FIGURE, dpi=130)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--build", default="build")
+    ap.add_argument("--sizes", nargs="+", default=list(SIZES), choices=list(SIZES))
+    ap.add_argument("--seeds", type=int, nargs="+", default=list(SEEDS))
+    ap.add_argument("--reuse", action="store_true", help="analyse the finished runs on disk")
+    args = ap.parse_args()
+    if len(set(args.seeds)) != len(args.seeds) or min(args.seeds) < 0:
+        ap.error("--seeds: distinct non-negative integers")
+    exe = os.path.join(ROOT, args.build, "app", "sanguis")
+    keys = [(size, seed) for size in args.sizes for seed in args.seeds]
+    if not args.reuse:
+        with ThreadPoolExecutor(max_workers=2) as pool:
+            for job in [pool.submit(run_one, exe, size, seed) for size, seed in keys]:
+                job.result()
+    results = {key: measure(exe, *key) for key in keys}
+
+    checks, rows, notes = [], [], []
+    for (size, seed), r in results.items():
+        s = r["summary"]
+        label = f"{SIZES[size].count} crosses, seed {seed}"
+        checks += SIZES[size].checks(label, r["peak"], r["peak_t"], r["below"])
+        checks.append({"quantity": f"sanity, {label}: mean speed at the opening [m/s]",
+                       "measured": f"{r['mean_speed_at_opening']:.2g}", "thesis": "—",
+                       "tolerance": "< 1e-3", "pass": r["mean_speed_at_opening"] < 1e-3})
+        rows.append([label, f"{100 * s['L0_m']:.1f}", f"{100 * s['L0_m'] / (100 * CROSS_LENGTH_M):.2f}",
+                     f"{100 * s['H0_m']:.1f}", f"{s['aspect_ratio_H0_over_L0']:.2f}",
+                     f"{r['peak']:.3f}", f"{r['peak_t']:.1f}",
+                     f"{r['below']:.1f}" if math.isfinite(r["below"]) else "never",
+                     f"{r['x_top']:.2f}", f"{s['runout_ratio']:.2f}", regime_name(s),
+                     f"{r['pour_s'] / 3600:.2f}", f"{r['collapse_s'] / 3600:.2f}"])
+        notes.append(f"{label.capitalize()}: poured with Table 3.1 and at rest at "
+                     f"{r['opening']:g} s; the collapse {r['stopped']}.")
+    if set(args.sizes) == set(SIZES):
+        checks += contrast_checks(results, args.seeds)
+    notes.append("The thesis' sphere curves of Fig. 3.9a are checked by dam_break_scaling "
+                 "(its column of a = 3.2); they are drawn here in grey when its runs are on "
+                 "disk.")
+    paused = paused_minutes(RUNS)
+    if paused:
+        notes.append(f"The wall times include {paused:.0f} min in which the runs were "
+                     "stopped (SIGSTOP) while other work used the cores (listed in "
+                     "results/runs/crosses_column_width/PAUSES.txt); the run time leaves "
+                     "them out.")
+    draw(results, args.sizes, args.seeds)
+    elapsed = two_at_a_time_span([r["pour_s"] + r["collapse_s"] for r in results.values()])
+    elapsed -= 60.0 * (paused or 0.0)
+    ok = all(c["pass"] for c in checks if c["pass"] is not None)
+    summary = {
+        "name": "crosses_column_width",
+        "title": "Narrow and wide columns of crosses at a = 3.2",
+        "thesis": "§3.3.2, Fig. 3.9",
+        "description": (
+            "The box of crosses_dam_break 15 cm deep; columns of a = 3.2 of 1000 crosses "
+            "(L0 under two cross lengths) and 3000 (over three), three packings each, poured "
+            f"with Table 3.1, collapsed with kt {KT:g} N/m, γt {GAMMA_T:g} 1/s (the "
+            "calibration of crosses_recalibrated) until at rest; the mean speed against "
+            "the thesis' Fig. 3.9a curves."),
+        "command": "/usr/bin/python3 validation/dem/crosses_column_width.py --build BUILD"
+                   + ("" if args.sizes == list(SIZES) else " --sizes " + " ".join(args.sizes))
+                   + ("" if args.seeds == list(SEEDS)
+                      else " --seeds " + " ".join(map(str, args.seeds))),
+        "figures": ["docs/validation/figures/crosses_column_width.png"],
+        "checks": checks,
+        "tables": [{"caption": "Per run (`sanguis analyze`; the top's x at 3 τc).",
+                    "header": ["run", "L0 [cm]", "L0 / cross length", "H0 [cm]", "a",
+                               "peak v/√(gH0)", "peak t/τc", "below 5 % from t/τc",
+                               "top x/L0 at 3 τc", "(L∞−L0)/L0", "regime", "pour [h]",
+                               "collapse [h]"],
+                    "rows": rows}],
+        "notes": notes,
+    }
+    write_summary(summary, RESULTS, elapsed, False, ok)
+    print(f"{'PASS' if ok else 'FAIL'}: {len(results)} run(s), {elapsed / 3600:.2f} h")
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

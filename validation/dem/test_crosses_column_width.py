@@ -1,0 +1,59 @@
+"""Unit tests of crosses_column_width's columns and checks (run by ctest
+ValidationScripts.DemHelpers)."""
+import math
+import os
+import sys
+import unittest
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import crosses_column_width as cw  # noqa: E402
+
+
+class Columns(unittest.TestCase):
+    def test_the_small_column_is_under_two_cross_lengths_the_large_over_three(self):
+        small, large = cw.SIZES["small"].column(), cw.SIZES["large"].column()
+        self.assertLess(small.gate_cm / 100, 2 * cw.CROSS_LENGTH_M)
+        self.assertGreater(large.gate_cm / 100, 3 * cw.CROSS_LENGTH_M)
+        self.assertEqual((small.count, large.count), (1000, 3000))
+        self.assertEqual(small.depth_m, 0.15)
+
+    def test_the_gate_gives_a_of_fig_3_9_for_the_estimated_bulk_volume(self):
+        for size in cw.SIZES.values():
+            col = size.column()
+            l0 = col.gate_cm / 100
+            h0 = size.count * cw.CROSS_VOLUME_M3 / (l0 * col.depth_m)
+            self.assertAlmostEqual(h0 / l0, cw.ASPECT, delta=0.1)
+            self.assertGreater(col.pour_bottom_m, h0)  # the pour starts above the column
+
+    def test_the_pour_region_stays_at_the_cases_bottom_for_the_small_column(self):
+        self.assertEqual(cw.SIZES["small"].column().pour_bottom_m, 0.28)
+
+
+class Checks(unittest.TestCase):
+    def test_tolerances_widen_the_thesis_ranges_as_for_the_spheres(self):
+        small = cw.SIZES["small"]
+        checks = small.checks("x", 0.30, 4.0, 7.0)
+        self.assertEqual([c["tolerance"] for c in checks],
+                         ["[0.272, 0.468] (±20 %)", "[2.5, 5.5]", "[5, 9]"])
+        self.assertTrue(all(c["pass"] for c in checks))
+        checks = cw.SIZES["large"].checks("x", 0.30, 1.9, math.inf)
+        self.assertEqual([c["pass"] for c in checks], [False, False, False])
+        self.assertEqual(checks[2]["measured"], "never")
+        self.assertEqual(checks[1]["tolerance"], "[2, 3]")
+
+    def test_contrast_checks_compare_the_means(self):
+        results = {("small", 1): {"peak": 0.3, "below": 7.0, "x_top": 0.9},
+                   ("small", 2): {"peak": 0.2, "below": 6.0, "x_top": 0.7},
+                   ("large", 1): {"peak": 0.2, "below": 9.0, "x_top": 0.2},
+                   ("large", 2): {"peak": 0.25, "below": 4.0, "x_top": 0.3}}
+        checks = cw.contrast_checks(results, [1, 2])
+        self.assertEqual([c["pass"] for c in checks], [True, False, True])
+        self.assertEqual(checks[0]["measured"], "0.225 against 0.250")
+
+    def test_span(self):
+        self.assertEqual(cw.span((2.5, 2.5)), "2.5")
+        self.assertEqual(cw.span((0.34, 0.39)), "0.34-0.39")
+
+
+if __name__ == "__main__":
+    unittest.main()
