@@ -29,6 +29,9 @@ move as the thesis' crosses move. Each pour (seeds 1-3) is followed with the gat
 at once until at rest (mean speed below 1 mm/s, checked from 1.5 s after the opening) or
 for 3 s, with frames every 0.02 s (0.12-0.15 tau_c).
 
+The same collapse with Table 3.1 follows from the first packing of each size (reported,
+not checked; `--without-table31` leaves it out).
+
 Checks (tolerances fixed before running, those of dam_break_scaling's sphere column: the
 peak within 20 % of the thesis' range, its time within 0.5 tau_c of it, the 5 % crossing
 within 1 tau_c of it), for each of the six runs:
@@ -47,7 +50,7 @@ a run stopped on the way is continued from its checkpoint by the same command, s
 six runs may span several sessions. `--sizes small` runs and reports the small columns
 only; `--reuse` analyses the finished runs on disk.
 Usage: /usr/bin/python3 validation/dem/crosses_column_width.py [--build build]
-           [--sizes small large] [--seeds 1 2 3] [--reuse]
+           [--sizes small large] [--seeds 1 2 3] [--reuse] [--without-table31]
 """
 import argparse
 import math
@@ -127,20 +130,24 @@ SIZES = {"small": Size("small", 1000, (0.34, 0.39), (3.0, 5.0), (6.0, 8.0)),
 
 
 def folders(size, seed):
-    """The pour and the calibrated collapse of one size and seed."""
+    """The pour, the calibrated collapse and the Table 3.1 collapse of one size and seed."""
     tag = f"{size}_seed{seed}"
     return (os.path.join(RUNS, f"{tag}_pour"),
-            os.path.join(RUNS, f"{tag}_kt{KT:g}_gamma{GAMMA_T:g}"))
+            os.path.join(RUNS, f"{tag}_kt{KT:g}_gamma{GAMMA_T:g}"),
+            os.path.join(RUNS, f"{tag}_table31"))
 
 
-def run_one(exe, size, seed):
-    """Pour (Table 3.1, gate in place, at rest), then the calibrated collapse; one thread.
-    Either goes on from its checkpoint when stopped on the way."""
+def run_one(exe, size, seed, table31):
+    """Pour (Table 3.1, gate in place, at rest), then the calibrated collapse and, if
+    `table31`, the Table 3.1 one; one thread. Each goes on from its checkpoint when
+    stopped on the way."""
     col = SIZES[size].column()
-    pour, out = folders(size, seed)
+    pour, out, out31 = folders(size, seed)
     opening = pour_gate(exe, col, pour, 1, extra=seed_settings(seed))
-    collapse(exe, col, pour, out, opening, 1, seed=seed,
-             extra=["--set", f"output.interval_s={FRAME_S}"])
+    frames = ["--set", f"output.interval_s={FRAME_S}"]
+    collapse(exe, col, pour, out, opening, 1, seed=seed, extra=frames)
+    if table31:
+        collapse(exe, col, pour, out31, opening, 1, tangential=None, seed=seed, extra=frames)
 
 
 def highest_point(run, opening, h0, l0, count=5):
@@ -155,11 +162,12 @@ def highest_point(run, opening, h0, l0, count=5):
     return float(points[top, 0].mean() / l0), (time_s - opening) / tau_c
 
 
-def measure(exe, size, seed):
-    """The analysed figures of one finished run."""
-    pour, out = folders(size, seed)
+def measure(exe, size, seed, tangential=(KT, GAMMA_T)):
+    """The analysed figures of one finished collapse (tangential None: Table 3.1)."""
+    pour, out, out31 = folders(size, seed)
+    out = out if tangential else out31
     opening = diagnostics(pour)[-1]["time_s"]
-    if not finished(out, (KT, GAMMA_T), opening):
+    if not finished(out, tangential, opening):
         sys.exit(f"{out}: not finished; run without --reuse to finish it")
     subprocess.run([exe, "analyze", out], check=True, stdout=subprocess.DEVNULL)
     s = read_summary(out)
@@ -207,7 +215,7 @@ def sphere_curves():
 
 def snapshot(ax, size, seed, result):
     """Side view (x, z) of a run at the frame nearest 3 tau_c, coloured by speed."""
-    _, out = folders(size, seed)
+    out = folders(size, seed)[1]
     s = result["summary"]
     tau_c = math.sqrt(s["H0_m"] / G)
     frames = read_pvd(os.path.join(out, "particles.pvd"))
@@ -226,7 +234,7 @@ def snapshot(ax, size, seed, result):
                  f"(top at x = {result['x_top']:.2f} L0)", fontsize=8)
 
 
-def draw(results, sizes, seeds):
+def draw(results, table31, sizes, seeds):
     fig = plt.figure(figsize=(12, 4.4))
     ax = fig.add_subplot(1, 2, 1)
     for k, (t, v) in enumerate(sphere_curves()):
@@ -239,6 +247,10 @@ def draw(results, sizes, seeds):
             t, v = results[(size, seed)]["curve"]
             ax.plot(t, v, color=colours[size], ls=styles[k % 3],
                     label=f"{SIZES[size].count} crosses, seed {seed}")
+        if (size, seeds[0]) in table31:
+            t, v = table31[(size, seeds[0])]["curve"]
+            ax.plot(t, v, color=colours[size], lw=0.6, alpha=0.6,
+                    label=f"{SIZES[size].count} crosses, seed {seeds[0]}, Table 3.1")
     draw_velocity_bands(ax)
     ax.set_xlim(0, 16)
     ax.set_title(f"a = {ASPECT}, kt {KT:g} N/m, γt {GAMMA_T:g} 1/s", fontsize=9)
@@ -255,16 +267,21 @@ def main():
     ap.add_argument("--sizes", nargs="+", default=list(SIZES), choices=list(SIZES))
     ap.add_argument("--seeds", type=int, nargs="+", default=list(SEEDS))
     ap.add_argument("--reuse", action="store_true", help="analyse the finished runs on disk")
+    ap.add_argument("--without-table31", action="store_true",
+                    help="leave out the Table 3.1 collapse of each size's first packing")
     args = ap.parse_args()
     if len(set(args.seeds)) != len(args.seeds) or min(args.seeds) < 0:
         ap.error("--seeds: distinct non-negative integers")
     exe = os.path.join(ROOT, args.build, "app", "sanguis")
     keys = [(size, seed) for size in args.sizes for seed in args.seeds]
+    with_table31 = [] if args.without_table31 else [(size, args.seeds[0]) for size in args.sizes]
     if not args.reuse:
         with ThreadPoolExecutor(max_workers=2) as pool:
-            for job in [pool.submit(run_one, exe, size, seed) for size, seed in keys]:
+            for job in [pool.submit(run_one, exe, size, seed, (size, seed) in with_table31)
+                        for size, seed in keys]:
                 job.result()
     results = {key: measure(exe, *key) for key in keys}
+    table31 = {key: measure(exe, *key, tangential=None) for key in with_table31}
 
     checks, rows, notes = [], [], []
     for (size, seed), r in results.items():
@@ -274,7 +291,7 @@ def main():
         checks.append({"quantity": f"sanity, {label}: mean speed at the opening [m/s]",
                        "measured": f"{r['mean_speed_at_opening']:.2g}", "thesis": "—",
                        "tolerance": "< 1e-3", "pass": r["mean_speed_at_opening"] < 1e-3})
-        rows.append([label, f"{100 * s['L0_m']:.1f}", f"{100 * s['L0_m'] / (100 * CROSS_LENGTH_M):.2f}",
+        rows.append([label, f"{100 * s['L0_m']:.1f}", f"{s['L0_m'] / CROSS_LENGTH_M:.2f}",
                      f"{100 * s['H0_m']:.1f}", f"{s['aspect_ratio_H0_over_L0']:.2f}",
                      f"{r['peak']:.3f}", f"{r['peak_t']:.1f}",
                      f"{r['below']:.1f}" if math.isfinite(r["below"]) else "never",
@@ -282,6 +299,22 @@ def main():
                      f"{r['pour_s'] / 3600:.2f}", f"{r['collapse_s'] / 3600:.2f}"])
         notes.append(f"{label.capitalize()}: poured with Table 3.1 and at rest at "
                      f"{r['opening']:g} s; the collapse {r['stopped']}.")
+    for (size, seed), r in table31.items():
+        s = r["summary"]
+        label = f"{SIZES[size].count} crosses, seed {seed}, Table 3.1 (kt 3e2, γt 1e3)"
+        checks.append({"quantity": f"{label}: peak mean speed / √(g H0); below 5 % from t / τc",
+                       "measured": f"{r['peak']:.3f}; "
+                                   + (f"{r['below']:.2f}" if math.isfinite(r["below"]) else "never"),
+                       "thesis": f"{span(SIZES[size].peak)}; {span(SIZES[size].rest_time)}",
+                       "tolerance": "reported", "pass": None})
+        rows.append([label, f"{100 * s['L0_m']:.1f}", f"{s['L0_m'] / CROSS_LENGTH_M:.2f}",
+                     f"{100 * s['H0_m']:.1f}", f"{s['aspect_ratio_H0_over_L0']:.2f}",
+                     f"{r['peak']:.3f}", f"{r['peak_t']:.1f}",
+                     f"{r['below']:.1f}" if math.isfinite(r["below"]) else "never",
+                     f"{r['x_top']:.2f}", f"{s['runout_ratio']:.2f}", regime_name(s),
+                     "(as above)", f"{r['collapse_s'] / 3600:.2f}"])
+        notes.append(f"{label.capitalize()}: the collapse from the same packing "
+                     f"{r['stopped']}.")
     if set(args.sizes) == set(SIZES):
         checks += contrast_checks(results, args.seeds)
     notes.append("The thesis' sphere curves of Fig. 3.9a are checked by dam_break_scaling "
@@ -293,8 +326,10 @@ def main():
                      "stopped (SIGSTOP) while other work used the cores (listed in "
                      "results/runs/crosses_column_width/PAUSES.txt); the run time leaves "
                      "them out.")
-    draw(results, args.sizes, args.seeds)
-    elapsed = two_at_a_time_span([r["pour_s"] + r["collapse_s"] for r in results.values()])
+    draw(results, table31, args.sizes, args.seeds)
+    elapsed = two_at_a_time_span([r["pour_s"] + r["collapse_s"]
+                                  + (table31[key]["collapse_s"] if key in table31 else 0.0)
+                                  for key, r in results.items()])
     elapsed -= 60.0 * (paused or 0.0)
     ok = all(c["pass"] for c in checks if c["pass"] is not None)
     summary = {
@@ -310,7 +345,8 @@ def main():
         "command": "/usr/bin/python3 validation/dem/crosses_column_width.py --build BUILD"
                    + ("" if args.sizes == list(SIZES) else " --sizes " + " ".join(args.sizes))
                    + ("" if args.seeds == list(SEEDS)
-                      else " --seeds " + " ".join(map(str, args.seeds))),
+                      else " --seeds " + " ".join(map(str, args.seeds)))
+                   + (" --without-table31" if args.without_table31 else ""),
         "figures": ["docs/validation/figures/crosses_column_width.png"],
         "checks": checks,
         "tables": [{"caption": "Per run (`sanguis analyze`; the top's x at 3 τc).",
