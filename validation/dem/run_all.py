@@ -122,7 +122,8 @@ def report(summaries, meta):
     for name, s in summaries:
         out += ["", f"<a id=\"{name}\"></a>", ""]
         if s is None:
-            out += [f"## {name}", "", "The script wrote no summary; see its output.", ""]
+            out += [f"## {name}", "", "No summary in validation/dem/results: the script has not "
+                    "run to its end (not run yet, or it failed; see its output).", ""]
             continue
         out += [f"## {s['title']} (thesis {s['thesis']})", "", s["description"], "",
                 f"Command: `{s['command']}`. Run on {s.get('date', '?')}"
