@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 #include "dem/analysis/collapse.hpp"
 
@@ -127,6 +128,26 @@ TEST(Collapse, RegimeFromHeightsAndLengths) {
   EXPECT_EQ(classify_regime(0.2, 0.2, 0.05, 0.2), FlowRegime::kFractured);
   EXPECT_EQ(classify_regime(0.2, 0.199, 0.05, 0.052), FlowRegime::kStable);
   EXPECT_EQ(to_string(FlowRegime::kFractured), "fractured");
+}
+
+TEST(Collapse, AHaltIsALongStretchUnderTheLineBetweenTwoStretchesAboveIt) {
+  // t / tau_c every 0.5; the speed starts the collapse, halts 0.02 for 2 tau_c, goes on.
+  const std::vector<double> t = {0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0, 4.5, 5.0};
+  const std::vector<double> v = {0.0, 0.1, 0.3, 0.04, 0.02, 0.02, 0.03, 0.2, 0.1, 0.01, 0.0};
+  const Halts h = find_halts(t, v);
+  EXPECT_EQ(h.count, 1);
+  EXPECT_DOUBLE_EQ(h.longest, 2.0);  // from 1.5, the first sample under 0.05, to 3.5
+  // The final stop (4.5 on) is no halt: nothing follows it. Before the start, no halt.
+  const std::vector<double> quiet = {0.0, 0.01, 0.01, 0.01, 0.01, 0.2, 0.3, 0.1, 0.0, 0.0, 0.0};
+  EXPECT_EQ(find_halts(t, quiet).count, 0);
+  // Shorter than min_duration: a dip, not a halt; a lower line sees none either.
+  EXPECT_EQ(find_halts(t, v, {0.05, 2.5}).count, 0);
+  EXPECT_EQ(find_halts(t, v, {0.01, 1.0}).count, 0);
+  // Two halts; the longest is reported.
+  const std::vector<double> twice = {0.1, 0.0, 0.0, 0.0, 0.1, 0.0, 0.0, 0.0, 0.0, 0.1, 0.0};
+  const Halts h2 = find_halts(t, twice);
+  EXPECT_EQ(h2.count, 2);
+  EXPECT_DOUBLE_EQ(h2.longest, 2.0);
 }
 
 }  // namespace

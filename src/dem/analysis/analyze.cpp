@@ -217,6 +217,16 @@ std::vector<std::pair<std::string, double>> summary_values(const RunAnalysis& a)
   }
   const Coordination whole = a.coordination.empty() ? Coordination{} : a.coordination[0].second;
   const Coordination bulk = a.bulk();
+  // Staggered collapses (Fig. 3.10) on the non-dimensional curve of velocity.csv.
+  Halts halts;
+  if (h0 > 0) {
+    std::vector<double> t, v;
+    for (const TimeSample& s : a.series) {
+      t.push_back((s.time - a.release_time) / a.time_scale());
+      v.push_back(s.mean_speed / a.velocity_scale());
+    }
+    halts = find_halts(t, v);
+  }
   return {
       {"initial_time_s", a.initial_time},
       {"release_time_s", a.release_time},
@@ -240,6 +250,8 @@ std::vector<std::pair<std::string, double>> summary_values(const RunAnalysis& a)
       {"com_displacement_x_over_L0", l0 > 0 ? (c1.x - c0.x) / l0 : 0.0},
       {"peak_mean_speed_over_sqrt_gH0", h0 > 0 ? peak_speed / a.velocity_scale() : 0.0},
       {"peak_time_over_tau_c", h0 > 0 ? (peak_time - a.release_time) / a.time_scale() : 0.0},
+      {"halts", static_cast<double>(halts.count)},
+      {"longest_halt_over_tau_c", halts.longest},
       {"pair_coordination", whole.pair_coordination},
       {"contact_point_coordination", whole.contact_point_coordination},
       {"fabric_anisotropy", a.fabric.anisotropy},

@@ -1,5 +1,6 @@
 #include "dem/analysis/collapse.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace sanguis::dem::analysis {
@@ -41,6 +42,27 @@ FlowRegime classify_regime(double initial_height, double final_height, double in
   if (height_dropped) return FlowRegime::kCollapsed;
   const bool ran_out = final_length - initial_length > t.runout_gain * initial_length;
   return ran_out ? FlowRegime::kFractured : FlowRegime::kStable;
+}
+
+Halts find_halts(std::span<const double> time, std::span<const double> speed,
+                 const HaltThresholds& t) {
+  Halts halts;
+  bool started = false, below = false;
+  double below_since = 0.0;  // start of the current stretch under the line, when `below`
+  for (std::size_t k = 0; k < std::min(time.size(), speed.size()); ++k) {
+    if (speed[k] >= t.speed) {
+      if (below && time[k] - below_since >= t.min_duration) {
+        ++halts.count;
+        halts.longest = std::max(halts.longest, time[k] - below_since);
+      }
+      below = false;
+      started = true;
+    } else if (started && !below) {
+      below = true;
+      below_since = time[k];
+    }
+  }
+  return halts;
 }
 
 }  // namespace sanguis::dem::analysis
