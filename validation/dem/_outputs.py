@@ -3,6 +3,7 @@ binary base64, UInt64 headers, Float64 / Int64 arrays) as numpy arrays, and the
 summary row of `sanguis analyze`. Not a general VTK reader."""
 import base64
 import csv
+import heapq
 import json
 import os
 import re
@@ -65,10 +66,16 @@ def regime_name(summary):
 
 def speed_landmarks(t, v, line=0.05):
     """Of a mean-speed curve (t / tau_c, speed / sqrt(g H0)): the peak, its time and the
-    first time after it that the speed is below `line` (inf if never): the three figures
-    the thesis gives for each curve of Fig. 3.9a."""
+    time from which the speed stays below `line` to the end of the curve (inf if it ends
+    above; a collapse that halts and goes on, Fig. 3.10, ends at its last stop; the peak's
+    own time if the peak is below the line): the three figures the thesis gives for each
+    curve of Fig. 3.9a."""
     peak = max(range(len(v)), key=lambda i: v[i])
-    below = next((t[i] for i in range(peak, len(v)) if v[i] < line), float("inf"))
+    last_above = max((i for i in range(peak, len(v)) if v[i] >= line), default=None)
+    if last_above is None:
+        below = t[peak]
+    else:
+        below = t[last_above + 1] if last_above + 1 < len(v) else float("inf")
     return v[peak], t[peak], below
 
 
@@ -231,6 +238,16 @@ def wall_time(run, after=-1.0):
     """Wall-clock seconds of the run: the sum of its finished segments, or of those that
     ended after time `after` [s]."""
     return sum(seconds for end, seconds in finished_segments(run) if end > after + 1e-9)
+
+
+def pool_span(durations, workers=2):
+    """Wall-clock seconds of jobs of these durations run by a pool of `workers` in this
+    order, each started as soon as any worker is free (concurrent.futures' executors)."""
+    free = [0.0] * workers
+    for d in durations:
+        start = heapq.heappop(free)
+        heapq.heappush(free, start + d)
+    return max(free)
 
 
 def two_at_a_time_span(durations):

@@ -17,7 +17,7 @@ one choice that meets both statements at a = 3.2: with the bulk volume of a pour
 in this box (1.29 cm^3: the 4 cm gate's 3.9 x 21.5 x 20 cm over 1300 crosses), 1000
 crosses stand 5.2 cm long (under two cross lengths, 5.4 cm) and 3000 crosses 9.0 cm (over
 three, 8.1 cm); a 20 cm box would give 4.5 and 7.8 cm, the latter under three lengths,
-and any depth from 13.6 to 18.1 cm meets both. The gate goes at the L0 of that estimate;
+and any depth from 13.8 to 18.4 cm meets both. The gate goes at the L0 of that estimate;
 the measured a of each pour is reported.
 
 The parameters. With Table 3.1 the crosses of this model stand at a = 1.9-5.5
@@ -29,8 +29,8 @@ move as the thesis' crosses move. Each pour (seeds 1-3) is followed with the gat
 at once until at rest (mean speed below 1 mm/s, checked from 1.5 s after the opening) or
 for 3 s, with frames every 0.02 s (0.12-0.15 tau_c).
 
-The same collapse with Table 3.1 follows from the first packing of each size (reported,
-not checked; `--without-table31` leaves it out).
+The same collapse with Table 3.1 follows from the first packing (the lowest seed) of each
+size (reported, not checked; `--without-table31` leaves it out).
 
 Checks (tolerances fixed before running, those of dam_break_scaling's sphere column: the
 peak within 20 % of the thesis' range, its time within 0.5 tau_c of it, the 5 % crossing
@@ -63,9 +63,8 @@ import matplotlib
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import (paused_minutes, read_arrays, read_pvd, read_summary,  # noqa: E402
-                      regime_name, speed_landmarks, two_at_a_time_span, wall_time,
-                      write_summary)
+from _outputs import (paused_minutes, pool_span, read_arrays, read_pvd,  # noqa: E402
+                      read_summary, regime_name, speed_landmarks, wall_time, write_summary)
 from crosses_calibrated_gates import (GAMMA_T, KT, collapse, finished,  # noqa: E402
                                       seed_settings)
 from crosses_dam_break import (RESULTS, ROOT, Column, diagnostics, draw_velocity_bands,  # noqa: E402
@@ -119,6 +118,11 @@ class Size:
              "pass": r_lo <= below <= r_hi}]
 
 
+def sentence(text):
+    """The text with its first letter a capital (the rest unchanged, "Table 3.1" too)."""
+    return text[:1].upper() + text[1:]
+
+
 def span(pair):
     return f"{pair[0]:g}" if pair[0] == pair[1] else f"{pair[0]:g}-{pair[1]:g}"
 
@@ -150,6 +154,20 @@ def run_one(exe, size, seed, table31):
         collapse(exe, col, pour, out31, opening, 1, tangential=None, seed=seed, extra=frames)
 
 
+def run_all_jobs(exe, keys, with_table31):
+    """run_one for every (size, seed), two at a time; the first failure (or Ctrl-C)
+    cancels the jobs not yet started and is raised once the running ones end."""
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        jobs = [pool.submit(run_one, exe, size, seed, (size, seed) in with_table31)
+                for size, seed in keys]
+        try:
+            for job in jobs:
+                job.result()
+        except BaseException:
+            pool.shutdown(wait=True, cancel_futures=True)
+            raise
+
+
 def highest_point(run, opening, h0, l0, count=5):
     """At t = 3 tau_c after the opening (the frame nearest it): the mean x of the `count`
     highest crosses over L0 (0: the back wall, 1: the gate's face), as Fig. 3.9b-c
@@ -166,6 +184,8 @@ def measure(exe, size, seed, tangential=(KT, GAMMA_T)):
     """The analysed figures of one finished collapse (tangential None: Table 3.1)."""
     pour, out, out31 = folders(size, seed)
     out = out if tangential else out31
+    if not os.path.exists(os.path.join(pour, "diagnostics.csv")):
+        sys.exit(f"{pour}: no pour; run without --reuse to make it")
     opening = diagnostics(pour)[-1]["time_s"]
     if not finished(out, tangential, opening):
         sys.exit(f"{out}: not finished; run without --reuse to finish it")
@@ -274,12 +294,10 @@ def main():
         ap.error("--seeds: distinct non-negative integers")
     exe = os.path.join(ROOT, args.build, "app", "sanguis")
     keys = [(size, seed) for size in args.sizes for seed in args.seeds]
-    with_table31 = [] if args.without_table31 else [(size, args.seeds[0]) for size in args.sizes]
+    first = min(args.seeds)
+    with_table31 = [] if args.without_table31 else [(size, first) for size in args.sizes]
     if not args.reuse:
-        with ThreadPoolExecutor(max_workers=2) as pool:
-            for job in [pool.submit(run_one, exe, size, seed, (size, seed) in with_table31)
-                        for size, seed in keys]:
-                job.result()
+        run_all_jobs(exe, keys, with_table31)
     results = {key: measure(exe, *key) for key in keys}
     table31 = {key: measure(exe, *key, tangential=None) for key in with_table31}
 
@@ -295,9 +313,10 @@ def main():
                      f"{100 * s['H0_m']:.1f}", f"{s['aspect_ratio_H0_over_L0']:.2f}",
                      f"{r['peak']:.3f}", f"{r['peak_t']:.1f}",
                      f"{r['below']:.1f}" if math.isfinite(r["below"]) else "never",
-                     f"{r['x_top']:.2f}", f"{s['runout_ratio']:.2f}", regime_name(s),
+                     f"{r['x_top']:.2f}", f"{s['halts']:.0f}", f"{s['runout_ratio']:.2f}",
+                     regime_name(s),
                      f"{r['pour_s'] / 3600:.2f}", f"{r['collapse_s'] / 3600:.2f}"])
-        notes.append(f"{label.capitalize()}: poured with Table 3.1 and at rest at "
+        notes.append(f"{sentence(label)}: poured with Table 3.1 and at rest at "
                      f"{r['opening']:g} s; the collapse {r['stopped']}.")
     for (size, seed), r in table31.items():
         s = r["summary"]
@@ -311,9 +330,10 @@ def main():
                      f"{100 * s['H0_m']:.1f}", f"{s['aspect_ratio_H0_over_L0']:.2f}",
                      f"{r['peak']:.3f}", f"{r['peak_t']:.1f}",
                      f"{r['below']:.1f}" if math.isfinite(r["below"]) else "never",
-                     f"{r['x_top']:.2f}", f"{s['runout_ratio']:.2f}", regime_name(s),
+                     f"{r['x_top']:.2f}", f"{s['halts']:.0f}", f"{s['runout_ratio']:.2f}",
+                     regime_name(s),
                      "(as above)", f"{r['collapse_s'] / 3600:.2f}"])
-        notes.append(f"{label.capitalize()}: the collapse from the same packing "
+        notes.append(f"{sentence(label)}: the collapse from the same packing "
                      f"{r['stopped']}.")
     if set(args.sizes) == set(SIZES):
         checks += contrast_checks(results, args.seeds)
@@ -322,12 +342,12 @@ def main():
                  "disk.")
     paused = paused_minutes(RUNS)
     if paused:
-        notes.append(f"The wall times include {paused:.0f} min in which the runs were "
+        notes.append(f"The wall times include {paused:.1f} min in which the runs were "
                      "stopped (SIGSTOP) while other work used the cores (listed in "
                      "results/runs/crosses_column_width/PAUSES.txt); the run time leaves "
                      "them out.")
     draw(results, table31, args.sizes, args.seeds)
-    elapsed = two_at_a_time_span([r["pour_s"] + r["collapse_s"]
+    elapsed = pool_span([r["pour_s"] + r["collapse_s"]
                                   + (table31[key]["collapse_s"] if key in table31 else 0.0)
                                   for key, r in results.items()])
     elapsed -= 60.0 * (paused or 0.0)
@@ -352,7 +372,8 @@ def main():
         "tables": [{"caption": "Per run (`sanguis analyze`; the top's x at 3 τc).",
                     "header": ["run", "L0 [cm]", "L0 / cross length", "H0 [cm]", "a",
                                "peak v/√(gH0)", "peak t/τc", "below 5 % from t/τc",
-                               "top x/L0 at 3 τc", "(L∞−L0)/L0", "regime", "pour [h]",
+                               "top x/L0 at 3 τc", "halts (Fig. 3.10)", "(L∞−L0)/L0", "regime",
+                               "pour [h]",
                                "collapse [h]"],
                     "rows": rows}],
         "notes": notes,

@@ -110,6 +110,11 @@ def pour_rate(col):
     return 150.0 * col.gate_cm * col.depth_m / 0.20
 
 
+def depth_text(depth_m):
+    """The box's depth as the settings write it (the case's 20 cm as "0.20", as always)."""
+    return "0.20" if depth_m == 0.20 else f"{depth_m!r}"
+
+
 def overrides(col):
     """The gate's position, the pour and its region; the gate stays until released. The
     box's depth and the region's bottom are set only where they differ from the case's."""
@@ -120,9 +125,10 @@ def overrides(col):
                 f"obstacle[{GATE_INDEX}].remove_at_s=1e6",
                 f"particles[0].count={col.count}",
                 f"particles[0].rate_per_s={rate}",
-                f"particles[0].region_max_m=[{l0}, {col.depth_m:.2f}, 0.72]"]
+                f"particles[0].region_max_m=[{l0}, {depth_text(col.depth_m)}, 0.72]"]
     if col.depth_m != 0.20:
-        settings.append(f"obstacle[{SIDE_WALL_INDEX}].point_m=[0.0, {col.depth_m}, 0.0]")
+        depth = depth_text(col.depth_m)
+        settings.append(f"obstacle[{SIDE_WALL_INDEX}].point_m=[0.0, {depth}, 0.0]")
     if col.pour_bottom_m != 0.28:
         settings.append(f"particles[0].region_min_m=[0.0, 0.0, {col.pour_bottom_m}]")
     return settings

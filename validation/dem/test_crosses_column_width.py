@@ -50,6 +50,30 @@ class Checks(unittest.TestCase):
         self.assertEqual([c["pass"] for c in checks], [True, False, True])
         self.assertEqual(checks[0]["measured"], "0.225 against 0.250")
 
+    def test_a_failed_job_cancels_the_jobs_not_yet_started(self):
+        started = []
+
+        def fake_run_one(exe, size, seed, table31):
+            started.append((size, seed, table31))
+            if seed == 1:
+                raise RuntimeError("run failed")
+
+        real = cw.run_one
+        cw.run_one = fake_run_one
+        try:
+            keys = [("small", s) for s in (1, 2, 3, 4, 5, 6)]
+            with self.assertRaises(RuntimeError):
+                cw.run_all_jobs("exe", keys, [("small", 1)])
+        finally:
+            cw.run_one = real
+        self.assertIn(("small", 1, True), started)
+        self.assertLess(len(started), len(keys))
+
+    def test_sentence(self):
+        self.assertEqual(cw.sentence("1000 crosses, seed 1, Table 3.1"),
+                         "1000 crosses, seed 1, Table 3.1")
+        self.assertEqual(cw.sentence("gate 8 cm"), "Gate 8 cm")
+
     def test_span(self):
         self.assertEqual(cw.span((2.5, 2.5)), "2.5")
         self.assertEqual(cw.span((0.34, 0.39)), "0.34-0.39")

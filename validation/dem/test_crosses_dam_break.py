@@ -79,6 +79,11 @@ class Columns(unittest.TestCase):
         self.assertIn("particles[0].region_min_m=[0.0, 0.0, 0.33]", settings)
         self.assertAlmostEqual(db.pour_rate(db.Column(4, 1300, 0.15)), 0.75 * 600.0)
 
+    def test_the_pour_region_and_the_wall_take_the_same_depth(self):
+        settings = db.overrides(db.Column(5, 100, 0.135))
+        self.assertIn("particles[0].region_max_m=[0.05, 0.135, 0.72]", settings)
+        self.assertIn(f"obstacle[{db.SIDE_WALL_INDEX}].point_m=[0.0, 0.135, 0.0]", settings)
+
 
 if __name__ == "__main__":
     unittest.main()

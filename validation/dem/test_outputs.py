@@ -187,6 +187,26 @@ class TwoAtATime(unittest.TestCase):
         self.assertEqual(_outputs.two_at_a_time_span([1, 1, 1, 1]), 2)
 
 
+class PoolSpan(unittest.TestCase):
+    def test_a_pool_starts_each_job_when_any_worker_is_free(self):
+        self.assertEqual(_outputs.pool_span([10, 2, 1]), 10)  # two at a time, oldest first: 11
+        self.assertEqual(_outputs.pool_span([1, 2, 3, 4]), 6)
+        self.assertEqual(_outputs.pool_span([5]), 5)
+        self.assertEqual(_outputs.pool_span([3, 3, 3], workers=3), 3)
+
+
+class SpeedLandmarks(unittest.TestCase):
+    def test_peak_its_time_and_the_last_stop_under_the_line(self):
+        t = [0, 1, 2, 3, 4, 5, 6, 7]
+        landmarks = _outputs.speed_landmarks
+        self.assertEqual(landmarks(t, [0, 0.3, 0.1, 0.04, 0.01, 0, 0, 0]), (0.3, 1, 3))
+        # A halt and a restart (Fig. 3.10): the collapse ends at its last stop.
+        self.assertEqual(landmarks(t, [0, 0.3, 0.01, 0.01, 0.2, 0.01, 0, 0]), (0.3, 1, 5))
+        # Still moving at the end; never above the line.
+        self.assertEqual(landmarks(t, [0, 0.3, 0.1, 0.1, 0.1, 0.1, 0.1, 0.1])[2], float("inf"))
+        self.assertEqual(landmarks(t, [0, 0.01, 0.02, 0.01, 0, 0, 0, 0]), (0.02, 2, 2))
+
+
 class PourCommand(unittest.TestCase):
     CMD = ["sanguis", "run", "case.toml", "-o", "pour"]
 
