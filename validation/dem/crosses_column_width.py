@@ -47,10 +47,10 @@ Writes validation/dem/results/crosses_column_width.json and
 docs/validation/figures/crosses_column_width.png. The runs go two at a time, one thread
 each (hours: a pour and a collapse of 1000 crosses about 2 h, of 3000 crosses several);
 a run stopped on the way is continued from its checkpoint by the same command, so the
-six runs may span several sessions. `--sizes small` runs and reports the small columns
-only; `--reuse` analyses the finished runs on disk.
+six runs may span several sessions. `--sizes small` (or `--quick`) runs and reports the
+small columns only; `--reuse` analyses the finished runs on disk.
 Usage: /usr/bin/python3 validation/dem/crosses_column_width.py [--build build]
-           [--sizes small large] [--seeds 1 2 3] [--reuse] [--without-table31]
+           [--sizes small large] [--seeds 1 2 3] [--reuse] [--without-table31] [--quick]
 """
 import argparse
 import math
@@ -289,7 +289,10 @@ def main():
     ap.add_argument("--reuse", action="store_true", help="analyse the finished runs on disk")
     ap.add_argument("--without-table31", action="store_true",
                     help="leave out the Table 3.1 collapse of each size's first packing")
+    ap.add_argument("--quick", action="store_true", help="the small columns only")
     args = ap.parse_args()
+    if args.quick:
+        args.sizes = ["small"]
     if len(set(args.seeds)) != len(args.seeds) or min(args.seeds) < 0:
         ap.error("--seeds: distinct non-negative integers")
     exe = os.path.join(ROOT, args.build, "app", "sanguis")
@@ -363,7 +366,8 @@ def main():
             "calibration of crosses_recalibrated) until at rest; the mean speed against "
             "the thesis' Fig. 3.9a curves."),
         "command": "/usr/bin/python3 validation/dem/crosses_column_width.py --build BUILD"
-                   + ("" if args.sizes == list(SIZES) else " --sizes " + " ".join(args.sizes))
+                   + (" --quick" if args.quick else "" if args.sizes == list(SIZES)
+                      else " --sizes " + " ".join(args.sizes))
                    + ("" if args.seeds == list(SEEDS)
                       else " --seeds " + " ".join(map(str, args.seeds)))
                    + (" --without-table31" if args.without_table31 else ""),
@@ -378,7 +382,7 @@ def main():
                     "rows": rows}],
         "notes": notes,
     }
-    write_summary(summary, RESULTS, elapsed, False, ok)
+    write_summary(summary, RESULTS, elapsed, args.quick, ok)
     print(f"{'PASS' if ok else 'FAIL'}: {len(results)} run(s), {elapsed / 3600:.2f} h")
     return 0 if ok else 1
 
