@@ -3,6 +3,7 @@ its machine, and the report it writes. Run by ctest (ValidationScripts.DemHelper
 by hand: /usr/bin/python3 -m unittest discover -s validation/dem -p 'test_*.py'"""
 import json
 import os
+import subprocess
 import sys
 import tempfile
 import time
@@ -31,6 +32,14 @@ class Scripts(unittest.TestCase):
         for name in names:
             self.assertFalse(name.startswith(("_", "test_")), name)
             self.assertNotEqual(name, "run_all.py")
+
+    def test_every_script_takes_the_options_run_all_passes(self):
+        # run_all calls each script with --build DIR, and --quick under `run_all --quick`.
+        for path in run_all.scripts():
+            usage = subprocess.run([sys.executable, path, "--help"], capture_output=True,
+                                   text=True, check=True).stdout
+            for option in ("--build", "--quick"):
+                self.assertIn(option, usage, os.path.basename(path))
 
 
 class Cells(unittest.TestCase):
