@@ -200,6 +200,22 @@ def measure(exe, size, seed, tangential=(KT, GAMMA_T)):
             "mean_speed_at_opening": diagnostics(pour)[-1]["mean_velocity_m_s"]}
 
 
+TABLE_HEADER = ["run", "L0 [cm]", "L0 / cross length", "H0 [cm]", "a", "peak v/√(gH0)",
+                "peak t/τc", "below 5 % from t/τc", "top x/L0 at 3 τc", "halts (Fig. 3.10)",
+                "(L∞−L0)/L0", "regime", "pour [h]", "collapse [h]"]
+
+
+def table_row(label, r, pour):
+    """One row of the per-run table from measure()'s figures (`pour`: its column's text)."""
+    s = r["summary"]
+    return [label, f"{100 * s['L0_m']:.1f}", f"{s['L0_m'] / CROSS_LENGTH_M:.2f}",
+            f"{100 * s['H0_m']:.1f}", f"{s['aspect_ratio_H0_over_L0']:.2f}",
+            f"{r['peak']:.3f}", f"{r['peak_t']:.1f}",
+            f"{r['below']:.1f}" if math.isfinite(r["below"]) else "never",
+            f"{r['x_top']:.2f}", f"{s['halts']:.0f}", f"{s['runout_ratio']:.2f}",
+            regime_name(s), pour, f"{r['collapse_s'] / 3600:.2f}"]
+
+
 def contrast_checks(results, seeds):
     """The thesis' contrast between the sizes, on the means over the packings."""
     def mean(size, key):
@@ -306,36 +322,22 @@ def main():
 
     checks, rows, notes = [], [], []
     for (size, seed), r in results.items():
-        s = r["summary"]
         label = f"{SIZES[size].count} crosses, seed {seed}"
         checks += SIZES[size].checks(label, r["peak"], r["peak_t"], r["below"])
         checks.append({"quantity": f"sanity, {label}: mean speed at the opening [m/s]",
                        "measured": f"{r['mean_speed_at_opening']:.2g}", "thesis": "—",
                        "tolerance": "< 1e-3", "pass": r["mean_speed_at_opening"] < 1e-3})
-        rows.append([label, f"{100 * s['L0_m']:.1f}", f"{s['L0_m'] / CROSS_LENGTH_M:.2f}",
-                     f"{100 * s['H0_m']:.1f}", f"{s['aspect_ratio_H0_over_L0']:.2f}",
-                     f"{r['peak']:.3f}", f"{r['peak_t']:.1f}",
-                     f"{r['below']:.1f}" if math.isfinite(r["below"]) else "never",
-                     f"{r['x_top']:.2f}", f"{s['halts']:.0f}", f"{s['runout_ratio']:.2f}",
-                     regime_name(s),
-                     f"{r['pour_s'] / 3600:.2f}", f"{r['collapse_s'] / 3600:.2f}"])
+        rows.append(table_row(label, r, f"{r['pour_s'] / 3600:.2f}"))
         notes.append(f"{sentence(label)}: poured with Table 3.1 and at rest at "
                      f"{r['opening']:g} s; the collapse {r['stopped']}.")
     for (size, seed), r in table31.items():
-        s = r["summary"]
         label = f"{SIZES[size].count} crosses, seed {seed}, Table 3.1 (kt 3e2, γt 1e3)"
         checks.append({"quantity": f"{label}: peak mean speed / √(g H0); below 5 % from t / τc",
                        "measured": f"{r['peak']:.3f}; "
                                    + (f"{r['below']:.2f}" if math.isfinite(r["below"]) else "never"),
                        "thesis": f"{span(SIZES[size].peak)}; {span(SIZES[size].rest_time)}",
                        "tolerance": "reported", "pass": None})
-        rows.append([label, f"{100 * s['L0_m']:.1f}", f"{s['L0_m'] / CROSS_LENGTH_M:.2f}",
-                     f"{100 * s['H0_m']:.1f}", f"{s['aspect_ratio_H0_over_L0']:.2f}",
-                     f"{r['peak']:.3f}", f"{r['peak_t']:.1f}",
-                     f"{r['below']:.1f}" if math.isfinite(r["below"]) else "never",
-                     f"{r['x_top']:.2f}", f"{s['halts']:.0f}", f"{s['runout_ratio']:.2f}",
-                     regime_name(s),
-                     "(as above)", f"{r['collapse_s'] / 3600:.2f}"])
+        rows.append(table_row(label, r, "(as above)"))
         notes.append(f"{sentence(label)}: the collapse from the same packing "
                      f"{r['stopped']}.")
     if set(args.sizes) == set(SIZES):
@@ -374,11 +376,7 @@ def main():
         "figures": ["docs/validation/figures/crosses_column_width.png"],
         "checks": checks,
         "tables": [{"caption": "Per run (`sanguis analyze`; the top's x at 3 τc).",
-                    "header": ["run", "L0 [cm]", "L0 / cross length", "H0 [cm]", "a",
-                               "peak v/√(gH0)", "peak t/τc", "below 5 % from t/τc",
-                               "top x/L0 at 3 τc", "halts (Fig. 3.10)", "(L∞−L0)/L0", "regime",
-                               "pour [h]",
-                               "collapse [h]"],
+                    "header": TABLE_HEADER,
                     "rows": rows}],
         "notes": notes,
     }

@@ -69,6 +69,16 @@ class Checks(unittest.TestCase):
         self.assertIn(("small", 1, True), started)
         self.assertLess(len(started), len(keys))
 
+    def test_a_row_has_a_cell_per_column(self):
+        summary = {"L0_m": 0.052, "H0_m": 0.166, "aspect_ratio_H0_over_L0": 3.19, "halts": 0.0,
+                   "runout_ratio": 4.2, "regime": 2.0}
+        r = {"summary": summary, "peak": 0.3, "peak_t": 3.1, "below": math.inf, "x_top": 0.8,
+             "collapse_s": 3600.0}
+        row = cw.table_row("1000 crosses, seed 1", r, "0.50")
+        self.assertEqual(len(row), len(cw.TABLE_HEADER))
+        self.assertEqual(row[7], "never")
+        self.assertEqual(row[11], "collapsed")
+
     def test_sentence(self):
         self.assertEqual(cw.sentence("1000 crosses, seed 1, Table 3.1"),
                          "1000 crosses, seed 1, Table 3.1")
