@@ -38,7 +38,10 @@ class Checks(unittest.TestCase):
         self.assertTrue(all(c["pass"] for c in checks))
         checks = cw.SIZES["large"].checks("x", 0.30, 1.9, math.inf)
         self.assertEqual([c["pass"] for c in checks], [False, False, False])
-        self.assertEqual(checks[2]["measured"], "never")
+        self.assertEqual(checks[2]["measured"], "still above 5 % at the end")
+        standing = cw.SIZES["large"].checks("x", 0.02, 9.5, 9.5)[2]
+        self.assertEqual(standing["measured"], "never above 5 %")
+        self.assertFalse(standing["pass"])  # its peak's time is no end of a collapse
         self.assertEqual(checks[1]["tolerance"], "[2, 3]")
 
     def test_contrast_checks_compare_the_means(self):
@@ -76,7 +79,7 @@ class Checks(unittest.TestCase):
              "collapse_s": 3600.0}
         row = cw.table_row("1000 crosses, seed 1", r, "0.50")
         self.assertEqual(len(row), len(cw.TABLE_HEADER))
-        self.assertEqual(row[7], "never")
+        self.assertEqual(row[7], "still above 5 % at the end")
         self.assertEqual(row[11], "collapsed")
 
     def test_sentence(self):
