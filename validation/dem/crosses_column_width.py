@@ -176,16 +176,18 @@ def run_all_jobs(exe, keys, with_table31):
             raise
 
 
-def highest_point(run, opening, h0, l0, count=5):
-    """At t = 3 tau_c after the opening (the frame nearest it): the mean x of the `count`
-    highest crosses over L0 (0: the back wall, 1: the gate's face), as Fig. 3.9b-c
-    locate the top of the column."""
-    tau_c = math.sqrt(h0 / G)
+def frame_near(run, time_s):
+    """(time, arrays) of the run's particle frame nearest time_s."""
     frames = read_pvd(os.path.join(run, "particles.pvd"))
-    time_s, path = min(frames, key=lambda f: abs(f[0] - (opening + 3 * tau_c)))
-    points = read_arrays(path)["Points"]
+    t, path = min(frames, key=lambda f: abs(f[0] - time_s))
+    return t, read_arrays(path)
+
+
+def highest_point(points, l0, count=5):
+    """The mean x of the `count` highest crosses over L0 (0: the back wall, 1: the gate's
+    face), as Fig. 3.9b-c locate the top of the column."""
     top = np.argsort(points[:, 2])[-count:]
-    return float(points[top, 0].mean() / l0), (time_s - opening) / tau_c
+    return float(points[top, 0].mean() / l0)
 
 
 def measure(exe, size, seed, tangential=(KT, GAMMA_T)):
@@ -194,18 +196,22 @@ def measure(exe, size, seed, tangential=(KT, GAMMA_T)):
     out = out if tangential else out31
     if not os.path.exists(os.path.join(pour, "diagnostics.csv")):
         sys.exit(f"{pour}: no pour; run without --reuse to make it")
-    opening = diagnostics(pour)[-1]["time_s"]
+    at_opening = diagnostics(pour)[-1]
+    opening = at_opening["time_s"]
     if not finished(out, tangential, opening):
         sys.exit(f"{out}: not finished; run without --reuse to finish it")
     subprocess.run([exe, "analyze", out], check=True, stdout=subprocess.DEVNULL)
     s = read_summary(out)
     t, v = velocity_curve(out)
     peak, peak_t, below = speed_landmarks(t, v)
-    x_top, at = highest_point(out, opening, s["H0_m"], s["L0_m"])
+    tau_c = math.sqrt(s["H0_m"] / G)
+    frame_t, frame = frame_near(out, opening + 3 * tau_c)  # Fig. 3.9b-c: t = 3 tau_c
     return {"summary": s, "curve": (t, v), "peak": peak, "peak_t": peak_t, "below": below,
-            "x_top": x_top, "x_top_at": at, "opening": opening, "pour_s": wall_time(pour),
-            "collapse_s": wall_time(out, opening), "stopped": stopped(out, opening),
-            "mean_speed_at_opening": diagnostics(pour)[-1]["mean_velocity_m_s"]}
+            "x_top": highest_point(frame["Points"], s["L0_m"]), "frame": frame,
+            "x_top_at": (frame_t - opening) / tau_c, "opening": opening,
+            "pour_s": wall_time(pour), "collapse_s": wall_time(out, opening),
+            "stopped": stopped(out, opening),
+            "mean_speed_at_opening": at_opening["mean_velocity_m_s"]}
 
 
 TABLE_HEADER = ["run", "L0 [cm]", "L0 / cross length", "H0 [cm]", "a", "peak v/√(gH0)",
@@ -259,14 +265,9 @@ def sphere_curves():
 
 def snapshot(ax, size, seed, result):
     """Side view (x, z) of a run at the frame nearest 3 tau_c, coloured by speed."""
-    out = folders(size, seed)[1]
     s = result["summary"]
-    tau_c = math.sqrt(s["H0_m"] / G)
-    frames = read_pvd(os.path.join(out, "particles.pvd"))
-    _, path = min(frames, key=lambda f: abs(f[0] - (result["opening"] + 3 * tau_c)))
-    arrays = read_arrays(path)
-    speed = np.linalg.norm(arrays["velocity"], axis=1)
-    p = arrays["Points"]
+    speed = np.linalg.norm(result["frame"]["velocity"], axis=1)
+    p = result["frame"]["Points"]
     ax.scatter(100 * p[:, 0], 100 * p[:, 2], c=speed, s=4, cmap="jet")
     ax.axvline(100 * s["L0_m"], color="k", lw=0.8, ls=":")
     ax.set_aspect("equal")
@@ -291,10 +292,11 @@ def draw(results, table31, sizes, seeds):
             t, v = results[(size, seed)]["curve"]
             ax.plot(t, v, color=colours[size], ls=styles[k % 3],
                     label=f"{SIZES[size].count} crosses, seed {seed}")
-        if (size, seeds[0]) in table31:
-            t, v = table31[(size, seeds[0])]["curve"]
-            ax.plot(t, v, color=colours[size], lw=0.6, alpha=0.6,
-                    label=f"{SIZES[size].count} crosses, seed {seeds[0]}, Table 3.1")
+        for (of_size, seed), r in table31.items():
+            if of_size == size:
+                t, v = r["curve"]
+                ax.plot(t, v, color=colours[size], lw=0.6, alpha=0.6,
+                        label=f"{SIZES[size].count} crosses, seed {seed}, Table 3.1")
     draw_velocity_bands(ax)
     ax.set_xlim(0, 16)
     ax.set_title(f"a = {ASPECT}, kt {KT:g} N/m, γt {GAMMA_T:g} 1/s", fontsize=9)
