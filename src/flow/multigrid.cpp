@@ -841,8 +841,10 @@ double MultigridReport::mean_reduction() const {
   return std::pow(residuals.front() / residuals.back(), 1.0 / cycles_done);
 }
 
-Multigrid::Multigrid(const Forest& forest, const std::array<BcKind, 6>& kinds, bool merge_blocks)
-    : forest_(forest), kinds_(kinds), merge_blocks_(merge_blocks) {
+Multigrid::Multigrid(const Forest& forest, const std::array<BcKind, 6>& kinds, bool merge_blocks,
+                     bool level_by_level)
+    : forest_(forest), kinds_(kinds), merge_blocks_(merge_blocks), level_by_level_(level_by_level) {
+  homogeneous_.kind = kinds;
   for (int d = 0; d < 3; ++d) {
     const bool periodic = forest.spec().periodic[D(d)];
     for (int side = 0; side < 2; ++side) {
@@ -873,8 +875,12 @@ void Multigrid::rebuild() {
     return;  // the new solver's coefficients are the reset ones (alpha 0, beta 1)
   }
   const int n = forest_.local_blocks();
+  // Level by level: only the finest level here, the rest on the coarsened forest.
+  coarsened_.reset();
+  const bool by_level = composite_ && level_by_level_;
+  if (by_level) levels_.resize(1);
   std::size_t m = 0;
-  for (int b = forest_.block_cells(); b >= 1; b /= 2, ++m) {
+  for (int b = forest_.block_cells(); b >= 1 && !(by_level && m == 1); b /= 2, ++m) {
     if (levels_.size() == m) levels_.emplace_back();
     // The finest level shares the layout of the caller's fields; coarser
     // ones keep the one ghost layer their smoother and prolongation read.
@@ -897,6 +903,20 @@ void Multigrid::rebuild() {
     }
   }
   shifted_rhs_.reshape(n, forest_.block_cells());
+  if (by_level) {
+    coarsened_ = std::make_unique<Coarsened>();
+    Coarsened& c = *coarsened_;
+    c.forest = coarsen_finest_level(forest_);
+    c.transfers = std::make_unique<CoarsenedBlocks>(forest_, *c.forest);
+    c.solver = std::make_unique<Multigrid>(*c.forest, kinds_, merge_blocks_, true);
+    const int blocks = c.forest->local_blocks(), b = forest_.block_cells();
+    c.x.reshape(blocks, b);
+    c.rhs.reshape(blocks, b);
+    c.alpha.reshape(blocks, b);
+    c.active.reshape(blocks, b, 1);
+    reshape(c.beta, blocks, b, kGhost);  // the layout of the finest level, which takes it
+    c.residual.reshape(n, b);
+  }
   set_coefficients(nullptr, nullptr);
 }
 
@@ -960,6 +980,24 @@ void Multigrid::set_coefficients(const BlockField* alpha, const FaceField* beta)
             }
       }
     });
+  }
+  if (coarsened_) {
+    // The coarsened forest's coefficients as the in-block levels take theirs: alpha the
+    // mean of the 8 children, beta of the 4 fine faces.
+    Coarsened& c = *coarsened_;
+    c.transfers->restrict_cells(fine.alpha, c.alpha);
+    for (int d = 0; d < 3; ++d) c.transfers->restrict_faces(fine.beta[D(d)], d, c.beta[D(d)]);
+    c.solver->set_coefficients(has_alpha_ ? &c.alpha : nullptr, &c.beta);
+    cell_activity(*c.forest, c.alpha, c.beta, c.active);
+    // The ghost ring, as compute_activity() fills it: the prolongation reads it.
+    c.forest->exchange(c.active, 1);
+    fill_boundary_ghosts(*c.forest, c.active, uniform_kinds(*c.forest, BcKind::Neumann), 1);
+    double all = 1.0;
+    for (int blk = 0; blk < c.forest->local_blocks(); ++blk)
+      for (int k = -1; k <= fine.cells; ++k)
+        for (int j = -1; j <= fine.cells; ++j)
+          for (int i = -1; i <= fine.cells; ++i) all = std::min(all, c.active(blk, i, j, k));
+    c.all_active = -forest_.max(-all) == 1.0;
   }
   bool dirichlet = false;
   for (const BcKind k : kinds_) dirichlet = dirichlet || k == BcKind::Dirichlet;
@@ -1025,27 +1063,35 @@ void Multigrid::detect_constant_coefficients() {
 
 int Multigrid::constant_blocks(int level) const {
   if (merged_) return merged_->solver->constant_blocks(level);
+  if (coarsened_ && level > 0) return coarsened_->solver->constant_blocks(level - 1);
   int count = 0;
   for (const unsigned char c : levels_[D(level)].block_constant) count += c ? 1 : 0;
   return count;
 }
 
-void Multigrid::compute_activity() {
-  Level& fine = levels_.front();
-  const int b = fine.cells;
-  const BlockLayout L = fine.alpha.layout();
-  forest_.for_each_block([&](int blk) {
+void Multigrid::cell_activity(const Forest& forest, const BlockField& alpha, const FaceField& beta,
+                              BlockField& active) {
+  const int b = alpha.cells();
+  const BlockLayout L = alpha.layout();
+  const BlockLayout A = active.layout();
+  forest.for_each_block([&](int blk) {
     for (int k = 0; k < b; ++k)
       for (int j = 0; j < b; ++j)
         for (int i = 0; i < b; ++i) {
           const std::ptrdiff_t c = L.index(i, j, k);
-          double open = fine.alpha.block(blk)[c];
+          double open = alpha.block(blk)[c];
           for (int d = 0; d < 3; ++d) {
-            open += fine.beta[D(d)].block(blk)[c] + fine.beta[D(d)].block(blk)[c + L.stride(d)];
+            const BlockLayout F = beta[D(d)].layout();
+            const std::ptrdiff_t f = F.index(i, j, k);
+            open += beta[D(d)].block(blk)[f] + beta[D(d)].block(blk)[f + F.stride(d)];
           }
-          fine.active.block(blk)[c] = open > 0.0 ? 1.0 : 0.0;
+          active.block(blk)[A.index(i, j, k)] = open > 0.0 ? 1.0 : 0.0;
         }
   });
+}
+
+void Multigrid::compute_activity() {
+  cell_activity(forest_, levels_.front().alpha, levels_.front().beta, levels_.front().active);
   for (std::size_t m = 1; m < levels_.size(); ++m) {
     const Level& f = levels_[m - 1];
     Level& c = levels_[m];
@@ -1061,6 +1107,7 @@ void Multigrid::compute_activity() {
 }
 
 void Multigrid::build_coarse_operator() {
+  if (coarsened_) return;  // the coarsened forest's solver has the bottom level
   if (composite_) {
     build_composite_operator();
     return;
@@ -1472,6 +1519,10 @@ void prolong_all_active(const BlockField& coarse, int blk, int b, BlockField& x)
 }  // namespace
 
 void Multigrid::vcycle(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc) {
+  if (coarsened_) {
+    vcycle_level_by_level(x, rhs, bc);
+    return;
+  }
   if (static_cast<std::size_t>(level) + 1 == levels_.size()) {
     coarse_solve();
     return;
@@ -1514,6 +1565,32 @@ void Multigrid::vcycle(int level, BlockField& x, const BlockField& rhs, const Sc
         }
   });
   smooth(level, x, rhs, bc, post_sweeps_);
+}
+
+void Multigrid::vcycle_level_by_level(BlockField& x, const BlockField& rhs,
+                                      const ScalarBoundary* bc) {
+  smooth(0, x, rhs, bc, pre_sweeps_);
+  Coarsened& c = *coarsened_;
+  compute_residual(0, x, rhs, bc, &c.residual, false);
+  c.transfers->restrict_cells(c.residual, c.rhs);
+  c.solver->correction(c.x, c.rhs);
+  // Trilinear on the merged families, from active coarse cells only (as vcycle()).
+  c.transfers->prolong_add(c.x, c.all_active ? nullptr : &c.active, x);
+  smooth(0, x, rhs, bc, post_sweeps_);
+}
+
+void Multigrid::correction(BlockField& x, const BlockField& rhs) {
+  if (merged_) {
+    to_merged(nullptr, rhs);
+    merged_->solver->correction(merged_->x, merged_->rhs);
+    from_merged(x, homogeneous_, true);
+    return;
+  }
+  // Level 0 here is a finest level (its Dirichlet closure, its ghost rule), with zero
+  // boundary values: the correction's.
+  x.fill(0.0);
+  vcycle(0, x, rhs, &homogeneous_);
+  fill_ghosts(0, x, &homogeneous_, false, false);  // values, not matched fluxes
 }
 
 double Multigrid::rms(const BlockField& f) {
@@ -1617,6 +1694,9 @@ void Multigrid::take_options(const MultigridOptions& options) {
   constant_kernels_ = options.constant_coefficient_kernels;
   in_place_ = options.read_neighbours_in_place;
   prefetch_ = options.prefetch;
+  // The solvers that take the coarse corrections (correction() does not take options).
+  if (merged_) merged_->solver->take_options(options);
+  if (coarsened_) coarsened_->solver->take_options(options);
 }
 
 void Multigrid::relax(BlockField& x, const BlockField& rhs, const ScalarBoundary& bc, int sweeps,

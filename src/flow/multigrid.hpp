@@ -31,8 +31,14 @@
 // cavity it runs 2-3x faster on 16^3 blocks (docs/performance.md, "Solver
 // blocks").
 //
-// Composite grids (blocks at several levels, issue #7): every in-block level
-// is itself a composite grid with the same 2:1 structure, so the V-cycle is
+// Composite grids (blocks at several levels, issue #7): by default the level
+// below the finest is the forest with its finest level coarsened (its families
+// merged into their parents, the same cells per block: coarsened_blocks.hpp),
+// solved by a Multigrid of its own, and so on down to a uniform forest; each
+// forest relaxes its finest level only. This converges per cycle about as the
+// uniform grids do (docs/theory/flow.md, "Level by level"). With
+// level_by_level false (comparisons), every in-block level
+// is itself a composite grid with the same 2:1 structure, and the V-cycle is
 // unchanged: Forest::exchange fills fine ghosts from coarser blocks by
 // quadratic interpolation and coarse ghosts from finer blocks by averaging.
 // The operator is made conservative (flux matching): at a coarse-fine face
@@ -53,6 +59,7 @@
 
 #include "flow/block_field.hpp"
 #include "flow/boundary.hpp"
+#include "flow/coarsened_blocks.hpp"
 #include "flow/forest.hpp"
 #include "flow/merged_blocks.hpp"
 
@@ -116,7 +123,12 @@ class Multigrid {
   /// direction; the caller's fields copied in and out), where a V-cycle of
   /// the 64^3 cavity costs about half what it costs on 8^3 blocks. false: the
   /// caller's blocks (for comparisons).
-  Multigrid(const Forest& forest, const std::array<BcKind, 6>& kinds, bool merge_blocks = true);
+  /// level_by_level: on a composite forest, the level below the finest is the forest with
+  /// its finest level coarsened (coarsened_blocks.hpp), and so on down to a uniform forest,
+  /// whose blocks then halve their cells; false: every block halves its own cells from the
+  /// finest level on (the block-by-block hierarchy, for comparisons).
+  Multigrid(const Forest& forest, const std::array<BcKind, 6>& kinds, bool merge_blocks = true,
+            bool level_by_level = true);
 
   /// After the forest has changed (Forest::adapt): the levels for its new
   /// blocks, in the storage of the old ones where it is large enough, and
@@ -146,12 +158,14 @@ class Multigrid {
   /// r = rhs - A x on the finest level (fills x's ghosts with bc).
   void residual(BlockField& x, const BlockField& rhs, const ScalarBoundary& bc, BlockField& r);
 
-  /// Whether every block of `level` (0: finest), on every rank, runs the
-  /// constant-coefficient kernels when MultigridOptions::constant_coefficient_kernels
-  /// is on. On merged solver blocks: the merged blocks and their levels (level
-  /// 0 has the same cells; level l has 2b >> l cells per merged block).
+  /// Whether every block of `level` (0: finest; level by level, the levels below are the
+  /// coarsened forest's), on every rank, runs the constant-coefficient kernels when
+  /// MultigridOptions::constant_coefficient_kernels is on. On merged solver blocks: the merged
+  /// blocks and their levels (level 0 has the same cells; level l has 2b >> l cells per merged
+  /// block).
   [[nodiscard]] bool constant_coefficients(int level) const {
     if (merged_) return merged_->solver->constant_coefficients(level);
+    if (coarsened_ && level > 0) return coarsened_->solver->constant_coefficients(level - 1);
     return levels_[static_cast<std::size_t>(level)].constant_coefficients;
   }
   /// How many of this rank's blocks of `level` run them (merged blocks when merged).
@@ -165,6 +179,9 @@ class Multigrid {
   /// forest of blocks smaller than 16^3 with at least 2 merged blocks per
   /// direction).
   [[nodiscard]] bool merged() const { return merged_ != nullptr; }
+  /// Whether the V-cycle takes its coarse correction on the forest with the finest level
+  /// coarsened (a composite forest with level_by_level).
+  [[nodiscard]] bool level_by_level() const { return coarsened_ != nullptr; }
   /// Cells per edge of the blocks the solves run on (the merged ones when merged).
   [[nodiscard]] int solver_block_cells() const {
     return merged_ ? merged_->forest->block_cells() : forest_.block_cells();
@@ -232,6 +249,13 @@ class Multigrid {
                         BlockField* r, bool squares_wanted = true, bool ghosts_wanted = false,
                         BlockField* restricted = nullptr);
   void vcycle(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc);
+  /// The V-cycle of the level-by-level hierarchy on the finest level: relaxation, the
+  /// residual restricted to the coarsened forest, one V-cycle there, its correction
+  /// prolonged back, relaxation.
+  void vcycle_level_by_level(BlockField& x, const BlockField& rhs, const ScalarBoundary* bc);
+  /// x = one V-cycle from zero for rhs with homogeneous boundary values (the coarse
+  /// correction of the level above), x's ghosts then filled with values.
+  void correction(BlockField& x, const BlockField& rhs);
   void coarse_solve();
   void build_coarse_operator();
   void build_composite_operator();  ///< the bottom level of a non-uniform forest
@@ -248,6 +272,9 @@ class Multigrid {
   /// f -= by in the active cells of the finest level (the mean removal).
   void shift_interior(BlockField& f, double by) const;
   void compute_activity();
+  /// active = 1 in the cells with an open face or alpha > 0, else 0 (not the ghosts).
+  static void cell_activity(const Forest& forest, const BlockField& alpha, const FaceField& beta,
+                            BlockField& active);
   void detect_constant_coefficients();
 
   /// The caller's fields into the merged solver's (cells; x unless null).
@@ -271,6 +298,19 @@ class Multigrid {
     FaceField beta;
   };
   std::unique_ptr<Merged> merged_;
+  /// The level-by-level hierarchy's next forest (its finest level coarsened) and solver.
+  struct Coarsened {
+    std::unique_ptr<Forest> forest;
+    std::unique_ptr<CoarsenedBlocks> transfers;
+    std::unique_ptr<Multigrid> solver;
+    BlockField x, rhs, alpha, active;  ///< on the coarsened forest
+    FaceField beta;
+    BlockField residual;  ///< on this forest
+    bool all_active = true;
+  };
+  std::unique_ptr<Coarsened> coarsened_;
+  bool level_by_level_ = true;
+  ScalarBoundary homogeneous_;  ///< kinds_, zero values
   bool has_alpha_ = false;
   bool singular_ = false;
   std::vector<Level> levels_;  ///< 0 finest (b = B), last one cell per block
