@@ -7,6 +7,8 @@
 #include <set>
 #include <stdexcept>
 
+#include "flow/payload_exchange.hpp"
+
 namespace sanguis::flow {
 
 namespace {
@@ -188,34 +190,9 @@ void CoarsenedBlocks::move(Kind kind, int d, Produce&& produce, Consume&& consum
   const int ranks = fine_.ranks();
   if (ranks == 1) return;
   const bool from_fine = kind != Kind::Prolong;
-  const auto& outgoing = from_fine ? send_ : receive_;
-  const auto& incoming = from_fine ? receive_ : send_;
-  std::vector<int> send_counts(D(ranks), 0), receive_counts(D(ranks), 0);
-  std::vector<int> send_offsets(D(ranks), 0), receive_offsets(D(ranks), 0);
-  for (int r = 0; r < ranks; ++r) {
-    for (const Link& link : outgoing[D(r)]) send_counts[D(r)] += payload(link, kind, d);
-    for (const Link& link : incoming[D(r)]) receive_counts[D(r)] += payload(link, kind, d);
-    if (r > 0) {
-      send_offsets[D(r)] = send_offsets[D(r - 1)] + send_counts[D(r - 1)];
-      receive_offsets[D(r)] = receive_offsets[D(r - 1)] + receive_counts[D(r - 1)];
-    }
-  }
-  std::vector<double> packed(D(send_offsets.back() + send_counts.back()));
-  std::vector<double> unpacked(D(receive_offsets.back() + receive_counts.back()));
-  std::size_t at = 0;
-  for (int r = 0; r < ranks; ++r)
-    for (const Link& link : outgoing[D(r)]) {
-      produce(link, packed.data() + at);
-      at += D(payload(link, kind, d));
-    }
-  MPI_Alltoallv(packed.data(), send_counts.data(), send_offsets.data(), MPI_DOUBLE, unpacked.data(),
-                receive_counts.data(), receive_offsets.data(), MPI_DOUBLE, fine_.comm());
-  at = 0;
-  for (int r = 0; r < ranks; ++r)
-    for (const Link& link : incoming[D(r)]) {
-      consume(link, unpacked.data() + at);
-      at += D(payload(link, kind, d));
-    }
+  exchange_payloads(
+      fine_.comm(), from_fine ? send_ : receive_, from_fine ? receive_ : send_,
+      [&](const Link& link) { return payload(link, kind, d); }, produce, consume);
 }
 
 void CoarsenedBlocks::restrict_cells(const BlockField& fine, BlockField& coarse) const {
@@ -296,19 +273,10 @@ void CoarsenedBlocks::prolong_add(const BlockField& coarse, const BlockField* ac
     }
     const auto o = octant_offset(link.octant, h);
     for_box({b, b, b}, [&](int i, int j, int k) {
-      const int ci = o[0] + (i >> 1), cj = o[1] + (j >> 1), ck = o[2] + (k >> 1);
-      const int si = (i & 1) ? 1 : -1, sj = (j & 1) ? 1 : -1, sk = (k & 1) ? 1 : -1;
-      double value = 0.0, weight = 0.0;
-      for (int dk = 0; dk < 2; ++dk)
-        for (int dj = 0; dj < 2; ++dj)
-          for (int di = 0; di < 2; ++di) {
-            const int ii = ci + di * si, jj = cj + dj * sj, kk = ck + dk * sk;
-            double w = (di ? 0.25 : 0.75) * (dj ? 0.25 : 0.75) * (dk ? 0.25 : 0.75);
-            if (active) w *= (*active)(link.coarse, ii, jj, kk);
-            value += w * coarse(link.coarse, ii, jj, kk);
-            weight += w;
-          }
-      out[at++] = weight > 0.0 ? value / weight : 0.0;
+      const WeightedSum sum = trilinear_sum(coarse, active, link.coarse,
+                                            {o[0] + (i >> 1), o[1] + (j >> 1), o[2] + (k >> 1)},
+                                            {(i & 1) ? 1 : -1, (j & 1) ? 1 : -1, (k & 1) ? 1 : -1});
+      out[at++] = sum.weight > 0.0 ? sum.value / sum.weight : 0.0;
     });
   };
   const auto consume = [&](const Link& link, const double* in) {

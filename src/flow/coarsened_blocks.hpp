@@ -17,6 +17,7 @@
 // on different ranks in the two forests: the values then travel through one MPI_Alltoallv,
 // so one process and several give the same values.
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -25,6 +26,29 @@
 #include "flow/forest.hpp"
 
 namespace sanguis::flow {
+
+/// The trilinear prolongation of a correction (weights 3/4 and 1/4 per direction) at a fine
+/// cell in coarse cell c of block blk, towards the side s (+-1 per direction), from the active
+/// coarse cells only (`active` 1 or 0; nullptr: all of them): the weighted sum and the sum of
+/// the weights, for the caller to divide (no weight left: no correction there). Shared by the
+/// in-block levels (multigrid.cpp) and the coarsened forest.
+struct WeightedSum {
+  double value = 0.0, weight = 0.0;
+};
+inline WeightedSum trilinear_sum(const BlockField& coarse, const BlockField* active, int blk,
+                                 const std::array<int, 3>& c, const std::array<int, 3>& s) {
+  WeightedSum sum;
+  for (int dk = 0; dk < 2; ++dk)
+    for (int dj = 0; dj < 2; ++dj)
+      for (int di = 0; di < 2; ++di) {
+        const int i = c[0] + di * s[0], j = c[1] + dj * s[1], k = c[2] + dk * s[2];
+        double w = (di ? 0.25 : 0.75) * (dj ? 0.25 : 0.75) * (dk ? 0.25 : 0.75);
+        if (active) w *= (*active)(blk, i, j, k);
+        sum.value += w * coarse(blk, i, j, k);
+        sum.weight += w;
+      }
+  return sum;
+}
 
 /// The forest `fine` with every family of its finest level coarsened (same spec and
 /// ranks; 2:1 balanced as `fine` is). `fine` must not be uniform.

@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include "flow/payload_exchange.hpp"
+
 namespace sanguis::flow {
 
 namespace {
@@ -170,42 +172,26 @@ void MergedBlocks::transfer(const BlockField& from, BlockField& to, int face_dir
   const int ranks = fine_.ranks();
   if (ranks == 1) return;
   // The others: packed in the order of send_ (fine side) and receive_ (merged side).
-  const auto& outgoing = kToMerged ? send_ : receive_;
-  const auto& incoming = kToMerged ? receive_ : send_;
-  std::vector<int> send_counts(D(ranks), 0), receive_counts(D(ranks), 0);
-  std::vector<int> send_offsets(D(ranks), 0), receive_offsets(D(ranks), 0);
   const auto values = [&](const Child& c) {
     const auto n = child_box(b_, face_dir, c.octant);
     return n[0] * n[1] * n[2];
   };
-  for (int r = 0; r < ranks; ++r) {
-    for (const Child& c : outgoing[D(r)]) send_counts[D(r)] += values(c);
-    for (const Child& c : incoming[D(r)]) receive_counts[D(r)] += values(c);
-    if (r > 0) {
-      send_offsets[D(r)] = send_offsets[D(r - 1)] + send_counts[D(r - 1)];
-      receive_offsets[D(r)] = receive_offsets[D(r - 1)] + receive_counts[D(r - 1)];
-    }
-  }
-  std::vector<double> packed(D(send_offsets.back() + send_counts.back()));
-  std::vector<double> unpacked(D(receive_offsets.back() + receive_counts.back()));
-  std::size_t at = 0;
-  for (int r = 0; r < ranks; ++r)
-    for (const Child& c : outgoing[D(r)]) {
-      const double* src = kToMerged ? from.block(c.block) : from.block(c.merged);
-      for_child_values(F, M, face_dir, c.octant, [&](std::ptrdiff_t f, std::ptrdiff_t m) {
-        packed[at++] = src[kToMerged ? f : m];
+  exchange_payloads(
+      fine_.comm(), kToMerged ? send_ : receive_, kToMerged ? receive_ : send_, values,
+      [&](const Child& c, double* out) {
+        const double* src = kToMerged ? from.block(c.block) : from.block(c.merged);
+        std::size_t at = 0;
+        for_child_values(F, M, face_dir, c.octant, [&](std::ptrdiff_t f, std::ptrdiff_t m) {
+          out[at++] = src[kToMerged ? f : m];
+        });
+      },
+      [&](const Child& c, const double* in) {
+        double* dst = kToMerged ? to.block(c.merged) : to.block(c.block);
+        std::size_t at = 0;
+        for_child_values(F, M, face_dir, c.octant, [&](std::ptrdiff_t f, std::ptrdiff_t m) {
+          dst[kToMerged ? m : f] = in[at++];
+        });
       });
-    }
-  MPI_Alltoallv(packed.data(), send_counts.data(), send_offsets.data(), MPI_DOUBLE, unpacked.data(),
-                receive_counts.data(), receive_offsets.data(), MPI_DOUBLE, fine_.comm());
-  at = 0;
-  for (int r = 0; r < ranks; ++r)
-    for (const Child& c : incoming[D(r)]) {
-      double* dst = kToMerged ? to.block(c.merged) : to.block(c.block);
-      for_child_values(F, M, face_dir, c.octant, [&](std::ptrdiff_t f, std::ptrdiff_t m) {
-        dst[kToMerged ? m : f] = unpacked[at++];
-      });
-    }
 }
 
 std::int64_t MergedBlocks::children_elsewhere() const {

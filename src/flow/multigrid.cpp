@@ -1549,19 +1549,10 @@ void Multigrid::vcycle(int level, BlockField& x, const BlockField& rhs, const Sc
     for (int k = 0; k < b; ++k)
       for (int j = 0; j < b; ++j)
         for (int i = 0; i < b; ++i) {
-          const int ci = i >> 1, cj = j >> 1, ck = k >> 1;
-          const int si = (i & 1) ? 1 : -1, sj = (j & 1) ? 1 : -1, sk = (k & 1) ? 1 : -1;
-          double value = 0.0, weight = 0.0;
-          for (int dk = 0; dk < 2; ++dk)
-            for (int dj = 0; dj < 2; ++dj)
-              for (int di = 0; di < 2; ++di) {
-                const int ii = ci + di * si, jj = cj + dj * sj, kk = ck + dk * sk;
-                double w = (di ? 0.25 : 0.75) * (dj ? 0.25 : 0.75) * (dk ? 0.25 : 0.75);
-                if (!all_active) w *= coarse.active(blk, ii, jj, kk);
-                value += w * coarse.x(blk, ii, jj, kk);
-                weight += w;
-              }
-          if (weight > 0.0) x(blk, i, j, k) += value / weight;
+          const WeightedSum sum = trilinear_sum(
+              coarse.x, all_active ? nullptr : &coarse.active, blk, {i >> 1, j >> 1, k >> 1},
+              {(i & 1) ? 1 : -1, (j & 1) ? 1 : -1, (k & 1) ? 1 : -1});
+          if (sum.weight > 0.0) x(blk, i, j, k) += sum.value / sum.weight;
         }
   });
   smooth(level, x, rhs, bc, post_sweeps_);
