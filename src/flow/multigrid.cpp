@@ -1565,7 +1565,7 @@ void Multigrid::vcycle_level_by_level(BlockField& x, const BlockField& rhs,
   compute_residual(0, x, rhs, bc, &c.residual, false);
   c.transfers->restrict_cells(c.residual, c.rhs);
   c.solver->correction(c.x, c.rhs);
-  // Trilinear on the merged families, from active coarse cells only (as vcycle()).
+  // Trilinear on the coarsened families, from active coarse cells only (as vcycle()).
   c.transfers->prolong_add(c.x, c.all_active ? nullptr : &c.active, x);
   smooth(0, x, rhs, bc, post_sweeps_);
 }
