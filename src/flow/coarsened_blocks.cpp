@@ -108,7 +108,7 @@ std::unique_ptr<Forest> coarsen_finest_level(const Forest& fine) {
 }
 
 CoarsenedBlocks::CoarsenedBlocks(const Forest& fine, const Forest& coarse)
-    : fine_(fine), coarse_(coarse), b_(fine.block_cells()) {
+    : fine_(fine), b_(fine.block_cells()) {
   if (coarse.block_cells() != b_ || fine.uniform() || coarse.max_level() + 1 != fine.max_level()) {
     throw std::invalid_argument(
         "coarsened blocks: the forests are not a composite one and its "

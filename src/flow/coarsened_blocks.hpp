@@ -91,7 +91,6 @@ class CoarsenedBlocks {
   void move(Kind kind, int d, Produce&& produce, Consume&& consume) const;
 
   const Forest& fine_;
-  const Forest& coarse_;
   int b_ = 0;
   std::vector<Link> local_;  ///< per fine block of this rank; coarse = -1 when elsewhere
   /// Per rank: this rank's fine blocks whose coarse block is there (fine side), and the
