@@ -140,30 +140,13 @@ CoarsenedBlocks::CoarsenedBlocks(const Forest& fine, const Forest& coarse)
   if (ranks == 1) return;
   // Each rank tells the coarse blocks' ranks which (coarse block, octant) its blocks
   // feed, in the order their values will travel.
-  std::vector<int> send_counts(D(ranks)), receive_counts(D(ranks));
-  std::vector<int> send_offsets(D(ranks), 0), receive_offsets(D(ranks), 0);
-  std::vector<std::int32_t> headers;
-  for (int r = 0; r < ranks; ++r) {
-    send_counts[D(r)] = 2 * static_cast<int>(send_[D(r)].size());
-    for (const Link& link : send_[D(r)]) {
-      headers.push_back(link.coarse);
-      headers.push_back(link.octant);
-    }
-  }
-  MPI_Alltoall(send_counts.data(), 1, MPI_INT, receive_counts.data(), 1, MPI_INT, fine.comm());
-  for (int r = 1; r < ranks; ++r) {
-    send_offsets[D(r)] = send_offsets[D(r - 1)] + send_counts[D(r - 1)];
-    receive_offsets[D(r)] = receive_offsets[D(r - 1)] + receive_counts[D(r - 1)];
-  }
-  std::vector<std::int32_t> received(D(receive_offsets.back() + receive_counts.back()));
-  MPI_Alltoallv(headers.data(), send_counts.data(), send_offsets.data(), MPI_INT32_T,
-                received.data(), receive_counts.data(), receive_offsets.data(), MPI_INT32_T,
-                fine.comm());
+  std::vector<std::vector<std::array<std::int32_t, 2>>> headers(D(ranks));
   for (int r = 0; r < ranks; ++r)
-    for (int e = 0; e < receive_counts[D(r)]; e += 2) {
-      const auto at = D(receive_offsets[D(r)] + e);
-      receive_[D(r)].push_back(Link{-1, received[at], received[at + 1]});
-    }
+    for (const Link& link : send_[D(r)]) headers[D(r)].push_back({link.coarse, link.octant});
+  const auto received = exchange_pairs(fine.comm(), headers);
+  for (int r = 0; r < ranks; ++r)
+    for (const auto& [coarse_block, octant] : received[D(r)])
+      receive_[D(r)].push_back(Link{-1, coarse_block, octant});
 }
 
 int CoarsenedBlocks::payload(const Link& link, Kind kind, int d) const {

@@ -115,31 +115,13 @@ MergedBlocks::MergedBlocks(const Forest& fine, const Forest& merged)
   if (ranks == 1) return;
   // Each rank tells the merged blocks' ranks which (merged block, octant) its
   // children fill, in the order their values will travel.
-  std::vector<int> send_counts(counts.size()), receive_counts(counts.size());
-  std::vector<int> send_offsets(counts.size(), 0), receive_offsets(counts.size(), 0);
-  std::vector<std::int32_t> headers;
-  for (int r = 0; r < ranks; ++r) {
-    send_counts[D(r)] = 2 * static_cast<int>(send_[D(r)].size());
-    for (const Child& child : send_[D(r)]) {
-      headers.push_back(child.merged);
-      headers.push_back(child.octant);
-    }
-  }
-  MPI_Alltoall(send_counts.data(), 1, MPI_INT, receive_counts.data(), 1, MPI_INT, fine.comm());
-  for (std::size_t r = 1; r < counts.size(); ++r) {
-    send_offsets[r] = send_offsets[r - 1] + send_counts[r - 1];
-    receive_offsets[r] = receive_offsets[r - 1] + receive_counts[r - 1];
-  }
-  std::vector<std::int32_t> received(
-      static_cast<std::size_t>(receive_offsets.back() + receive_counts.back()));
-  MPI_Alltoallv(headers.data(), send_counts.data(), send_offsets.data(), MPI_INT32_T,
-                received.data(), receive_counts.data(), receive_offsets.data(), MPI_INT32_T,
-                fine.comm());
+  std::vector<std::vector<std::array<std::int32_t, 2>>> headers(D(ranks));
   for (int r = 0; r < ranks; ++r)
-    for (int e = 0; e < receive_counts[D(r)]; e += 2) {
-      const auto at = static_cast<std::size_t>(receive_offsets[D(r)] + e);
-      receive_[D(r)].push_back(Child{-1, received[at], received[at + 1]});
-    }
+    for (const Child& child : send_[D(r)]) headers[D(r)].push_back({child.merged, child.octant});
+  const auto received = exchange_pairs(fine.comm(), headers);
+  for (int r = 0; r < ranks; ++r)
+    for (const auto& [merged, octant] : received[D(r)])
+      receive_[D(r)].push_back(Child{-1, merged, octant});
 }
 
 template <bool kToMerged>

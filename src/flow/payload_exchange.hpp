@@ -5,10 +5,43 @@
 
 #include <mpi.h>
 
+#include <array>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 namespace sanguis::flow {
+
+/// Pairs of numbers, each rank's outgoing[r] sent to rank r in order; returns, per rank,
+/// what that rank sent here, in its order. The headers that tell the receiving side which
+/// block (and octant) each payload of exchange_payloads() is for.
+inline std::vector<std::vector<std::array<std::int32_t, 2>>> exchange_pairs(
+    MPI_Comm comm, const std::vector<std::vector<std::array<std::int32_t, 2>>>& outgoing) {
+  const std::size_t ranks = outgoing.size();
+  std::vector<int> send_counts(ranks, 0), receive_counts(ranks, 0);
+  std::vector<int> send_offsets(ranks, 0), receive_offsets(ranks, 0);
+  std::vector<std::int32_t> headers;
+  for (std::size_t r = 0; r < ranks; ++r) {
+    send_counts[r] = 2 * static_cast<int>(outgoing[r].size());
+    for (const auto& pair : outgoing[r]) headers.insert(headers.end(), pair.begin(), pair.end());
+  }
+  MPI_Alltoall(send_counts.data(), 1, MPI_INT, receive_counts.data(), 1, MPI_INT, comm);
+  for (std::size_t r = 1; r < ranks; ++r) {
+    send_offsets[r] = send_offsets[r - 1] + send_counts[r - 1];
+    receive_offsets[r] = receive_offsets[r - 1] + receive_counts[r - 1];
+  }
+  std::vector<std::int32_t> received(
+      static_cast<std::size_t>(receive_offsets.back() + receive_counts.back()));
+  MPI_Alltoallv(headers.data(), send_counts.data(), send_offsets.data(), MPI_INT32_T,
+                received.data(), receive_counts.data(), receive_offsets.data(), MPI_INT32_T, comm);
+  std::vector<std::vector<std::array<std::int32_t, 2>>> incoming(ranks);
+  for (std::size_t r = 0; r < ranks; ++r)
+    for (int e = 0; e < receive_counts[r]; e += 2) {
+      const auto at = static_cast<std::size_t>(receive_offsets[r] + e);
+      incoming[r].push_back({received[at], received[at + 1]});
+    }
+  return incoming;
+}
 
 /// For every rank r: produce(item, out) packs each item of outgoing[r], in order, into
 /// size(item) values; consume(item, in) unpacks each item of incoming[r] from as many.
