@@ -272,6 +272,11 @@ int main(int argc, char** argv) {
                    "flow-cavity: the same for the projections' pressure solves only (A/B)")
       ->check(CLI::Range(0.0, 2.0));
   bench_cmd
+      ->add_option("--beside-finer-relaxation", bo.beside_finer_relaxation,
+                   "flow-adaptive: relaxation of the cells beside finer blocks in both solves "
+                   "(default: the solver's, 1.0; 2 relaxes them as the rest; A/B)")
+      ->check(CLI::Range(0.0, 2.0));
+  bench_cmd
       ->add_option("--sweeps", bo.sweeps,
                    "flow-cavity: smoothing sweeps before and after the coarse correction "
                    "(default: the solver's, 2)")

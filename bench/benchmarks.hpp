@@ -35,6 +35,9 @@ struct BenchOptions {
   double relaxation = 0.0;
   // flow-cavity: the same for the projections' (pressure) solves only, after `relaxation`.
   double pressure_relaxation = 0.0;
+  // flow-adaptive: MultigridOptions::beside_finer_relaxation of both solves (0: the solver's),
+  // for A/B runs (at least the relaxation: the cells beside finer blocks relax as the rest).
+  double beside_finer_relaxation = 0.0;
   // flow-cavity: red-black sweeps before and after the coarse correction (0: the solver's).
   int sweeps = 0;
   // dem-spheres: lattice sites filled in random order, so that ids (and the storage

@@ -24,6 +24,10 @@ std::string run_flow_adaptive(const BenchOptions& o, const std::filesystem::path
   c.forest.threads = o.threads;
   c.vtk = false;
   c.checkpoint_interval = 0.0;
+  if (o.beside_finer_relaxation > 0.0) {
+    c.options.pressure.beside_finer_relaxation = o.beside_finer_relaxation;
+    c.options.viscous.beside_finer_relaxation = o.beside_finer_relaxation;
+  }
   const fs::path dir =
       fs::temp_directory_path() / ("sanguis_bench_flow_adaptive_" + std::to_string(getpid()));
   flow::FlowRunOptions run;
@@ -48,6 +52,8 @@ std::string run_flow_adaptive(const BenchOptions& o, const std::filesystem::path
        << ",\"cells_uniform\":" << static_cast<std::int64_t>(uniform)
        << ",\"seconds\":" << s.wall_seconds
        << ",\"seconds_per_step\":" << s.wall_seconds / static_cast<double>(s.steps)
+       << ",\"pressure_vcycles_per_step\":"
+       << static_cast<double>(s.pressure_cycles) / static_cast<double>(s.steps)
        << ",\"regrid_fraction\":" << s.regrid_seconds / s.wall_seconds << "}";
   return json.str();
 }

@@ -229,7 +229,7 @@ def bilinear(coarse, level, i, j, row, rows, cols, vals):
 
 def smooth(a, colours, omega, sweeps, x):
     """Applies `sweeps` red-black sweeps (each colour relaxed against values fixed for the
-    half-sweep) to the errors in the columns of x."""
+    half-sweep) to the errors in the columns of x; omega: one value or one per row."""
     inv_diag = 1.0 / diagonal(a)
     for _ in range(sweeps):
         for colour in (0, 1):
@@ -286,23 +286,42 @@ def hierarchy(refined, nb, block_cells, finest_rule, coarser):
     return levels, ops, transfers
 
 
+def beside_finer_rows(level, a):
+    """The rows whose stencil reaches a finer cell: the coarse cells beside a finer block,
+    which hold the matched fluxes (MultigridOptions::beside_finer_relaxation)."""
+    a = sparse.csr_matrix(a) if sparse else np.asarray(a)
+    cell_level = np.array([c[0] for c in level.cells])
+    rows = np.zeros(len(cell_level), dtype=bool)
+    for row in range(len(cell_level)):
+        cols = a.indices[a.indptr[row]:a.indptr[row + 1]] if sparse else np.nonzero(a[row])[0]
+        rows[row] = np.any(cell_level[cols] > cell_level[row])
+    return rows
+
+
 def cycle_error(levels, ops, transfers, omega, sweeps, exact, k, x, inverses):
     """The error after one V-cycle at level k from the errors in the columns of x; level
-    `exact` and below solved exactly."""
+    `exact` and below solved exactly; omega: per level, one value or one per row."""
     a = ops[k]
     if k >= exact:
         return x - inverses[k] @ (a @ x)
-    x = smooth(a, levels[k].colours(), omega, sweeps, x)
+    x = smooth(a, levels[k].colours(), omega[k], sweeps, x)
     r, p = transfers[k]
     y = inverses[k + 1] @ (r @ (a @ x))  # the exact correction, then its cycle's error
     if k + 1 < exact:
         y = y - cycle_error(levels, ops, transfers, omega, sweeps, exact, k + 1, y, inverses)
     x = x - p @ y
-    return smooth(a, levels[k].colours(), omega, sweeps, x)
+    return smooth(a, levels[k].colours(), omega[k], sweeps, x)
 
 
-def rate(levels, ops, transfers, omega, sweeps, exact):
-    """Asymptotic reduction per cycle: 1 / spectral radius, constant mode removed."""
+def rate(levels, ops, transfers, omega, sweeps, exact, beside_finer=None):
+    """Asymptotic reduction per cycle: 1 / spectral radius, constant mode removed. With
+    beside_finer, the rows beside finer cells relax at min(omega, beside_finer) (the code's
+    rule since 2026-12-05); without, at omega as the rest."""
+    omegas = [omega] * len(levels)
+    if beside_finer is not None:
+        for k, level in enumerate(levels):
+            omegas[k] = np.where(beside_finer_rows(level, ops[k]), min(omega, beside_finer),
+                                 omega)
     inverses = [np.linalg.pinv(dense(op)) if 0 < k <= exact else None
                 for k, op in enumerate(ops)]
     n = ops[0].shape[0]
@@ -313,7 +332,7 @@ def rate(levels, ops, transfers, omega, sweeps, exact):
         return x - np.outer(np.ones(n), volume @ x) if x.ndim == 2 else x - volume @ x
 
     def cycle(x):
-        return without_mean(cycle_error(levels, ops, transfers, omega, sweeps, exact, 0,
+        return without_mean(cycle_error(levels, ops, transfers, omegas, sweeps, exact, 0,
                                         without_mean(x), inverses))
 
     if eigs:  # Arnoldi (ARPACK) on the cycle applied to vectors, a few eigenvalues for safety
@@ -346,6 +365,9 @@ def main():
     parser.add_argument("--finest", nargs="+", default=["interpolated", "composite"])
     parser.add_argument("--coarser", nargs="+",
                         default=["rediscretised", "galerkin", "level by level"])
+    parser.add_argument("--beside-finer", type=float, nargs="*", default=[],
+                        help="also the cycles with the rows beside finer cells relaxed at "
+                             "min(omega, this), one row per value (the code's default: 1.0)")
     args = parser.parse_args()
     nb, bc = args.blocks, args.block_cells
     if args.work:
@@ -361,7 +383,7 @@ def main():
                 print(f"{name:14s} {coarser:15s} {sum(counts) / counts[0]:.3f} = {shares}")
         return
     print("reduction per cycle (1/spectral radius), V(2,2); two-grid = level 1 solved exactly")
-    print(f"{'grid':14s} {'finest rule':12s} {'coarser levels':15s}"
+    print(f"{'grid':14s} {'finest rule':12s} {'coarser levels':29s}"
           + "".join(f" {'V w=' + str(w):>10s} {'2-grid':>8s}" for w in args.omega))
     for name in args.grids:
         refined = [[0] * nb for _ in range(nb)]
@@ -374,12 +396,15 @@ def main():
         variants = [v for v in variants if v[1] in args.coarser and v[0] in args.finest]
         for finest, coarser in variants:
             levels, ops, transfers = hierarchy(refined, nb, bc, finest, coarser)
-            cells = []
-            for w in args.omega:
-                v = rate(levels, ops, transfers, w, 2, len(levels) - 1)
-                t = rate(levels, ops, transfers, w, 2, 1)
-                cells.append(f" {v:10.1f} {t:8.1f}")
-            print(f"{name:14s} {finest:12s} {coarser:15s}" + "".join(cells), flush=True)
+            composite = not name.startswith("uniform")
+            for beside in [None] + (args.beside_finer if composite else []):
+                cells = []
+                for w in args.omega:
+                    v = rate(levels, ops, transfers, w, 2, len(levels) - 1, beside)
+                    t = rate(levels, ops, transfers, w, 2, 1, beside)
+                    cells.append(f" {v:10.1f} {t:8.1f}")
+                label = coarser if beside is None else f"{coarser}, {beside:g} by finer"
+                print(f"{name:14s} {finest:12s} {label:29s}" + "".join(cells), flush=True)
 
 
 if __name__ == "__main__":

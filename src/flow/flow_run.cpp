@@ -251,6 +251,7 @@ FlowRunSummary run_flow_case(const FlowCase& c, const FlowRunOptions& options,
   ProgressReporter progress(std::cerr, root && !options.quiet && isatty(STDERR_FILENO) != 0);
   const std::int64_t first_step = steps;
   double cell_updates = 0.0;
+  std::int64_t pressure_cycles = 0;
   try {
     while (ns.time() < end - eps &&
            (options.max_steps < 0 || steps - first_step < options.max_steps)) {
@@ -260,6 +261,7 @@ FlowRunSummary run_flow_case(const FlowCase& c, const FlowRunOptions& options,
       dt = std::min({dt, next_output - ns.time(), end - ns.time()});
       last = ns.step(dt);
       ++steps;
+      pressure_cycles += last.pressure_cycles;
       cell_updates += leaf_cells(forest);
       if (ns.time() >= next_output - eps) {
         record();
@@ -289,6 +291,7 @@ FlowRunSummary run_flow_case(const FlowCase& c, const FlowRunOptions& options,
   summary.wall_seconds = progress.elapsed_seconds();
   summary.regrid_seconds = regrid_seconds;
   summary.cells = leaf_cells(forest);
+  summary.pressure_cycles = pressure_cycles;
   summary.ranks = forest.ranks();
   std::ostringstream done;
   done.precision(4);

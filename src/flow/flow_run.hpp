@@ -21,12 +21,13 @@ struct FlowRunOptions {
 };
 
 struct FlowRunSummary {
-  std::int64_t steps = 0;       ///< steps done by this call
-  double simulated_time = 0.0;  ///< time reached (s)
-  double wall_seconds = 0.0;    ///< of the time loop
-  double regrid_seconds = 0.0;  ///< of the time loop spent regridding ([flow.adapt])
-  double cells = 0.0;           ///< leaf cells at the end (all ranks)
-  int ranks = 1;                ///< MPI ranks sharing the forest
+  std::int64_t steps = 0;            ///< steps done by this call
+  double simulated_time = 0.0;       ///< time reached (s)
+  double wall_seconds = 0.0;         ///< of the time loop
+  double regrid_seconds = 0.0;       ///< of the time loop spent regridding ([flow.adapt])
+  double cells = 0.0;                ///< leaf cells at the end (all ranks)
+  std::int64_t pressure_cycles = 0;  ///< V-cycles of each step's final projection, summed
+  int ranks = 1;                     ///< MPI ranks sharing the forest
 };
 
 FlowRunSummary run_flow_case(const FlowCase& c, const FlowRunOptions& options,

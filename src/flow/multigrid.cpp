@@ -1262,6 +1262,33 @@ CoarseGhosts ghost_rule(int level, bool operator_ghosts) {
                                                        : CoarseGhosts::Interpolated;
 }
 
+/// The cells of a block's layers beside faces with finer blocks across
+/// (ClosedFaces::matched), each cell once, in a fixed order: f(face slot, u, v, cell).
+template <typename F>
+void for_each_matched_layer_cell(const BlockLayout& L, const std::array<bool, 6>& matched, F f) {
+  const int b = L.cells;
+  for (int d = 0; d < 3; ++d)
+    for (int side = 0; side < 2; ++side) {
+      if (!matched[D(face_index(d, side))]) continue;
+      const int u_axis = d == 0 ? 1 : 0;
+      const int v_axis = d == 2 ? 1 : 2;
+      for (int v = 0; v < b; ++v)
+        for (int u = 0; u < b; ++u) {
+          std::array<int, 3> q{};
+          q[D(d)] = side == 0 ? 0 : b - 1;
+          q[D(u_axis)] = u;
+          q[D(v_axis)] = v;
+          // A cell on an edge or corner of two matched faces belongs to the first.
+          bool earlier = false;
+          for (int e = 0; e <= d && !earlier; ++e)
+            for (int t = 0; t < 2 && !earlier; ++t)
+              earlier = (e < d || t < side) && matched[D(face_index(e, t))] &&
+                        q[D(e)] == (t == 0 ? 0 : b - 1);
+          if (!earlier) f(face_index(d, side), u, v, L.index(q[0], q[1], q[2]));
+        }
+    }
+}
+
 }  // namespace
 
 void Multigrid::fill_ghosts(int level, BlockField& x, const ScalarBoundary* bc, bool faces_only,
@@ -1341,9 +1368,31 @@ void Multigrid::relax_block(int level, int blk, BlockField& x, const BlockField&
   const int first = (parity + colour) & 1;
   const AcrossFaces across =
       in_place ? same_level_neighbours(forest_, x, blk, bc ? bc->kind : kinds_) : AcrossFaces{};
+  // The cells beside a finer block relax at beside_finer_omega_ (see
+  // MultigridOptions::beside_finer_relaxation): the kernels relax them at
+  // omega_ with the rest, and their change is scaled back afterwards.
+  const bool scale_beside_finer =
+      composite_ && beside_finer_omega_ != omega_ &&
+      std::any_of(faces.matched.begin(), faces.matched.end(), [](bool m) { return m; });
+  double* before = nullptr;
+  if (scale_beside_finer) {
+    before = thread_scratch(6 * static_cast<std::ptrdiff_t>(b) * b);
+    for_each_matched_layer_cell(L, faces.matched, [&](int f, int u, int v, std::ptrdiff_t c) {
+      before[(f * b + v) * b + u] = xb[c];
+    });
+  }
+  const auto scale_changes_beside_finer = [&] {
+    if (!scale_beside_finer) return;
+    const double scale = beside_finer_omega_ / omega_;
+    for_each_matched_layer_cell(L, faces.matched, [&](int f, int u, int v, std::ptrdiff_t c) {
+      const double old = before[(f * b + v) * b + u];
+      xb[c] = old + scale * (xb[c] - old);
+    });
+  };
   if (constant_kernels_ && lv.block_constant[at]) {
     relax_constant(xb, rb, L, first, lv.block_alpha[at], lv.block_beta[at], inv_h2, omega_, faces,
                    across, next_block(x, rhs, next_blk));
+    scale_changes_beside_finer();
     return;
   }
   // The general kernel, by rows, reading same-level neighbours as relax_constant does.
@@ -1364,6 +1413,7 @@ void Multigrid::relax_block(int level, int blk, BlockField& x, const BlockField&
         row[i] += omega_ * (relaxed_value(around, i, rb[c], k, c, s, inv_h2, implicit) - row[i]);
       }
     }
+  scale_changes_beside_finer();
 }
 
 void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const ScalarBoundary* bc,
@@ -1682,6 +1732,7 @@ void Multigrid::take_options(const MultigridOptions& options) {
   pre_sweeps_ = options.pre_sweeps;
   post_sweeps_ = options.post_sweeps;
   omega_ = options.relaxation;
+  beside_finer_omega_ = std::min(options.relaxation, options.beside_finer_relaxation);
   constant_kernels_ = options.constant_coefficient_kernels;
   in_place_ = options.read_neighbours_in_place;
   prefetch_ = options.prefetch;
