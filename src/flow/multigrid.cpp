@@ -1263,9 +1263,12 @@ CoarseGhosts ghost_rule(int level, bool operator_ghosts) {
 }
 
 /// The cells of a block's layers beside faces with finer blocks across
-/// (ClosedFaces::matched), each cell once, in a fixed order: f(face slot, u, v, cell).
+/// (ClosedFaces::matched) that a half-sweep relaxes ((i + j + k + first) even,
+/// as in relax_block), each cell once, in a fixed order: f(face slot, u, v, cell).
+/// The other colour is left alone: other blocks may be reading it meanwhile.
 template <typename F>
-void for_each_matched_layer_cell(const BlockLayout& L, const std::array<bool, 6>& matched, F f) {
+void for_each_matched_layer_cell(const BlockLayout& L, const std::array<bool, 6>& matched,
+                                 int first, F f) {
   const int b = L.cells;
   for (int d = 0; d < 3; ++d)
     for (int side = 0; side < 2; ++side) {
@@ -1284,7 +1287,8 @@ void for_each_matched_layer_cell(const BlockLayout& L, const std::array<bool, 6>
             for (int t = 0; t < 2 && !earlier; ++t)
               earlier = (e < d || t < side) && matched[D(face_index(e, t))] &&
                         q[D(e)] == (t == 0 ? 0 : b - 1);
-          if (!earlier) f(face_index(d, side), u, v, L.index(q[0], q[1], q[2]));
+          if (!earlier && ((q[0] + q[1] + q[2] + first) & 1) == 0)
+            f(face_index(d, side), u, v, L.index(q[0], q[1], q[2]));
         }
     }
 }
@@ -1377,17 +1381,18 @@ void Multigrid::relax_block(int level, int blk, BlockField& x, const BlockField&
   double* before = nullptr;
   if (scale_beside_finer) {
     before = thread_scratch(6 * static_cast<std::ptrdiff_t>(b) * b);
-    for_each_matched_layer_cell(L, faces.matched, [&](int f, int u, int v, std::ptrdiff_t c) {
-      before[(f * b + v) * b + u] = xb[c];
-    });
+    for_each_matched_layer_cell(
+        L, faces.matched, first,
+        [&](int f, int u, int v, std::ptrdiff_t c) { before[(f * b + v) * b + u] = xb[c]; });
   }
   const auto scale_changes_beside_finer = [&] {
     if (!scale_beside_finer) return;
     const double scale = beside_finer_omega_ / omega_;
-    for_each_matched_layer_cell(L, faces.matched, [&](int f, int u, int v, std::ptrdiff_t c) {
-      const double old = before[(f * b + v) * b + u];
-      xb[c] = old + scale * (xb[c] - old);
-    });
+    for_each_matched_layer_cell(L, faces.matched, first,
+                                [&](int f, int u, int v, std::ptrdiff_t c) {
+                                  const double old = before[(f * b + v) * b + u];
+                                  xb[c] = old + scale * (xb[c] - old);
+                                });
   };
   if (constant_kernels_ && lv.block_constant[at]) {
     relax_constant(xb, rb, L, first, lv.block_alpha[at], lv.block_beta[at], inv_h2, omega_, faces,

@@ -173,7 +173,8 @@ TEST(AdaptPoisson, CompositeCyclesConvergeAsFastAsUniformOnes) {
   // but for one corner block), 22 blocks picked by a hash, and 8^3 blocks with 4 in 10
   // refined (1898 blocks). The block-by-block hierarchy (every block halving its own cells,
   // the solver's until 2026-12-05) reached 0.74-0.91 of the uniform rate at the smoother's
-  // 1.15 and 0.43-0.49 at the pressure solves' 1.25; the level-by-level one (the finest
+  // 1.15 and 0.43-0.49 at the pressure solves' 1.25 (measured before the rule below, which
+  // by_block now runs with too); the level-by-level one (the finest
   // level coarsened first: coarsened_blocks.hpp) 0.96-1.06 and 0.72-0.95, and with plain
   // Gauss-Seidel in the cells beside finer blocks (MultigridOptions::beside_finer_relaxation)
   // 0.97-1.06 and 0.85-0.98 (measured 2026-12-05; the results are the same bits on every run
