@@ -75,6 +75,13 @@ std::array<int, 3> child_faces(int b, int d, int octant) {
 
 std::unique_ptr<Forest> coarsen_finest_level(const Forest& fine) {
   if (fine.uniform()) throw std::invalid_argument("coarsen_finest_level: a uniform forest");
+  auto coarse = std::make_unique<Forest>(fine.spec());
+  coarsen_finest_level(fine, *coarse);
+  return coarse;
+}
+
+void coarsen_finest_level(const Forest& fine, Forest& coarse) {
+  if (fine.uniform()) throw std::invalid_argument("coarsen_finest_level: a uniform forest");
   const int top = fine.max_level();
   // The target's leaves: the fine forest's below the finest level and the parents of its
   // finest blocks.
@@ -82,7 +89,6 @@ std::unique_ptr<Forest> coarsen_finest_level(const Forest& fine) {
   for (const auto& [id, where] : all_blocks(fine)) {
     target.insert(id[0] == top ? parent_of(id) : id);
   }
-  auto coarse = std::make_unique<Forest>(fine.spec());
   const auto under_a_target_leaf = [&](BlockId id) {
     while (id[0] > 0) {
       id = parent_of(id);
@@ -90,9 +96,11 @@ std::unique_ptr<Forest> coarsen_finest_level(const Forest& fine) {
     }
     return false;
   };
-  // From the spec's uniform forest towards the target, one level per pass each way.
-  for (int pass = 0; pass < 2 * (top + 1); ++pass) {
-    const bool changed = coarse->adapt(
+  // Towards the target, one level per pass each way (from the spec's uniform forest, or
+  // from the last coarsened forest of a regridded one).
+  const int passes = 2 * (std::max(top, coarse.max_level()) + 1);
+  for (int pass = 0; pass < passes; ++pass) {
+    const bool changed = coarse.adapt(
         [&](const Block& block) {
           const BlockId id = id_of(block);
           if (target.count(id) != 0) return AdaptFlag::Keep;
@@ -101,10 +109,9 @@ std::unique_ptr<Forest> coarsen_finest_level(const Forest& fine) {
         {});
     if (!changed) break;
   }
-  if (coarse->global_blocks() != static_cast<std::int64_t>(target.size())) {
+  if (coarse.global_blocks() != static_cast<std::int64_t>(target.size())) {
     throw std::logic_error("coarsen_finest_level: the coarsened forest missed its target");
   }
-  return coarse;
 }
 
 CoarsenedBlocks::CoarsenedBlocks(const Forest& fine, const Forest& coarse)

@@ -53,6 +53,9 @@ inline WeightedSum trilinear_sum(const BlockField& coarse, const BlockField* act
 /// The forest `fine` with every family of its finest level coarsened (same spec and
 /// ranks; 2:1 balanced as `fine` is). `fine` must not be uniform.
 std::unique_ptr<Forest> coarsen_finest_level(const Forest& fine);
+/// The same by adapting `coarse` (a forest of fine's spec: its uniform start, or the
+/// last coarsened forest of a regridded `fine`) until its leaves are those.
+void coarsen_finest_level(const Forest& fine, Forest& coarse);
 
 /// Transfers between a composite forest and coarsen_finest_level() of it.
 class CoarsenedBlocks {

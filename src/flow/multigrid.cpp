@@ -857,27 +857,45 @@ Multigrid::Multigrid(const Forest& forest, const std::array<BcKind, 6>& kinds, b
   rebuild();
 }
 
+namespace {
+
+bool same_spec(const ForestSpec& a, const ForestSpec& b) {
+  return a.trees == b.trees && a.periodic == b.periodic && a.level == b.level &&
+         a.block_cells == b.block_cells && a.tree_length == b.tree_length &&
+         a.origin.x == b.origin.x && a.origin.y == b.origin.y && a.origin.z == b.origin.z &&
+         a.threads == b.threads && a.comm == b.comm;
+}
+
+}  // namespace
+
 void Multigrid::rebuild() {
   composite_ = !forest_.uniform();
-  merged_.reset();
   const auto merged_spec = merge_blocks_ ? merged_forest_spec(forest_) : std::nullopt;
   if (merged_spec) {
     // The levels of the caller's blocks are not needed: free them.
     levels_.clear();
     shifted_rhs_ = BlockField();
-    merged_ = std::make_unique<Merged>();
-    merged_->forest = std::make_unique<Forest>(*merged_spec);
+    coarsened_.reset();
+    // A regrid that leaves this forest uniform at the same level (the bottom of the
+    // level-by-level chain, most of the time) keeps the merged forest and its solver, and
+    // so their storage: only the copies are rebuilt, for this forest's new partition.
+    if (!merged_ || !same_spec(merged_->forest->spec(), *merged_spec)) {
+      merged_ = std::make_unique<Merged>();
+      merged_->forest = std::make_unique<Forest>(*merged_spec);
+      merged_->solver = std::make_unique<Multigrid>(*merged_->forest, kinds_, false);
+    }
     merged_->copies = std::make_unique<MergedBlocks>(forest_, *merged_->forest);
-    merged_->solver = std::make_unique<Multigrid>(*merged_->forest, kinds_, false);
+    merged_->solver->set_coefficients(nullptr, nullptr);
     const int blocks = merged_->forest->local_blocks(), cells = merged_spec->block_cells;
     merged_->x.reshape(blocks, cells);
     merged_->rhs.reshape(blocks, cells);
-    return;  // the new solver's coefficients are the reset ones (alpha 0, beta 1)
+    return;  // the solver's coefficients are the reset ones (alpha 0, beta 1)
   }
+  merged_.reset();
   const int n = forest_.local_blocks();
   // Level by level: only the finest level here, the rest on the coarsened forest.
-  coarsened_.reset();
   const bool by_level = composite_ && level_by_level_;
+  if (!by_level) coarsened_.reset();
   if (by_level) levels_.resize(1);
   std::size_t m = 0;
   for (int b = forest_.block_cells(); b >= 1 && !(by_level && m == 1); b /= 2, ++m) {
@@ -904,11 +922,21 @@ void Multigrid::rebuild() {
   }
   shifted_rhs_.reshape(n, forest_.block_cells());
   if (by_level) {
-    coarsened_ = std::make_unique<Coarsened>();
+    // After a regrid the last coarsened forest is adapted to the new one and its solver
+    // rebuilt, so that both keep their storage (fresh pages cost a regrid more than the
+    // copies: docs/performance.md, "Regrids without fresh pages").
+    if (coarsened_) {
+      Coarsened& c = *coarsened_;
+      coarsen_finest_level(forest_, *c.forest);
+      c.solver->rebuild();
+    } else {
+      coarsened_ = std::make_unique<Coarsened>();
+      Coarsened& c = *coarsened_;
+      c.forest = coarsen_finest_level(forest_);
+      c.solver = std::make_unique<Multigrid>(*c.forest, kinds_, merge_blocks_, true);
+    }
     Coarsened& c = *coarsened_;
-    c.forest = coarsen_finest_level(forest_);
     c.transfers = std::make_unique<CoarsenedBlocks>(forest_, *c.forest);
-    c.solver = std::make_unique<Multigrid>(*c.forest, kinds_, merge_blocks_, true);
     const int blocks = c.forest->local_blocks(), b = forest_.block_cells();
     c.x.reshape(blocks, b);
     c.rhs.reshape(blocks, b);

@@ -1606,7 +1606,9 @@ RegridReport NavierStokes::regrid(Forest& forest, std::span<const AdaptFlag> fla
   // divergence this leaves (O(h^2), in those children only).
   average_shared_faces(uf_);
   set_boundary_faces(uf_);
-  BlockField potential(forest_.local_blocks(), forest_.block_cells());
+  // The potential in a scratch field, as set_velocity's (a new field would be fresh pages).
+  BlockField& potential = scratch_[1];
+  potential.fill(0.0);
   report.projection_cycles = project(potential).cycles;
   fill_velocity_ghosts(u_);
   return report;

@@ -242,10 +242,30 @@ TEST(AdaptPoisson, ARebuiltMultigridSolvesAsANewOne) {
     EXPECT_EQ(a.raw(), b.raw()) << grid;
   };
   solve_both("uniform");
+  reused.rebuild();  // the same uniform forest: the merged solver is kept
+  solve_both("uniform, rebuilt");
   testing::refine_where(forest, testing::in_refined_octant);
   ASSERT_FALSE(forest.uniform());
   reused.rebuild();
   solve_both("octant refined");
+  // Other composite forests: the coarsened forest is adapted in place, and its solver
+  // rebuilt (three levels: a chain of two coarsened forests).
+  forest.adapt(
+      [](const Block& block) {
+        return block.level == 3 && block.coord[0] == 0 && block.coord[1] == 0
+                   ? AdaptFlag::Refine
+                   : AdaptFlag::Keep;
+      },
+      {});
+  ASSERT_EQ(forest.max_level(), 4);
+  reused.rebuild();
+  solve_both("a corner refined twice");
+  forest.adapt(
+      [](const Block& block) { return block.level == 4 ? AdaptFlag::Coarsen : AdaptFlag::Keep; },
+      {});
+  ASSERT_EQ(forest.max_level(), 3);
+  reused.rebuild();
+  solve_both("back to the octant");
   forest.adapt(
       [](const Block& block) { return block.level > 2 ? AdaptFlag::Coarsen : AdaptFlag::Keep; },
       {});
