@@ -2,8 +2,10 @@
 // its finest level coarsened, and transfers that are exact where they should be.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <memory>
+#include <vector>
 
 #include "adapt_problems.hpp"
 #include "flow/coarsened_blocks.hpp"
@@ -45,6 +47,40 @@ TEST(CoarsenedBlocks, TheFinestLevelIsCoarsenedAndNothingElse) {
   EXPECT_TRUE(twice->uniform());
   EXPECT_EQ(twice->global_blocks(), 64);
   EXPECT_THROW(coarsen_finest_level(*twice), std::invalid_argument);
+}
+
+TEST(CoarsenedBlocks, ACoarsenedForestAdaptedInPlaceHasTheLeavesOfANewOne) {
+  // What a regrid does (Multigrid::rebuild): the last coarsened forest is adapted to the new
+  // fine forest's target instead of being built from the uniform one.
+  const auto made = three_level_forest();
+  Forest& fine = *made;
+  const auto reused = coarsen_finest_level(fine);
+  const auto leaves = [](const Forest& forest) {
+    std::vector<std::array<std::int64_t, 4>> out;
+    for (int b = 0; b < forest.local_blocks(); ++b) {
+      const Block& block = forest.block(b);
+      out.push_back({block.level, block.coord[0], block.coord[1], block.coord[2]});
+    }
+    return out;
+  };
+  // Refined elsewhere (a corner twice), then back to one level of refinement.
+  fine.adapt(
+      [](const Block& block) { return block.level > 2 ? AdaptFlag::Coarsen : AdaptFlag::Keep; },
+      {});
+  fine.adapt(
+      [](const Block& block) { return block.level == 3 ? AdaptFlag::Coarsen : AdaptFlag::Keep; },
+      {});
+  ASSERT_TRUE(fine.uniform());
+  testing::refine_where(fine, [](const Vec3& c) { return c.x < 0.25 && c.y < 0.25; });
+  testing::refine_where(fine,
+                        [](const Vec3& c) { return c.x < 0.125 && c.y < 0.125 && c.z < 0.5; });
+  ASSERT_EQ(fine.max_level(), 4);
+  coarsen_finest_level(fine, *reused);
+  EXPECT_EQ(leaves(*reused), leaves(*coarsen_finest_level(fine)));
+  EXPECT_EQ(reused->max_level(), 3);
+  testing::refine_where(fine, [](const Vec3& c) { return c.x > 0.75; });
+  coarsen_finest_level(fine, *reused);
+  EXPECT_EQ(leaves(*reused), leaves(*coarsen_finest_level(fine)));
 }
 
 TEST(CoarsenedBlocks, RestrictionAveragesAndCopies) {
