@@ -59,6 +59,19 @@ void for_box(const std::array<int, 3>& n, Body&& body) {
       for (int i = 0; i < n[0]; ++i) body(i, j, k);
 }
 
+/// Copies the box n of block blk (from its cell 0) to out, x fastest.
+void copy_out(const BlockField& f, int blk, const std::array<int, 3>& n, double* out) {
+  std::size_t at = 0;
+  for_box(n, [&](int i, int j, int k) { out[at++] = f(blk, i, j, k); });
+}
+
+/// Writes in, x fastest, into the box n of block blk from offset o.
+void copy_in(const double* in, const std::array<int, 3>& n, const std::array<int, 3>& o,
+             BlockField& f, int blk) {
+  std::size_t at = 0;
+  for_box(n, [&](int i, int j, int k) { f(blk, o[0] + i, o[1] + j, o[2] + k) = in[at++]; });
+}
+
 std::array<int, 3> octant_offset(int octant, int half) {
   return {(octant & 1) * half, ((octant >> 1) & 1) * half, ((octant >> 2) & 1) * half};
 }
@@ -188,11 +201,11 @@ void CoarsenedBlocks::move(Kind kind, int d, Produce&& produce, Consume&& consum
 void CoarsenedBlocks::restrict_cells(const BlockField& fine, BlockField& coarse) const {
   const int b = b_, h = b_ / 2;
   const auto produce = [&](const Link& link, double* out) {
-    std::size_t at = 0;
     if (link.octant < 0) {
-      for_box({b, b, b}, [&](int i, int j, int k) { out[at++] = fine(link.fine, i, j, k); });
+      copy_out(fine, link.fine, {b, b, b}, out);
       return;
     }
+    std::size_t at = 0;
     for_box({h, h, h}, [&](int i, int j, int k) {
       double sum = 0.0;
       for_box({2, 2, 2}, [&](int a, int c, int e) {
@@ -202,15 +215,11 @@ void CoarsenedBlocks::restrict_cells(const BlockField& fine, BlockField& coarse)
     });
   };
   const auto consume = [&](const Link& link, const double* in) {
-    std::size_t at = 0;
     if (link.octant < 0) {
-      for_box({b, b, b}, [&](int i, int j, int k) { coarse(link.coarse, i, j, k) = in[at++]; });
-      return;
+      copy_in(in, {b, b, b}, {0, 0, 0}, coarse, link.coarse);
+    } else {
+      copy_in(in, {h, h, h}, octant_offset(link.octant, h), coarse, link.coarse);
     }
-    const auto o = octant_offset(link.octant, h);
-    for_box({h, h, h}, [&](int i, int j, int k) {
-      coarse(link.coarse, o[0] + i, o[1] + j, o[2] + k) = in[at++];
-    });
   };
   move(Kind::Cells, -1, produce, consume);
 }
@@ -221,11 +230,11 @@ void CoarsenedBlocks::restrict_faces(const BlockField& fine, int d, BlockField& 
   std::array<int, 3> whole{b, b, b};
   whole[D(d)] = b + 1;
   const auto produce = [&](const Link& link, double* out) {
-    std::size_t at = 0;
     if (link.octant < 0) {
-      for_box(whole, [&](int i, int j, int k) { out[at++] = fine(link.fine, i, j, k); });
+      copy_out(fine, link.fine, whole, out);
       return;
     }
+    std::size_t at = 0;
     for_box(child_faces(b, d, link.octant), [&](int i, int j, int k) {
       double sum = 0.0;
       for (int s2 = 0; s2 < 2; ++s2)
@@ -239,15 +248,12 @@ void CoarsenedBlocks::restrict_faces(const BlockField& fine, int d, BlockField& 
     });
   };
   const auto consume = [&](const Link& link, const double* in) {
-    std::size_t at = 0;
     if (link.octant < 0) {
-      for_box(whole, [&](int i, int j, int k) { coarse(link.coarse, i, j, k) = in[at++]; });
-      return;
+      copy_in(in, whole, {0, 0, 0}, coarse, link.coarse);
+    } else {
+      copy_in(in, child_faces(b, d, link.octant), octant_offset(link.octant, h), coarse,
+              link.coarse);
     }
-    const auto o = octant_offset(link.octant, h);
-    for_box(child_faces(b, d, link.octant), [&](int i, int j, int k) {
-      coarse(link.coarse, o[0] + i, o[1] + j, o[2] + k) = in[at++];
-    });
   };
   move(Kind::Faces, d, produce, consume);
 }
@@ -256,11 +262,11 @@ void CoarsenedBlocks::prolong_add(const BlockField& coarse, const BlockField* ac
                                   BlockField& fine) const {
   const int b = b_, h = b_ / 2;
   const auto produce = [&](const Link& link, double* out) {
-    std::size_t at = 0;
     if (link.octant < 0) {
-      for_box({b, b, b}, [&](int i, int j, int k) { out[at++] = coarse(link.coarse, i, j, k); });
+      copy_out(coarse, link.coarse, {b, b, b}, out);
       return;
     }
+    std::size_t at = 0;
     const auto o = octant_offset(link.octant, h);
     for_box({b, b, b}, [&](int i, int j, int k) {
       const WeightedSum sum = trilinear_sum(coarse, active, link.coarse,

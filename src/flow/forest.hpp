@@ -47,6 +47,8 @@ struct ForestSpec {
   Vec3 origin{};                   ///< lower corner of the domain (m)
   int threads = 1;                 ///< OpenMP threads over blocks
   MPI_Comm comm = MPI_COMM_WORLD;  ///< ranks sharing the forest (MPI_COMM_SELF: this rank alone)
+
+  bool operator==(const ForestSpec&) const = default;
 };
 
 /// How a block reaches one of its 26 neighbours.

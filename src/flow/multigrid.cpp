@@ -857,17 +857,6 @@ Multigrid::Multigrid(const Forest& forest, const std::array<BcKind, 6>& kinds, b
   rebuild();
 }
 
-namespace {
-
-bool same_spec(const ForestSpec& a, const ForestSpec& b) {
-  return a.trees == b.trees && a.periodic == b.periodic && a.level == b.level &&
-         a.block_cells == b.block_cells && a.tree_length == b.tree_length &&
-         a.origin.x == b.origin.x && a.origin.y == b.origin.y && a.origin.z == b.origin.z &&
-         a.threads == b.threads && a.comm == b.comm;
-}
-
-}  // namespace
-
 void Multigrid::rebuild() {
   composite_ = !forest_.uniform();
   const auto merged_spec = merge_blocks_ ? merged_forest_spec(forest_) : std::nullopt;
@@ -879,7 +868,7 @@ void Multigrid::rebuild() {
     // A regrid that leaves this forest uniform at the same level (the bottom of the
     // level-by-level chain, most of the time) keeps the merged forest and its solver, and
     // so their storage: only the copies are rebuilt, for this forest's new partition.
-    if (!merged_ || !same_spec(merged_->forest->spec(), *merged_spec)) {
+    if (!merged_ || !(merged_->forest->spec() == *merged_spec)) {
       merged_ = std::make_unique<Merged>();
       merged_->forest = std::make_unique<Forest>(*merged_spec);
       merged_->solver = std::make_unique<Multigrid>(*merged_->forest, kinds_, false);
@@ -925,15 +914,14 @@ void Multigrid::rebuild() {
     // After a regrid the last coarsened forest is adapted to the new one and its solver
     // rebuilt, so that both keep their storage (fresh pages cost a regrid more than the
     // copies: docs/performance.md, "Regrids without fresh pages").
-    if (coarsened_) {
-      Coarsened& c = *coarsened_;
-      coarsen_finest_level(forest_, *c.forest);
-      c.solver->rebuild();
-    } else {
+    if (!coarsened_) {
       coarsened_ = std::make_unique<Coarsened>();
-      Coarsened& c = *coarsened_;
-      c.forest = coarsen_finest_level(forest_);
-      c.solver = std::make_unique<Multigrid>(*c.forest, kinds_, merge_blocks_, true);
+      coarsened_->forest = coarsen_finest_level(forest_);
+      coarsened_->solver =
+          std::make_unique<Multigrid>(*coarsened_->forest, kinds_, merge_blocks_, true);
+    } else {
+      coarsen_finest_level(forest_, *coarsened_->forest);
+      coarsened_->solver->rebuild();
     }
     Coarsened& c = *coarsened_;
     c.transfers = std::make_unique<CoarsenedBlocks>(forest_, *c.forest);
