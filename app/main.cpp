@@ -250,8 +250,8 @@ int main(int argc, char** argv) {
   bench_cmd->add_option(
       "--block-cells", bo.block_cells,
       "flow-cavity: cells per block edge (a power of two; default: as a case file "
-      "without block_cells chooses, 16 where the cells per edge are a multiple of 16 "
-      "and at least 64, else 8)");
+      "without block_cells chooses: 32 where the cells per edge are a multiple of 32 "
+      "and at least 128, else 16 where they are a multiple of 16 and at least 64, else 8)");
   bench_cmd->add_flag("--general-kernels", bo.general_kernels,
                       "flow-cavity: multigrid kernels that read constant coefficients too (A/B)");
   bench_cmd->add_flag("--unmerged-solver", bo.unmerged_solver,

@@ -102,10 +102,17 @@ TEST(FlowCase, ValidCaseResolvesGridBoundariesAndFluid) {
   EXPECT_DOUBLE_EQ(c.options.dt_max, 0.005);
 }
 
-TEST(FlowCase, ALargeGridThatDoesNotAdaptGetsSixteenCellBlocksUnlessTheCaseSetsThem) {
-  // The rule: 16 where the grid does not adapt, every count is a multiple of
-  // 16 and at least 32, and the grid holds 64 such blocks or more; else 8.
+TEST(FlowCase, ALargeGridThatDoesNotAdaptGetsLargerBlocksUnlessTheCaseSetsThem) {
+  // The rule: where the grid does not adapt, 32 where every count is a
+  // multiple of 32 and at least 64 and the grid holds 64 such blocks or more,
+  // else 16 on the same terms; else 8.
   EXPECT_EQ(automatic_block_cells({64, 64, 64}, false), 16);
+  EXPECT_EQ(automatic_block_cells({128, 128, 128}, false), 32);
+  EXPECT_EQ(automatic_block_cells({64, 64, 512}, false), 32);    // 2 x 2 x 16 blocks
+  EXPECT_EQ(automatic_block_cells({128, 128, 64}, false), 16);   // 32 blocks of 32^3
+  EXPECT_EQ(automatic_block_cells({32, 128, 128}, false), 16);   // one 32^3 block along x
+  EXPECT_EQ(automatic_block_cells({144, 128, 128}, false), 16);  // 144 is no multiple of 32
+  EXPECT_EQ(automatic_block_cells({128, 128, 128}, true), 8);
   EXPECT_EQ(automatic_block_cells({32, 64, 128}, false), 16);
   EXPECT_EQ(automatic_block_cells({64, 64, 64}, true), 8);
   EXPECT_EQ(automatic_block_cells({32, 32, 32}, false), 8);    // 8 blocks: too few to share
@@ -148,6 +155,18 @@ TEST(FlowCase, ALargeGridThatDoesNotAdaptGetsSixteenCellBlocksUnlessTheCaseSetsT
   EXPECT_NE(describe(set).find(hint), std::string::npos);
   EXPECT_EQ(describe(set).find("block_cells not given"), std::string::npos);
   EXPECT_EQ(with_blocks(text, 32).forest.block_cells, 32);
+  EXPECT_EQ(block_size_hint(with_blocks(text, 16)), "");
+  // 128^3 cells: 32^3 blocks, and 16 set by the case gets the hint towards 32.
+  const std::string large = replaced(text, "cells = [64, 64, 64]", "cells = [128, 128, 128]");
+  EXPECT_EQ(parse(large).forest.block_cells, 32);
+  EXPECT_NE(describe(parse(large)).find("(block_cells not given: 32, as the grid does not adapt "
+                                        "and makes 64 blocks of 32^3)"),
+            std::string::npos);
+  const FlowCase sixteen = parse(replaced(large, "cells = [128, 128, 128]",
+                                          "cells = [128, 128, 128]\nblock_cells = 16"));
+  EXPECT_EQ(sixteen.forest.block_cells, 16);
+  EXPECT_NE(block_size_hint(sixteen).find("block_cells = 32"), std::string::npos)
+      << block_size_hint(sixteen);
   // Small blocks where the rule would give 8 too (adaptive, or small): no hint.
   EXPECT_EQ(
       block_size_hint(with_blocks(text + "\n[flow.adapt]\nvelocity_threshold_m_s = 1e-3\n", 4)),
