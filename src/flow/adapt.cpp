@@ -180,6 +180,43 @@ void prolong_faces(const BlockField& parent, int parent_blk, const std::array<in
 
 }  // namespace
 
+namespace {
+
+/// p8est_coarsen callback: a family of the level in the forest's user pointer.
+int coarsen_level_callback(p8est_t* forest, p4est_topidx_t /*tree*/, p8est_quadrant_t* family[]) {
+  return family[0]->level == *static_cast<const int*>(forest->user_pointer) ? 1 : 0;
+}
+
+}  // namespace
+
+void Forest::assign_coarsened_finest_level(const Forest& fine) {
+  if (!(fine.spec_ == spec_) || fine.uniform()) {
+    throw std::invalid_argument(
+        "forest: assign_coarsened_finest_level needs a forest of this spec with more than one "
+        "level");
+  }
+  // The copy borrows fine's connectivity; this forest's own is the same brick.
+  std::unique_ptr<p8est_t, P4estObjects::ForestDeleter> copy(
+      p8est_copy(fine.p4est_->forest.get(), 0));
+  copy->connectivity = p4est_->connectivity.get();
+  int top = fine.max_level_;
+  copy->user_pointer = &top;
+  p8est_coarsen_ext(copy.get(), 0, 0, coarsen_level_callback, nullptr, nullptr);
+  copy->user_pointer = nullptr;
+  p4est_->ghost.reset();
+  p4est_->forest = std::move(copy);
+  // Merging the finest level keeps the 2:1 balance: no block there had a neighbour
+  // more than one level coarser, and those of other levels do not change.
+  if (ranks_ > 1) p8est_partition(p4est_->forest.get(), 1, nullptr);
+  families_partitioned_ = true;
+  rebuild_tables();
+  if (max_level_ != top - 1) {
+    throw std::logic_error(
+        "forest: a family of the finest level is split over ranks; adapt() or partition() "
+        "keep them whole");
+  }
+}
+
 bool Forest::adapt(const std::function<AdaptFlag(const Block&)>& decide,
                    std::span<BlockField* const> fields, std::span<FaceField* const> face_fields,
                    int max_level) {

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <map>
-#include <set>
 #include <stdexcept>
 
 #include "flow/payload_exchange.hpp"
@@ -25,30 +24,6 @@ BlockId id_of(const Block& block) {
 
 BlockId parent_of(const BlockId& id) {
   return {id[0] - 1, id[1] >> 1, id[2] >> 1, id[3] >> 1};
-}
-
-/// Every rank's ids, in rank order, with their rank and local number.
-std::map<BlockId, std::pair<int, std::int32_t>> all_blocks(const Forest& forest) {
-  std::vector<std::int64_t> mine;
-  for (int b = 0; b < forest.local_blocks(); ++b) {
-    const BlockId id = id_of(forest.block(b));
-    mine.insert(mine.end(), id.begin(), id.end());
-  }
-  const int ranks = forest.ranks();
-  std::vector<int> counts(D(ranks), 0), offsets(D(ranks), 0);
-  const int count = static_cast<int>(mine.size());
-  MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, forest.comm());
-  for (std::size_t r = 1; r < counts.size(); ++r) offsets[r] = offsets[r - 1] + counts[r - 1];
-  std::vector<std::int64_t> all(D(offsets.back() + counts.back()));
-  MPI_Allgatherv(mine.data(), count, MPI_INT64_T, all.data(), counts.data(), offsets.data(),
-                 MPI_INT64_T, forest.comm());
-  std::map<BlockId, std::pair<int, std::int32_t>> owner;
-  for (int r = 0; r < ranks; ++r)
-    for (int e = 0; e < counts[D(r)]; e += 4) {
-      const auto at = D(offsets[D(r)] + e);
-      owner[{all[at], all[at + 1], all[at + 2], all[at + 3]}] = {r, e / 4};
-    }
-  return owner;
 }
 
 /// Calls body(i, j, k) over the box n (x fastest).
@@ -89,42 +64,13 @@ std::array<int, 3> child_faces(int b, int d, int octant) {
 std::unique_ptr<Forest> coarsen_finest_level(const Forest& fine) {
   if (fine.uniform()) throw std::invalid_argument("coarsen_finest_level: a uniform forest");
   auto coarse = std::make_unique<Forest>(fine.spec());
-  coarsen_finest_level(fine, *coarse);
+  coarse->assign_coarsened_finest_level(fine);
   return coarse;
 }
 
 void coarsen_finest_level(const Forest& fine, Forest& coarse) {
   if (fine.uniform()) throw std::invalid_argument("coarsen_finest_level: a uniform forest");
-  const int top = fine.max_level();
-  // The target's leaves: the fine forest's below the finest level and the parents of its
-  // finest blocks.
-  std::set<BlockId> target;
-  for (const auto& [id, where] : all_blocks(fine)) {
-    target.insert(id[0] == top ? parent_of(id) : id);
-  }
-  const auto under_a_target_leaf = [&](BlockId id) {
-    while (id[0] > 0) {
-      id = parent_of(id);
-      if (target.count(id) != 0) return true;
-    }
-    return false;
-  };
-  // Towards the target, one level per pass each way (from the spec's uniform forest, or
-  // from the last coarsened forest of a regridded one).
-  const int passes = 2 * (std::max(top, coarse.max_level()) + 1);
-  for (int pass = 0; pass < passes; ++pass) {
-    const bool changed = coarse.adapt(
-        [&](const Block& block) {
-          const BlockId id = id_of(block);
-          if (target.count(id) != 0) return AdaptFlag::Keep;
-          return under_a_target_leaf(id) ? AdaptFlag::Coarsen : AdaptFlag::Refine;
-        },
-        {});
-    if (!changed) break;
-  }
-  if (coarse.global_blocks() != static_cast<std::int64_t>(target.size())) {
-    throw std::logic_error("coarsen_finest_level: the coarsened forest missed its target");
-  }
+  coarse.assign_coarsened_finest_level(fine);
 }
 
 CoarsenedBlocks::CoarsenedBlocks(const Forest& fine, const Forest& coarse)
@@ -135,38 +81,46 @@ CoarsenedBlocks::CoarsenedBlocks(const Forest& fine, const Forest& coarse)
         "finest level coarsened");
   }
   const int top = fine.max_level();
-  const auto owner = all_blocks(coarse);
+  // This rank's coarse blocks; a fine block whose coarse block lives elsewhere asks
+  // p8est's partition markers for its rank and names the block by its id.
+  std::map<BlockId, std::int32_t> mine;
+  for (int c = 0; c < coarse.local_blocks(); ++c) mine[id_of(coarse.block(c))] = c;
   const int ranks = fine.ranks();
   send_.assign(D(ranks), {});
   receive_.assign(D(ranks), {});
   local_.assign(D(fine.local_blocks()), Link{});
+  using Header = std::array<std::int32_t, 5>;  // the coarse block's level and coord, octant
+  std::vector<std::vector<Header>> headers(D(ranks));
   for (int f = 0; f < fine.local_blocks(); ++f) {
     const Block& block = fine.block(f);
     const bool child = block.level == top;
-    const auto found = owner.find(child ? parent_of(id_of(block)) : id_of(block));
-    if (found == owner.end()) throw std::logic_error("coarsened blocks: a block has no match");
-    const auto [rank, c] = found->second;
+    const BlockId target = child ? parent_of(id_of(block)) : id_of(block);
     const auto& q = block.coord;
-    const Link link{
-        f, c,
-        child ? static_cast<std::int32_t>((q[0] & 1) | ((q[1] & 1) << 1) | ((q[2] & 1) << 2)) : -1};
-    if (rank == fine.rank()) {
-      local_[D(f)] = link;
-    } else {
-      local_[D(f)] = Link{f, -1, link.octant};
-      send_[D(rank)].push_back(link);
+    const std::int32_t octant =
+        child ? static_cast<std::int32_t>((q[0] & 1) | ((q[1] & 1) << 1) | ((q[2] & 1) << 2)) : -1;
+    if (const auto found = mine.find(target); found != mine.end()) {
+      local_[D(f)] = Link{f, found->second, octant};
+      continue;
     }
+    const int rank =
+        coarse.owner_of(static_cast<int>(target[0]), {target[1], target[2], target[3]});
+    if (rank == fine.rank()) throw std::logic_error("coarsened blocks: a block has no match");
+    local_[D(f)] = Link{f, -1, octant};
+    send_[D(rank)].push_back(local_[D(f)]);
+    headers[D(rank)].push_back(
+        {static_cast<std::int32_t>(target[0]), static_cast<std::int32_t>(target[1]),
+         static_cast<std::int32_t>(target[2]), static_cast<std::int32_t>(target[3]), octant});
   }
   if (ranks == 1) return;
   // Each rank tells the coarse blocks' ranks which (coarse block, octant) its blocks
   // feed, in the order their values will travel.
-  std::vector<std::vector<std::array<std::int32_t, 2>>> headers(D(ranks));
+  const auto received = exchange_headers(fine.comm(), headers);
   for (int r = 0; r < ranks; ++r)
-    for (const Link& link : send_[D(r)]) headers[D(r)].push_back({link.coarse, link.octant});
-  const auto received = exchange_pairs(fine.comm(), headers);
-  for (int r = 0; r < ranks; ++r)
-    for (const auto& [coarse_block, octant] : received[D(r)])
-      receive_[D(r)].push_back(Link{-1, coarse_block, octant});
+    for (const Header& h : received[D(r)]) {
+      const auto found = mine.find({h[0], h[1], h[2], h[3]});
+      if (found == mine.end()) throw std::logic_error("coarsened blocks: a block has no match");
+      receive_[D(r)].push_back(Link{-1, found->second, h[4]});
+    }
 }
 
 int CoarsenedBlocks::payload(const Link& link, Kind kind, int d) const {

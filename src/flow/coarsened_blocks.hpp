@@ -53,8 +53,8 @@ inline WeightedSum trilinear_sum(const BlockField& coarse, const BlockField* act
 /// The forest `fine` with every family of its finest level coarsened (same spec and
 /// ranks; 2:1 balanced as `fine` is). `fine` must not be uniform.
 std::unique_ptr<Forest> coarsen_finest_level(const Forest& fine);
-/// The same by adapting `coarse` (a forest of fine's spec: its uniform start, or the
-/// last coarsened forest of a regridded `fine`) until its leaves are those.
+/// The same into `coarse`, a forest of fine's spec (the last coarsened forest of a
+/// regridded `fine`, whose solver is then rebuilt; Forest::assign_coarsened_finest_level).
 void coarsen_finest_level(const Forest& fine, Forest& coarse);
 
 /// Transfers between a composite forest and coarsen_finest_level() of it.
@@ -74,6 +74,12 @@ class CoarsenedBlocks {
   /// caller), each weight times `active` (1 or 0) of its coarse cell and renormalised
   /// (nullptr: every coarse cell active); nothing where no weight is left.
   void prolong_add(const BlockField& coarse, const BlockField* active, BlockField& fine) const;
+  /// This rank's fine blocks whose coarse block lives on another rank.
+  [[nodiscard]] std::int64_t links_to_other_ranks() const {
+    std::int64_t n = 0;
+    for (const auto& links : send_) n += static_cast<std::int64_t>(links.size());
+    return n;
+  }
 
  private:
   /// One fine block of this rank and where it goes: a coarse block (local on the rank

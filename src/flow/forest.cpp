@@ -54,7 +54,29 @@ Forest::Forest(const ForestSpec& spec) : spec_(spec), p4est_(std::make_unique<P4
       p8est_new_ext(comm_, p4est_->connectivity.get(), 0, spec_.level, 1, 0, nullptr, nullptr));
   p8est_partition(p4est_->forest.get(), 0, nullptr);
   families_partitioned_ = ranks_ == 1;
+  const p8est_connectivity_t& conn = *p4est_->connectivity;
+  p4est_->tree_at.assign(static_cast<std::size_t>(conn.num_trees), 0);
+  for (p4est_topidx_t t = 0; t < conn.num_trees; ++t) {
+    const auto pos = tree_position(conn, t);
+    p4est_->tree_at[static_cast<std::size_t>(
+        pos[0] + spec_.trees[0] * (pos[1] + std::int64_t{spec_.trees[1]} * pos[2]))] = t;
+  }
   rebuild_tables();
+}
+
+int Forest::owner_of(int level, const std::array<std::int64_t, 3>& coord) const {
+  std::array<std::int64_t, 3> tree{};
+  p8est_quadrant_t q{};
+  q.level = static_cast<std::int8_t>(level);
+  const int shift = P8EST_MAXLEVEL - level;
+  for (std::size_t d = 0; d < 3; ++d) {
+    tree[d] = coord[d] >> level;
+    const auto within = static_cast<p4est_qcoord_t>(coord[d] - (tree[d] << level));
+    (d == 0 ? q.x : d == 1 ? q.y : q.z) = within << shift;
+  }
+  const auto t = p4est_->tree_at[static_cast<std::size_t>(
+      tree[0] + spec_.trees[0] * (tree[1] + std::int64_t{spec_.trees[1]} * tree[2]))];
+  return p8est_comm_find_owner(p4est_->forest.get(), t, &q, rank_);
 }
 
 Forest::~Forest() = default;

@@ -275,6 +275,17 @@ class Forest {
   bool adapt(const std::function<AdaptFlag(const Block&)>& decide,
              std::span<BlockField* const> fields, std::span<FaceField* const> face_fields = {},
              int max_level = kForestMaxLevel);
+  /// Makes this forest's leaves those of `fine` with every family of its finest level
+  /// merged into the parent (the multigrid's level-by-level hierarchy,
+  /// coarsened_blocks.hpp), split over the ranks as partition() splits them. `fine` must
+  /// have this forest's spec, more than one level, and its families whole on one rank
+  /// (as adapt() and partition() leave them). Each rank works on its own blocks (a copy
+  /// of `fine`'s p8est, coarsened), and only the repartition talks to the others.
+  /// Fields are not carried.
+  void assign_coarsened_finest_level(const Forest& fine);
+  /// The rank that holds the leaf at (level, coord) of this forest (p8est's partition
+  /// markers; no communication).
+  [[nodiscard]] int owner_of(int level, const std::array<std::int64_t, 3>& coord) const;
 
  private:
   /// exchange(); with finer_face >= 0 only that face of blocks beside finer

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <memory>
 #include <type_traits>
+#include <vector>
 
 #include "flow/forest.hpp"
 
@@ -31,6 +32,8 @@ struct Forest::P4estObjects {
   std::unique_ptr<p8est_connectivity_t, ConnectivityDeleter> connectivity;
   std::unique_ptr<p8est_t, ForestDeleter> forest;
   std::unique_ptr<p8est_ghost_t, GhostDeleter> ghost;
+  /// The tree at each brick position, x fastest (Forest::owner_of).
+  std::vector<p4est_topidx_t> tree_at;
 };
 
 /// Integer position of tree t in the brick (its lowest vertex).

@@ -118,7 +118,7 @@ MergedBlocks::MergedBlocks(const Forest& fine, const Forest& merged)
   std::vector<std::vector<std::array<std::int32_t, 2>>> headers(D(ranks));
   for (int r = 0; r < ranks; ++r)
     for (const Child& child : send_[D(r)]) headers[D(r)].push_back({child.merged, child.octant});
-  const auto received = exchange_pairs(fine.comm(), headers);
+  const auto received = exchange_headers(fine.comm(), headers);
   for (int r = 0; r < ranks; ++r)
     for (const auto& [merged, octant] : received[D(r)])
       receive_[D(r)].push_back(Child{-1, merged, octant});

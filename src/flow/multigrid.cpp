@@ -911,8 +911,8 @@ void Multigrid::rebuild() {
   }
   shifted_rhs_.reshape(n, forest_.block_cells());
   if (by_level) {
-    // After a regrid the last coarsened forest is adapted to the new one and its solver
-    // rebuilt, so that both keep their storage (fresh pages cost a regrid more than the
+    // After a regrid the last coarsened forest takes the new one's coarsened leaves and its
+    // solver is rebuilt, so that both keep their storage (fresh pages cost a regrid more than the
     // copies: docs/performance.md, "Regrids without fresh pages").
     if (!coarsened_) {
       coarsened_ = std::make_unique<Coarsened>();

@@ -12,18 +12,21 @@
 
 namespace sanguis::flow {
 
-/// Pairs of numbers, each rank's outgoing[r] sent to rank r in order; returns, per rank,
-/// what that rank sent here, in its order. The headers that tell the receiving side which
-/// block (and octant) each payload of exchange_payloads() is for.
-inline std::vector<std::vector<std::array<std::int32_t, 2>>> exchange_pairs(
-    MPI_Comm comm, const std::vector<std::vector<std::array<std::int32_t, 2>>>& outgoing) {
+/// Headers of N numbers, each rank's outgoing[r] sent to rank r in order; returns, per
+/// rank, what that rank sent here, in its order. They tell the receiving side which block
+/// (and octant) each payload of exchange_payloads() is for.
+template <std::size_t N>
+std::vector<std::vector<std::array<std::int32_t, N>>> exchange_headers(
+    MPI_Comm comm, const std::vector<std::vector<std::array<std::int32_t, N>>>& outgoing) {
   const std::size_t ranks = outgoing.size();
+  constexpr int kN = static_cast<int>(N);
   std::vector<int> send_counts(ranks, 0), receive_counts(ranks, 0);
   std::vector<int> send_offsets(ranks, 0), receive_offsets(ranks, 0);
   std::vector<std::int32_t> headers;
   for (std::size_t r = 0; r < ranks; ++r) {
-    send_counts[r] = 2 * static_cast<int>(outgoing[r].size());
-    for (const auto& pair : outgoing[r]) headers.insert(headers.end(), pair.begin(), pair.end());
+    send_counts[r] = kN * static_cast<int>(outgoing[r].size());
+    for (const auto& header : outgoing[r])
+      headers.insert(headers.end(), header.begin(), header.end());
   }
   MPI_Alltoall(send_counts.data(), 1, MPI_INT, receive_counts.data(), 1, MPI_INT, comm);
   for (std::size_t r = 1; r < ranks; ++r) {
@@ -34,11 +37,13 @@ inline std::vector<std::vector<std::array<std::int32_t, 2>>> exchange_pairs(
       static_cast<std::size_t>(receive_offsets.back() + receive_counts.back()));
   MPI_Alltoallv(headers.data(), send_counts.data(), send_offsets.data(), MPI_INT32_T,
                 received.data(), receive_counts.data(), receive_offsets.data(), MPI_INT32_T, comm);
-  std::vector<std::vector<std::array<std::int32_t, 2>>> incoming(ranks);
+  std::vector<std::vector<std::array<std::int32_t, N>>> incoming(ranks);
   for (std::size_t r = 0; r < ranks; ++r)
-    for (int e = 0; e < receive_counts[r]; e += 2) {
+    for (int e = 0; e < receive_counts[r]; e += kN) {
       const auto at = static_cast<std::size_t>(receive_offsets[r] + e);
-      incoming[r].push_back({received[at], received[at + 1]});
+      std::array<std::int32_t, N> header;
+      for (std::size_t n = 0; n < N; ++n) header[n] = received[at + n];
+      incoming[r].push_back(header);
     }
   return incoming;
 }

@@ -4,13 +4,16 @@
 // ghosts across ranks and the data moved by adapt/partition must be exact
 // for linear fields; Navier-Stokes on a refined forest must give the
 // one-rank answer. Exit status 0 when all hold.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "adapt_poisson.hpp"
 #include "flow/adapt_criterion.hpp"
+#include "flow/coarsened_blocks.hpp"
 #include "flow/merged_blocks.hpp"
 #include "flow/mpi_session.hpp"
 #include "flow/navier_stokes.hpp"
@@ -241,6 +244,95 @@ int check_adaptive_ghosts() {
              : 1;
 }
 
+/// The multigrid's coarsened forest (coarsened_blocks.hpp) on several ranks: a forest
+/// refined twice around its centre, coarsened level by level, must have
+/// the one-rank forest's leaves; a linear field restricted into it must be exact (the mean
+/// of the children is the value at the parent's centre) and a linear correction prolonged
+/// back adds exactly, across ranks where a coarse block lies on another rank than its
+/// children, which the repartition makes happen here on 3 ranks (ctest's "adaptive" run;
+/// on 2 every parent stays with its children).
+int check_coarsened_blocks() {
+  auto linear = [](const sanguis::Vec3& x) { return 1.0 - 2.0 * x.x + 0.5 * x.y + 3.0 * x.z; };
+  const auto leaves = [](const Forest& forest) {
+    std::vector<double> ids;
+    for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+      const Block& block = forest.block(blk);
+      ids.push_back(block.level);
+      for (const auto c : block.coord) ids.push_back(static_cast<double>(c));
+    }
+    // Every rank's leaves, in rank order (rank 0's first).
+    int count = static_cast<int>(ids.size());
+    std::vector<int> counts(static_cast<std::size_t>(forest.ranks())), offsets(counts.size(), 0);
+    MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, forest.comm());
+    for (std::size_t r = 1; r < counts.size(); ++r) offsets[r] = offsets[r - 1] + counts[r - 1];
+    std::vector<double> all(static_cast<std::size_t>(offsets.back() + counts.back()));
+    MPI_Allgatherv(ids.data(), count, MPI_DOUBLE, all.data(), counts.data(), offsets.data(),
+                   MPI_DOUBLE, forest.comm());
+    return all;
+  };
+  const auto build = [&](MPI_Comm comm) {
+    ForestSpec spec;
+    spec.level = 2;
+    spec.block_cells = 4;
+    spec.comm = comm;
+    auto forest = std::make_unique<Forest>(spec);
+    // Refined away from the domain faces, so that every parent's ghost ring, which the
+    // prolongation reads, is filled by the exchange.
+    const auto within = [](double lo, double hi) {
+      return [lo, hi](const sanguis::Vec3& c) {
+        return c.x > lo && c.x < hi && c.y > lo && c.y < hi && c.z > lo && c.z < hi;
+      };
+    };
+    testing::refine_where(*forest, within(0.25, 0.75));
+    testing::refine_where(*forest, within(0.375, 0.625));
+    return forest;
+  };
+  const auto shared = build(MPI_COMM_WORLD), alone = build(MPI_COMM_SELF);
+  double worst = 0.0, other_ranks = 0.0;
+  bool same_leaves = true;
+  const Forest* fine_shared = shared.get();
+  const Forest* fine_alone = alone.get();
+  std::vector<std::unique_ptr<Forest>> chain;
+  while (!fine_shared->uniform()) {
+    auto coarse_shared = coarsen_finest_level(*fine_shared);
+    auto coarse_alone = coarsen_finest_level(*fine_alone);
+    same_leaves = same_leaves && leaves(*coarse_shared) == leaves(*coarse_alone);
+    const CoarsenedBlocks transfers(*fine_shared, *coarse_shared);
+    other_ranks += fine_shared->sum(static_cast<double>(transfers.links_to_other_ranks()));
+    BlockField fine(fine_shared->local_blocks(), 4), coarse(coarse_shared->local_blocks(), 4);
+    BlockField expected(coarse_shared->local_blocks(), 4);
+    testing::fill_cells(*fine_shared, fine, linear);
+    testing::fill_cells(*coarse_shared, expected, linear);
+    transfers.restrict_cells(fine, coarse);
+    for (std::size_t n = 0; n < coarse.raw().size(); ++n)
+      worst = std::max(worst, std::abs(coarse.raw()[n] - expected.raw()[n]));
+    // The correction prolonged back onto zero: the linear field again (the coarse
+    // ghost ring from the exchange, as the multigrid fills it).
+    coarse_shared->exchange(expected, 1);
+    BlockField back(fine_shared->local_blocks(), 4), exact(fine_shared->local_blocks(), 4);
+    testing::fill_cells(*fine_shared, exact, linear);
+    transfers.prolong_add(expected, nullptr, back);
+    for (int blk = 0; blk < fine_shared->local_blocks(); ++blk)
+      for (int k = 0; k < 4; ++k)
+        for (int j = 0; j < 4; ++j)
+          for (int i = 0; i < 4; ++i)
+            worst = std::max(worst, std::abs(back(blk, i, j, k) - exact(blk, i, j, k)));
+    chain.push_back(std::move(coarse_shared));
+    chain.push_back(std::move(coarse_alone));
+    fine_shared = chain[chain.size() - 2].get();
+    fine_alone = chain.back().get();
+  }
+  worst = shared->max(worst);
+  const auto& session = MpiSession::ensure();
+  if (session.rank() == 0) {
+    std::printf(
+        "coarsened forests (%zu levels coarsened): leaves as on one rank %s, linear field "
+        "restricted and prolonged %.3e, %g fine blocks feeding a coarse block on another rank\n",
+        chain.size() / 2, same_leaves ? "yes" : "NO", worst, other_ranks);
+  }
+  return same_leaves && worst <= 1e-13 && (session.size() != 3 || other_ranks > 0.0) ? 0 : 1;
+}
+
 /// Navier-Stokes on the forest with a refined octant (ABC flow, a tracer):
 /// 2 ranks against 1, the fine faces' values crossing ranks at coarse-fine faces.
 int check_refined_navier_stokes() {
@@ -381,7 +473,9 @@ int main(int argc, char** argv) {
   MpiSession::ensure();
   // "adaptive": only the adaptive run (ctest also runs it on 3 ranks, whose
   // even first split differs from adapt()'s family-keeping one).
-  if (argc > 1 && std::string(argv[1]) == "adaptive") return check_adaptive_navier_stokes();
+  if (argc > 1 && std::string(argv[1]) == "adaptive") {
+    return check_coarsened_blocks() + check_adaptive_navier_stokes() == 0 ? 0 : 1;
+  }
   // "merged": only the solves on merged blocks (ctest runs them on 3 ranks too,
   // where merged blocks and their children's blocks lie on different ranks).
   if (argc > 1 && std::string(argv[1]) == "merged") {
@@ -390,6 +484,6 @@ int main(int argc, char** argv) {
   const int failures = check(true, 16) + check(false, 16) + check(true, 32) + check(false, 32) +
                        check_navier_stokes(1) + check_navier_stokes(2) + check_adaptive_ghosts() +
                        check_refined(true) + check_refined(false) + check_refined_navier_stokes() +
-                       check_adaptive_navier_stokes();
+                       check_coarsened_blocks() + check_adaptive_navier_stokes();
   return failures == 0 ? 0 : 1;
 }

@@ -50,8 +50,8 @@ TEST(CoarsenedBlocks, TheFinestLevelIsCoarsenedAndNothingElse) {
 }
 
 TEST(CoarsenedBlocks, ACoarsenedForestAdaptedInPlaceHasTheLeavesOfANewOne) {
-  // What a regrid does (Multigrid::rebuild): the last coarsened forest is adapted to the new
-  // fine forest's target instead of being built from the uniform one.
+  // What a regrid does (Multigrid::rebuild): the last coarsened forest takes the new fine
+  // forest's coarsened leaves instead of a new forest being built.
   const auto made = three_level_forest();
   Forest& fine = *made;
   const auto reused = coarsen_finest_level(fine);

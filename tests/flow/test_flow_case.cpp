@@ -159,11 +159,12 @@ TEST(FlowCase, ALargeGridThatDoesNotAdaptGetsLargerBlocksUnlessTheCaseSetsThem) 
   // 128^3 cells: 32^3 blocks, and 16 set by the case gets the hint towards 32.
   const std::string large = replaced(text, "cells = [64, 64, 64]", "cells = [128, 128, 128]");
   EXPECT_EQ(parse(large).forest.block_cells, 32);
-  EXPECT_NE(describe(parse(large)).find("(block_cells not given: 32, as the grid does not adapt "
-                                        "and makes 64 blocks of 32^3)"),
+  EXPECT_NE(describe(parse(large))
+                .find("(block_cells not given: 32, as the grid does not adapt "
+                      "and makes 64 blocks of 32^3)"),
             std::string::npos);
-  const FlowCase sixteen = parse(replaced(large, "cells = [128, 128, 128]",
-                                          "cells = [128, 128, 128]\nblock_cells = 16"));
+  const FlowCase sixteen = parse(
+      replaced(large, "cells = [128, 128, 128]", "cells = [128, 128, 128]\nblock_cells = 16"));
   EXPECT_EQ(sixteen.forest.block_cells, 16);
   EXPECT_NE(block_size_hint(sixteen).find("block_cells = 32"), std::string::npos)
       << block_size_hint(sixteen);
