@@ -336,7 +336,6 @@ double viscosity_at(const FlowCase& c, const Vec3& x) {
 
 namespace {
 
-/// Whether the cell counts allow 16^3 blocks, two or more per direction, 64 or more in all.
 /// Whether the cell counts make 64 blocks of b^3 or more, two or more per direction.
 bool blocks_fit(const std::array<int, 3>& cells, int b) {
   const bool fit =
