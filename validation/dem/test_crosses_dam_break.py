@@ -1,5 +1,6 @@
 """Unit tests of crosses_dam_break's end of a collapse (run by ctest
 ValidationScripts.DemHelpers)."""
+import math
 import os
 import sys
 import tempfile
@@ -19,6 +20,59 @@ def fake_run(folder, log_lines, rows):
     with open(os.path.join(folder, "diagnostics.csv"), "w") as f:
         f.write(HEADER + "".join(f"{t},{v}\n" for t, v in rows))
     return folder
+
+
+def fake_pour(folder, count, log_lines, rows):
+    """fake_run with a checkpoint and a last frame of `count` crosses."""
+    fake_run(folder, log_lines, rows)
+    open(os.path.join(folder, "checkpoint.bin"), "w").close()
+    os.makedirs(os.path.join(folder, "particles"), exist_ok=True)
+    with open(os.path.join(folder, "particles", "particles_00000001.vtu"), "w") as f:
+        f.write(f'<Piece NumberOfPoints="{count}" NumberOfCells="0">')
+
+
+class EndOfPour(unittest.TestCase):
+    def setUp(self):
+        self.calls = []
+        self.saved = db.gate_runner
+        db.gate_runner = lambda *args, **kwargs: (
+            lambda end, more=(): self.calls.append((end, list(more))))
+
+    def tearDown(self):
+        db.gate_runner = self.saved
+
+    def test_a_pour_stops_at_rest_after_its_last_cross_is_due(self):
+        col = db.Column(4, 1300)
+        due = 1300 / db.pour_rate(col)
+        self.assertEqual(db.pour_stop_settings(col),
+                         ["--set", "stop.mean_velocity_below_m_s=1e-3",
+                          "--set", f"stop.check_after_s={due + db.POUR_REST_AFTER_S:.4f}"])
+        self.assertLess(db.POUR_REST_AFTER_S, db.SETTLE_S)
+
+    def test_pours_that_ended_are_taken_as_they_are(self):
+        col = db.Column(4, 1300)
+        end = math.ceil(10 * (1300 / db.pour_rate(col) + db.SETTLE_S)) / 10  # the SETTLE_S end
+        with tempfile.TemporaryDirectory() as d:
+            # Ended at its SETTLE_S end (before the stop at rest): opens there, as it did.
+            fake_pour(d, 1300, [f"done: t = {end} s, 9 steps in 1s"], [(end, 1e-5)])
+            self.assertAlmostEqual(db.pour_gate("sanguis", col, d, 1), end)
+            # Ended at rest before it: opens where it stopped.
+            fake_pour(d, 1300, ["done: t = 3.45 s, 9 steps in 1s, settled"], [(3.45, 2e-4)])
+            self.assertAlmostEqual(db.pour_gate("sanguis", col, d, 1), 3.45)
+        self.assertEqual(self.calls, [])
+
+    def test_a_pour_on_the_way_goes_on_with_the_stop_at_rest(self):
+        col = db.Column(4, 1300)
+        with tempfile.TemporaryDirectory() as d:
+            fake_pour(d, 1300, ["checkpoint: t = 2.5 s, 9 steps in 1s"], [(2.5, 0.02)])
+
+            def advance(end, more=()):
+                self.calls.append((end, list(more)))
+                fake_pour(d, 1300, ["done: t = 2.8 s, 9 steps in 1s, settled"], [(2.8, 5e-4)])
+            db.gate_runner = lambda *args, **kwargs: advance
+            self.assertAlmostEqual(db.pour_gate("sanguis", col, d, 1), 2.8)
+        self.assertEqual(len(self.calls), 1)
+        self.assertEqual(self.calls[0][1], db.pour_stop_settings(col))
 
 
 class EndOfCollapse(unittest.TestCase):
