@@ -78,50 +78,42 @@ MergedBlocks::MergedBlocks(const Forest& fine, const Forest& merged)
     throw std::invalid_argument("merged blocks: the forests are not a uniform one and its merge");
   }
   const int ranks = fine.ranks();
-  const auto n = merged.blocks_per_direction(merged.max_level());
-  // Every merged block's rank and local number, by key.
-  std::vector<std::int64_t> mine;
-  for (int m = 0; m < merged.local_blocks(); ++m) {
-    mine.push_back(block_key(merged.block(m).coord, n));
-  }
-  std::vector<int> counts(static_cast<std::size_t>(ranks), 0), offsets(counts.size(), 0);
-  const int count = static_cast<int>(mine.size());
-  MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, fine.comm());
-  for (std::size_t r = 1; r < counts.size(); ++r) offsets[r] = offsets[r - 1] + counts[r - 1];
-  std::vector<std::int64_t> all(static_cast<std::size_t>(offsets.back() + counts.back()));
-  MPI_Allgatherv(mine.data(), count, MPI_INT64_T, all.data(), counts.data(), offsets.data(),
-                 MPI_INT64_T, fine.comm());
-  std::unordered_map<std::int64_t, std::pair<int, std::int32_t>> owner;
-  for (int r = 0; r < ranks; ++r)
-    for (int m = 0; m < counts[D(r)]; ++m) {
-      owner[all[static_cast<std::size_t>(offsets[D(r)] + m)]] = {r, m};
-    }
-
+  const int level = merged.max_level();
+  const auto n = merged.blocks_per_direction(level);
+  // This rank's merged blocks, by key; a family whose merged block lives elsewhere asks
+  // p8est's partition markers for its rank and names the block by its coordinates.
+  std::unordered_map<std::int64_t, std::int32_t> mine;
+  for (int m = 0; m < merged.local_blocks(); ++m) mine[block_key(merged.block(m).coord, n)] = m;
   send_.assign(static_cast<std::size_t>(ranks), {});
   receive_.assign(static_cast<std::size_t>(ranks), {});
   local_.assign(static_cast<std::size_t>(fine.local_blocks()), Child{-1, -1, 0});
+  using Header = std::array<std::int32_t, 4>;  // the merged block's coord, octant
+  std::vector<std::vector<Header>> headers(D(ranks));
   for (int blk = 0; blk < fine.local_blocks(); ++blk) {
     const auto& c = fine.block(blk).coord;
-    const auto found = owner.find(block_key({c[0] >> 1, c[1] >> 1, c[2] >> 1}, n));
-    if (found == owner.end()) throw std::logic_error("merged blocks: a family has no merged block");
-    const auto [rank, m] = found->second;
-    const Child child{blk, m, octant_of(c)};
-    if (rank == fine.rank()) {
-      local_[D(blk)] = child;
-    } else {
-      send_[D(rank)].push_back(child);
+    const std::array<std::int64_t, 3> parent{c[0] >> 1, c[1] >> 1, c[2] >> 1};
+    if (const auto found = mine.find(block_key(parent, n)); found != mine.end()) {
+      local_[D(blk)] = Child{blk, found->second, octant_of(c)};
+      continue;
     }
+    const int rank = merged.owner_of(level, parent);
+    if (rank == fine.rank()) throw std::logic_error("merged blocks: a family has no merged block");
+    send_[D(rank)].push_back(Child{blk, -1, octant_of(c)});
+    headers[D(rank)].push_back({static_cast<std::int32_t>(parent[0]),
+                                static_cast<std::int32_t>(parent[1]),
+                                static_cast<std::int32_t>(parent[2]), octant_of(c)});
   }
   if (ranks == 1) return;
   // Each rank tells the merged blocks' ranks which (merged block, octant) its
   // children fill, in the order their values will travel.
-  std::vector<std::vector<std::array<std::int32_t, 2>>> headers(D(ranks));
-  for (int r = 0; r < ranks; ++r)
-    for (const Child& child : send_[D(r)]) headers[D(r)].push_back({child.merged, child.octant});
   const auto received = exchange_headers(fine.comm(), headers);
   for (int r = 0; r < ranks; ++r)
-    for (const auto& [merged, octant] : received[D(r)])
-      receive_[D(r)].push_back(Child{-1, merged, octant});
+    for (const Header& h : received[D(r)]) {
+      const auto found = mine.find(block_key({h[0], h[1], h[2]}, n));
+      if (found == mine.end())
+        throw std::logic_error("merged blocks: a family has no merged block");
+      receive_[D(r)].push_back(Child{-1, found->second, h[3]});
+    }
 }
 
 template <bool kToMerged>
