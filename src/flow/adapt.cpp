@@ -190,15 +190,18 @@ int coarsen_level_callback(p8est_t* forest, p4est_topidx_t /*tree*/, p8est_quadr
 }  // namespace
 
 void Forest::assign_coarsened_finest_level(const Forest& fine) {
-  if (!(fine.spec_ == spec_) || fine.uniform()) {
+  if (!(fine.spec_ == spec_) || fine.max_level_ == 0) {
     throw std::invalid_argument(
-        "forest: assign_coarsened_finest_level needs a forest of this spec with more than one "
-        "level");
+        "forest: assign_coarsened_finest_level needs a forest of this spec with blocks below "
+        "its trees");
   }
   // The copy borrows fine's connectivity; this forest's own is the same brick.
   std::unique_ptr<p8est_t, P4estObjects::ForestDeleter> copy(
       p8est_copy(fine.p4est_->forest.get(), 0));
   copy->connectivity = p4est_->connectivity.get();
+  // A forest split evenly (as built, not yet adapted) may split a family over two ranks:
+  // the copy is split as partition() splits it first (it carries no data).
+  if (ranks_ > 1 && !fine.families_partitioned_) p8est_partition(copy.get(), 1, nullptr);
   int top = fine.max_level_;
   copy->user_pointer = &top;
   p8est_coarsen_ext(copy.get(), 0, 0, coarsen_level_callback, nullptr, nullptr);

@@ -62,20 +62,20 @@ std::array<int, 3> child_faces(int b, int d, int octant) {
 }  // namespace
 
 std::unique_ptr<Forest> coarsen_finest_level(const Forest& fine) {
-  if (fine.uniform()) throw std::invalid_argument("coarsen_finest_level: a uniform forest");
+  if (fine.max_level() == 0) throw std::invalid_argument("coarsen_finest_level: only trees");
   auto coarse = std::make_unique<Forest>(fine.spec());
   coarse->assign_coarsened_finest_level(fine);
   return coarse;
 }
 
 void coarsen_finest_level(const Forest& fine, Forest& coarse) {
-  if (fine.uniform()) throw std::invalid_argument("coarsen_finest_level: a uniform forest");
+  if (fine.max_level() == 0) throw std::invalid_argument("coarsen_finest_level: only trees");
   coarse.assign_coarsened_finest_level(fine);
 }
 
 CoarsenedBlocks::CoarsenedBlocks(const Forest& fine, const Forest& coarse)
     : fine_(fine), b_(fine.block_cells()) {
-  if (coarse.block_cells() != b_ || fine.uniform() || coarse.max_level() + 1 != fine.max_level()) {
+  if (coarse.block_cells() != b_ || coarse.max_level() + 1 != fine.max_level()) {
     throw std::invalid_argument(
         "coarsened blocks: the forests are not a composite one and its "
         "finest level coarsened");

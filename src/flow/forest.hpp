@@ -278,10 +278,10 @@ class Forest {
   /// Makes this forest's leaves those of `fine` with every family of its finest level
   /// merged into the parent (the multigrid's level-by-level hierarchy,
   /// coarsened_blocks.hpp), split over the ranks as partition() splits them. `fine` must
-  /// have this forest's spec, more than one level, and its families whole on one rank
-  /// (as adapt() and partition() leave them). Each rank works on its own blocks (a copy
-  /// of `fine`'s p8est, coarsened), and only the repartition talks to the others.
-  /// Fields are not carried.
+  /// have this forest's spec and blocks below its trees' level. Each rank works on its own
+  /// blocks (a copy of `fine`'s p8est, coarsened; the families are whole on one rank as
+  /// adapt() and partition() leave them, and a copy of a forest split evenly is split so
+  /// first), and only the repartitions talk to the others. Fields are not carried.
   void assign_coarsened_finest_level(const Forest& fine);
   /// The rank that holds the leaf at (level, coord) of this forest (p8est's partition
   /// markers; no communication).

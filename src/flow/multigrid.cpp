@@ -842,8 +842,12 @@ double MultigridReport::mean_reduction() const {
 }
 
 Multigrid::Multigrid(const Forest& forest, const std::array<BcKind, 6>& kinds, bool merge_blocks,
-                     bool level_by_level)
-    : forest_(forest), kinds_(kinds), merge_blocks_(merge_blocks), level_by_level_(level_by_level) {
+                     bool level_by_level, std::int64_t gathered_blocks_limit)
+    : forest_(forest),
+      kinds_(kinds),
+      merge_blocks_(merge_blocks),
+      level_by_level_(level_by_level),
+      gathered_blocks_limit_(gathered_blocks_limit) {
   homogeneous_.kind = kinds;
   for (int d = 0; d < 3; ++d) {
     const bool periodic = forest.spec().periodic[D(d)];
@@ -871,7 +875,8 @@ void Multigrid::rebuild() {
     if (!merged_ || !(merged_->forest->spec() == *merged_spec)) {
       merged_ = std::make_unique<Merged>();
       merged_->forest = std::make_unique<Forest>(*merged_spec);
-      merged_->solver = std::make_unique<Multigrid>(*merged_->forest, kinds_, false);
+      merged_->solver = std::make_unique<Multigrid>(*merged_->forest, kinds_, false,
+                                                    level_by_level_, gathered_blocks_limit_);
     }
     merged_->copies = std::make_unique<MergedBlocks>(forest_, *merged_->forest);
     merged_->solver->set_coefficients(nullptr, nullptr);
@@ -882,8 +887,11 @@ void Multigrid::rebuild() {
   }
   merged_.reset();
   const int n = forest_.local_blocks();
-  // Level by level: only the finest level here, the rest on the coarsened forest.
-  const bool by_level = composite_ && level_by_level_;
+  // Level by level: only the finest level here, the rest on the coarsened forest. A
+  // uniform forest too when its blocks would make the gathered bottom solve too large.
+  const bool too_many_blocks = forest_.uniform() && forest_.max_level() >= 1 &&
+                               forest_.global_blocks() > gathered_blocks_limit_;
+  const bool by_level = level_by_level_ && (composite_ || too_many_blocks);
   if (!by_level) coarsened_.reset();
   if (by_level) levels_.resize(1);
   std::size_t m = 0;
@@ -917,8 +925,8 @@ void Multigrid::rebuild() {
     if (!coarsened_) {
       coarsened_ = std::make_unique<Coarsened>();
       coarsened_->forest = coarsen_finest_level(forest_);
-      coarsened_->solver =
-          std::make_unique<Multigrid>(*coarsened_->forest, kinds_, merge_blocks_, true);
+      coarsened_->solver = std::make_unique<Multigrid>(*coarsened_->forest, kinds_, merge_blocks_,
+                                                       true, gathered_blocks_limit_);
     } else {
       coarsen_finest_level(forest_, *coarsened_->forest);
       coarsened_->solver->rebuild();

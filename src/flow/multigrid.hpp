@@ -136,8 +136,20 @@ class Multigrid {
   /// its finest level coarsened (coarsened_blocks.hpp), and so on down to a uniform forest,
   /// whose blocks then halve their cells; false: every block halves its own cells from the
   /// finest level on (the block-by-block hierarchy, for comparisons).
+  /// gathered_blocks_limit: a uniform forest whose blocks outnumber it (and that is not at
+  /// the trees' level) coarsens level by level as well, down to where they do not: the
+  /// bottom of the in-block levels, one cell per block, is gathered on every rank and
+  /// solved there, which must stay small however many ranks share the grid.
   Multigrid(const Forest& forest, const std::array<BcKind, 6>& kinds, bool merge_blocks = true,
-            bool level_by_level = true);
+            bool level_by_level = true, std::int64_t gathered_blocks_limit = kGatheredBlocksLimit);
+  /// The default gathered_blocks_limit: 4096 unknowns in the bottom solve (a 16^3 grid of
+  /// blocks, 512^3 cells of 32^3 blocks).
+  static constexpr std::int64_t kGatheredBlocksLimit = 4096;
+  /// Forests below this one in the level-by-level hierarchy (0: none).
+  [[nodiscard]] int coarsened_forests() const {
+    if (merged_) return merged_->solver->coarsened_forests();
+    return coarsened_ ? 1 + coarsened_->solver->coarsened_forests() : 0;
+  }
 
   /// After the forest has changed (Forest::adapt): the levels for its new
   /// blocks, in the storage of the old ones where it is large enough, and
@@ -319,6 +331,7 @@ class Multigrid {
   };
   std::unique_ptr<Coarsened> coarsened_;
   bool level_by_level_ = true;
+  std::int64_t gathered_blocks_limit_ = kGatheredBlocksLimit;
   ScalarBoundary homogeneous_;  ///< kinds_, zero values
   bool has_alpha_ = false;
   bool singular_ = false;

@@ -44,6 +44,39 @@ std::vector<double> gathered(const Forest& forest, const BlockField& field) {
   return all;
 }
 
+/// Poisson on 32^3 cells of 4^3 blocks with the forest coarsened level by level down to its
+/// tree (Multigrid's gathered_blocks_limit 0) instead of the in-block levels' gathered
+/// bottom: several ranks against one. The forest as built is split evenly, so a family of
+/// blocks may lie on two ranks until the coarsened copy is repartitioned.
+int check_forest_levels(bool periodic) {
+  auto run = [&](MPI_Comm comm, std::vector<double>& values) {
+    ForestSpec spec;
+    spec.periodic = {periodic, periodic, periodic};
+    spec.block_cells = 4;
+    spec.level = 3;
+    spec.comm = comm;
+    const Forest forest(spec);
+    auto result = testing::solve_manufactured(periodic, 32, comm, 1e-13, 4, 0);
+    values = gathered(forest, result.solution);
+    return result;
+  };
+  std::vector<double> shared, alone;
+  const auto r2 = run(MPI_COMM_WORLD, shared);
+  const auto r1 = run(MPI_COMM_SELF, alone);
+  double diff = 0.0;
+  for (std::size_t i = 0; i < shared.size(); ++i)
+    diff = std::max(diff, std::abs(shared[i] - alone[i]));
+  const auto& session = MpiSession::ensure();
+  if (session.rank() == 0) {
+    std::printf(
+        "%s 32^3 on 4^3 blocks, %d forests coarsened below: %d ranks vs 1: max difference "
+        "%.3e, errors %.6e / %.6e, cycles %d / %d\n",
+        periodic ? "periodic" : "Dirichlet", r2.coarsened_forests, session.size(), diff, r2.error,
+        r1.error, r2.report.cycles, r1.report.cycles);
+  }
+  return diff <= 1e-11 && r2.coarsened_forests == 2 && r1.coarsened_forests == 2 ? 0 : 1;
+}
+
 /// Poisson on `cells`^3 (blocks of 8^3): 16^3 solves on the blocks, 32^3 on
 /// their families merged (Multigrid::merged), whose blocks lie on other
 /// ranks than their children's.
@@ -479,11 +512,16 @@ int main(int argc, char** argv) {
   // "merged": only the solves on merged blocks (ctest runs them on 3 ranks too,
   // where merged blocks and their children's blocks lie on different ranks).
   if (argc > 1 && std::string(argv[1]) == "merged") {
-    return check(true, 32) + check(false, 32) + check_navier_stokes(2) == 0 ? 0 : 1;
+    return check(true, 32) + check(false, 32) + check_navier_stokes(2) + check_forest_levels(true) +
+                       check_forest_levels(false) ==
+                   0
+               ? 0
+               : 1;
   }
   const int failures = check(true, 16) + check(false, 16) + check(true, 32) + check(false, 32) +
                        check_navier_stokes(1) + check_navier_stokes(2) + check_adaptive_ghosts() +
                        check_refined(true) + check_refined(false) + check_refined_navier_stokes() +
-                       check_coarsened_blocks() + check_adaptive_navier_stokes();
+                       check_coarsened_blocks() + check_forest_levels(true) +
+                       check_forest_levels(false) + check_adaptive_navier_stokes();
   return failures == 0 ? 0 : 1;
 }

@@ -65,32 +65,36 @@ struct PoissonResult {
   double error = 0.0;
   MultigridReport report;
   BlockField solution;
-  bool merged = false;  ///< the multigrid solved on merged blocks (Multigrid::merged)
+  bool merged = false;        ///< the multigrid solved on merged blocks (Multigrid::merged)
+  int coarsened_forests = 0;  ///< Multigrid::coarsened_forests
 };
 
-/// Solves -lap u = f on the unit cube with `cells` cells per direction (block size 8).
-inline PoissonResult solve_manufactured(bool periodic, int cells, MPI_Comm comm = MPI_COMM_WORLD,
-                                        double tolerance = 1e-10) {
+/// Solves -lap u = f on the unit cube with `cells` cells per direction (blocks of
+/// block_cells^3, the multigrid's gathered_blocks_limit).
+inline PoissonResult solve_manufactured(
+    bool periodic, int cells, MPI_Comm comm = MPI_COMM_WORLD, double tolerance = 1e-10,
+    int block_cells = 8, std::int64_t gathered_blocks_limit = Multigrid::kGatheredBlocksLimit) {
   ForestSpec spec;
   spec.periodic = {periodic, periodic, periodic};
-  spec.block_cells = 8;
+  spec.block_cells = block_cells;
   int level = 0;
-  while ((8 << level) < cells) ++level;
+  while ((block_cells << level) < cells) ++level;
   spec.level = level;
   spec.comm = comm;
   const Forest forest(spec);
   ScalarBoundary bc;
   bc.kind = uniform_kinds(forest, BcKind::Dirichlet);
   for (auto& v : bc.value) v = dirichlet_exact;
-  Multigrid mg(forest, bc.kind);
+  Multigrid mg(forest, bc.kind, true, true, gathered_blocks_limit);
   const BlockField rhs =
       periodic ? sample(forest, periodic_source) : sample(forest, dirichlet_source);
   PoissonResult result;
-  result.solution = BlockField(forest.local_blocks(), 8);
+  result.solution = BlockField(forest.local_blocks(), block_cells);
   MultigridOptions options;
   options.tolerance = tolerance;
   result.report = mg.solve(result.solution, rhs, bc, options);
   result.merged = mg.merged();
+  result.coarsened_forests = mg.coarsened_forests();
   result.error = periodic ? max_error(forest, result.solution, periodic_exact)
                           : max_error(forest, result.solution, dirichlet_exact);
   return result;

@@ -46,7 +46,16 @@ TEST(CoarsenedBlocks, TheFinestLevelIsCoarsenedAndNothingElse) {
   const auto twice = coarsen_finest_level(*once);
   EXPECT_TRUE(twice->uniform());
   EXPECT_EQ(twice->global_blocks(), 64);
-  EXPECT_THROW(coarsen_finest_level(*twice), std::invalid_argument);
+  // A uniform forest coarsens too (the multigrid's hierarchy on many blocks), down to
+  // its trees, and no further.
+  std::unique_ptr<Forest> coarser = coarsen_finest_level(*twice);
+  while (coarser->max_level() > 0) {
+    EXPECT_TRUE(coarser->uniform());
+    coarser = coarsen_finest_level(*coarser);
+  }
+  EXPECT_EQ(coarser->global_blocks(),
+            std::int64_t{fine.spec().trees[0]} * fine.spec().trees[1] * fine.spec().trees[2]);
+  EXPECT_THROW(coarsen_finest_level(*coarser), std::invalid_argument);
 }
 
 TEST(CoarsenedBlocks, ACoarsenedForestAdaptedInPlaceHasTheLeavesOfANewOne) {
