@@ -77,8 +77,8 @@ CoarsenedBlocks::CoarsenedBlocks(const Forest& fine, const Forest& coarse)
     : fine_(fine), b_(fine.block_cells()) {
   if (coarse.block_cells() != b_ || coarse.max_level() + 1 != fine.max_level()) {
     throw std::invalid_argument(
-        "coarsened blocks: the forests are not a composite one and its "
-        "finest level coarsened");
+        "coarsened blocks: the forests are not a forest and the same with its finest level "
+        "coarsened");
   }
   const int top = fine.max_level();
   // This rank's coarse blocks; a fine block whose coarse block lives elsewhere asks
