@@ -44,28 +44,42 @@ std::vector<double> gathered(const Forest& forest, const BlockField& field) {
   return all;
 }
 
+/// The manufactured Poisson problem (testing::solve_manufactured's arguments) solved on the
+/// ranks of MPI_COMM_WORLD and on this rank alone, and the largest difference of the two
+/// solutions, each gathered on a forest split as its solve's.
+struct SharedAndAlone {
+  testing::PoissonResult shared, alone;
+  double diff = 0.0;
+};
+
+SharedAndAlone solve_shared_and_alone(bool periodic, int cells, int block_cells = 8,
+                                      std::int64_t limit = Multigrid::kGatheredBlocksLimit) {
+  auto run = [&](MPI_Comm comm, std::vector<double>& values) {
+    ForestSpec spec;
+    spec.periodic = {periodic, periodic, periodic};
+    spec.block_cells = block_cells;
+    while ((block_cells << spec.level) < cells) ++spec.level;
+    spec.comm = comm;
+    const Forest forest(spec);
+    auto result = testing::solve_manufactured(periodic, cells, comm, 1e-13, block_cells, limit);
+    values = gathered(forest, result.solution);
+    return result;
+  };
+  std::vector<double> shared, alone;
+  SharedAndAlone out;
+  out.shared = run(MPI_COMM_WORLD, shared);
+  out.alone = run(MPI_COMM_SELF, alone);
+  for (std::size_t i = 0; i < shared.size(); ++i)
+    out.diff = std::max(out.diff, std::abs(shared[i] - alone[i]));
+  return out;
+}
+
 /// Poisson on 32^3 cells of 4^3 blocks with the forest coarsened level by level down to its
 /// tree (Multigrid's gathered_blocks_limit 0) instead of the in-block levels' gathered
 /// bottom: several ranks against one. The forest as built is split evenly, so a family of
 /// blocks may lie on two ranks until the coarsened copy is repartitioned.
 int check_forest_levels(bool periodic) {
-  auto run = [&](MPI_Comm comm, std::vector<double>& values) {
-    ForestSpec spec;
-    spec.periodic = {periodic, periodic, periodic};
-    spec.block_cells = 4;
-    spec.level = 3;
-    spec.comm = comm;
-    const Forest forest(spec);
-    auto result = testing::solve_manufactured(periodic, 32, comm, 1e-13, 4, 0);
-    values = gathered(forest, result.solution);
-    return result;
-  };
-  std::vector<double> shared, alone;
-  const auto r2 = run(MPI_COMM_WORLD, shared);
-  const auto r1 = run(MPI_COMM_SELF, alone);
-  double diff = 0.0;
-  for (std::size_t i = 0; i < shared.size(); ++i)
-    diff = std::max(diff, std::abs(shared[i] - alone[i]));
+  const auto [r2, r1, diff] = solve_shared_and_alone(periodic, 32, 4, 0);
   const auto& session = MpiSession::ensure();
   if (session.rank() == 0) {
     std::printf(
@@ -81,23 +95,7 @@ int check_forest_levels(bool periodic) {
 /// their families merged (Multigrid::merged), whose blocks lie on other
 /// ranks than their children's.
 int check(bool periodic, int cells) {
-  auto run = [&](MPI_Comm comm, std::vector<double>& values) {
-    ForestSpec spec;
-    spec.periodic = {periodic, periodic, periodic};
-    spec.level = cells == 16 ? 1 : 2;
-    spec.comm = comm;
-    const Forest forest(spec);
-    auto result = testing::solve_manufactured(periodic, cells, comm, 1e-13);
-    // Re-gather on a forest with the same partition as the solve.
-    values = gathered(forest, result.solution);
-    return result;
-  };
-  std::vector<double> shared, alone;
-  const auto r2 = run(MPI_COMM_WORLD, shared);
-  const auto r1 = run(MPI_COMM_SELF, alone);
-  double diff = 0.0;
-  for (std::size_t i = 0; i < shared.size(); ++i)
-    diff = std::max(diff, std::abs(shared[i] - alone[i]));
+  const auto [r2, r1, diff] = solve_shared_and_alone(periodic, cells);
   const auto& session = MpiSession::ensure();
   if (session.rank() == 0) {
     std::printf(
