@@ -3,7 +3,6 @@
 #include <mpi.h>
 
 #include <algorithm>
-#include <map>
 #include <stdexcept>
 
 #include "flow/payload_exchange.hpp"
@@ -14,16 +13,6 @@ namespace {
 
 constexpr std::size_t D(int d) {
   return static_cast<std::size_t>(d);
-}
-
-using BlockId = std::array<std::int64_t, 4>;  // level, coord
-
-BlockId id_of(const Block& block) {
-  return {block.level, block.coord[0], block.coord[1], block.coord[2]};
-}
-
-BlockId parent_of(const BlockId& id) {
-  return {id[0] - 1, id[1] >> 1, id[2] >> 1, id[3] >> 1};
 }
 
 /// Calls body(i, j, k) over the box n (x fastest).
@@ -81,46 +70,30 @@ CoarsenedBlocks::CoarsenedBlocks(const Forest& fine, const Forest& coarse)
         "coarsened");
   }
   const int top = fine.max_level();
-  // This rank's coarse blocks; a fine block whose coarse block lives elsewhere asks
-  // p8est's partition markers for its rank and names the block by its id.
-  std::map<BlockId, std::int32_t> mine;
-  for (int c = 0; c < coarse.local_blocks(); ++c) mine[id_of(coarse.block(c))] = c;
-  const int ranks = fine.ranks();
-  send_.assign(D(ranks), {});
-  receive_.assign(D(ranks), {});
-  local_.assign(D(fine.local_blocks()), Link{});
-  using Header = std::array<std::int32_t, 5>;  // the coarse block's level and coord, octant
-  std::vector<std::vector<Header>> headers(D(ranks));
+  // Each block's coarse block: itself, or the parent of a block of the finest level.
+  std::vector<BlockTarget> targets(D(fine.local_blocks()));
   for (int f = 0; f < fine.local_blocks(); ++f) {
     const Block& block = fine.block(f);
-    const bool child = block.level == top;
-    const BlockId target = child ? parent_of(id_of(block)) : id_of(block);
     const auto& q = block.coord;
-    const std::int32_t octant =
-        child ? static_cast<std::int32_t>((q[0] & 1) | ((q[1] & 1) << 1) | ((q[2] & 1) << 2)) : -1;
-    if (const auto found = mine.find(target); found != mine.end()) {
-      local_[D(f)] = Link{f, found->second, octant};
-      continue;
-    }
-    const int rank =
-        coarse.owner_of(static_cast<int>(target[0]), {target[1], target[2], target[3]});
-    if (rank == fine.rank()) throw std::logic_error("coarsened blocks: a block has no match");
-    local_[D(f)] = Link{f, -1, octant};
-    send_[D(rank)].push_back(local_[D(f)]);
-    headers[D(rank)].push_back(
-        {static_cast<std::int32_t>(target[0]), static_cast<std::int32_t>(target[1]),
-         static_cast<std::int32_t>(target[2]), static_cast<std::int32_t>(target[3]), octant});
+    targets[D(f)] = block.level == top
+                        ? BlockTarget{block.level - 1,
+                                      {q[0] >> 1, q[1] >> 1, q[2] >> 1},
+                                      static_cast<std::int32_t>((q[0] & 1) | ((q[1] & 1) << 1) |
+                                                                ((q[2] & 1) << 2))}
+                        : BlockTarget{block.level, q, -1};
   }
-  if (ranks == 1) return;
-  // Each rank tells the coarse blocks' ranks which (coarse block, octant) its blocks
-  // feed, in the order their values will travel.
-  const auto received = exchange_headers(fine.comm(), headers);
-  for (int r = 0; r < ranks; ++r)
-    for (const Header& h : received[D(r)]) {
-      const auto found = mine.find({h[0], h[1], h[2], h[3]});
-      if (found == mine.end()) throw std::logic_error("coarsened blocks: a block has no match");
-      receive_[D(r)].push_back(Link{-1, found->second, h[4]});
-    }
+  const BlockRoutes routes = route_blocks(coarse, targets, "coarsened blocks");
+  const int ranks = fine.ranks();
+  local_.assign(D(fine.local_blocks()), Link{});
+  for (int f = 0; f < fine.local_blocks(); ++f)
+    local_[D(f)] = Link{f, routes.local[D(f)], targets[D(f)].tag};
+  send_.assign(D(ranks), {});
+  receive_.assign(D(ranks), {});
+  for (int r = 0; r < ranks; ++r) {
+    for (const std::int32_t f : routes.sent[D(r)]) send_[D(r)].push_back(local_[D(f)]);
+    for (const auto& [coarse_block, octant] : routes.received[D(r)])
+      receive_[D(r)].push_back(Link{-1, coarse_block, octant});
+  }
 }
 
 int CoarsenedBlocks::payload(const Link& link, Kind kind, int d) const {

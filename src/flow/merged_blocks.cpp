@@ -3,7 +3,6 @@
 #include <mpi.h>
 
 #include <stdexcept>
-#include <unordered_map>
 
 #include "flow/payload_exchange.hpp"
 
@@ -13,11 +12,6 @@ namespace {
 
 constexpr std::size_t D(int d) {
   return static_cast<std::size_t>(d);
-}
-
-/// Key of the block at integer coordinates c among n blocks per direction.
-std::int64_t block_key(const std::array<std::int64_t, 3>& c, const std::array<std::int64_t, 3>& n) {
-  return (c[2] * n[1] + c[1]) * n[0] + c[0];
 }
 
 int octant_of(const std::array<std::int64_t, 3>& c) {
@@ -77,43 +71,24 @@ MergedBlocks::MergedBlocks(const Forest& fine, const Forest& merged)
   if (merged.block_cells() != 2 * b_ || !fine.uniform() || !merged.uniform()) {
     throw std::invalid_argument("merged blocks: the forests are not a uniform one and its merge");
   }
-  const int ranks = fine.ranks();
-  const int level = merged.max_level();
-  const auto n = merged.blocks_per_direction(level);
-  // This rank's merged blocks, by key; a family whose merged block lives elsewhere asks
-  // p8est's partition markers for its rank and names the block by its coordinates.
-  std::unordered_map<std::int64_t, std::int32_t> mine;
-  for (int m = 0; m < merged.local_blocks(); ++m) mine[block_key(merged.block(m).coord, n)] = m;
-  send_.assign(static_cast<std::size_t>(ranks), {});
-  receive_.assign(static_cast<std::size_t>(ranks), {});
-  local_.assign(static_cast<std::size_t>(fine.local_blocks()), Child{-1, -1, 0});
-  using Header = std::array<std::int32_t, 4>;  // the merged block's coord, octant
-  std::vector<std::vector<Header>> headers(D(ranks));
+  // Each block's merged block: its parent, where it is a child of octant octant_of.
+  std::vector<BlockTarget> targets(D(fine.local_blocks()));
   for (int blk = 0; blk < fine.local_blocks(); ++blk) {
     const auto& c = fine.block(blk).coord;
-    const std::array<std::int64_t, 3> parent{c[0] >> 1, c[1] >> 1, c[2] >> 1};
-    if (const auto found = mine.find(block_key(parent, n)); found != mine.end()) {
-      local_[D(blk)] = Child{blk, found->second, octant_of(c)};
-      continue;
-    }
-    const int rank = merged.owner_of(level, parent);
-    if (rank == fine.rank()) throw std::logic_error("merged blocks: a family has no merged block");
-    send_[D(rank)].push_back(Child{blk, -1, octant_of(c)});
-    headers[D(rank)].push_back({static_cast<std::int32_t>(parent[0]),
-                                static_cast<std::int32_t>(parent[1]),
-                                static_cast<std::int32_t>(parent[2]), octant_of(c)});
+    targets[D(blk)] = {merged.max_level(), {c[0] >> 1, c[1] >> 1, c[2] >> 1}, octant_of(c)};
   }
-  if (ranks == 1) return;
-  // Each rank tells the merged blocks' ranks which (merged block, octant) its
-  // children fill, in the order their values will travel.
-  const auto received = exchange_headers(fine.comm(), headers);
-  for (int r = 0; r < ranks; ++r)
-    for (const Header& h : received[D(r)]) {
-      const auto found = mine.find(block_key({h[0], h[1], h[2]}, n));
-      if (found == mine.end())
-        throw std::logic_error("merged blocks: a family has no merged block");
-      receive_[D(r)].push_back(Child{-1, found->second, h[3]});
-    }
+  const BlockRoutes routes = route_blocks(merged, targets, "merged blocks");
+  const int ranks = fine.ranks();
+  local_.assign(D(fine.local_blocks()), Child{-1, -1, 0});
+  for (int blk = 0; blk < fine.local_blocks(); ++blk)
+    local_[D(blk)] = Child{blk, routes.local[D(blk)], targets[D(blk)].tag};
+  send_.assign(D(ranks), {});
+  receive_.assign(D(ranks), {});
+  for (int r = 0; r < ranks; ++r) {
+    for (const std::int32_t blk : routes.sent[D(r)]) send_[D(r)].push_back(local_[D(blk)]);
+    for (const auto& [merged_block, octant] : routes.received[D(r)])
+      receive_[D(r)].push_back(Child{-1, merged_block, octant});
+  }
 }
 
 template <bool kToMerged>

@@ -1,14 +1,20 @@
 #pragma once
 // Values of blocks that live on other ranks in another forest, moved in one MPI_Alltoallv
-// (merged_blocks.hpp, coarsened_blocks.hpp): each rank lists, per rank, the items it sends
-// there and the items it receives from there, both sides in the same order.
+// (merged_blocks.hpp, coarsened_blocks.hpp): where each block goes (route_blocks), then
+// each rank lists, per rank, the items it sends there and the items it receives from
+// there, both sides in the same order.
 
 #include <mpi.h>
 
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <unordered_map>
 #include <vector>
+
+#include "flow/forest.hpp"
 
 namespace sanguis::flow {
 
@@ -46,6 +52,68 @@ std::vector<std::vector<std::array<std::int32_t, N>>> exchange_headers(
       incoming[r].push_back(header);
     }
   return incoming;
+}
+
+/// Where one block of this rank goes in another forest: the leaf at (level, coord) there,
+/// and a number that travels with it (the octant of a child in its parent).
+struct BlockTarget {
+  int level = 0;
+  std::array<std::int64_t, 3> coord{};
+  std::int32_t tag = -1;
+};
+
+/// Each block's target found in forest `to`: on this rank, or on the rank p8est's partition
+/// markers name (Forest::owner_of), which is sent the target's position once, so that no
+/// rank needs the list of all blocks.
+struct BlockRoutes {
+  /// Per block: its target's local number in `to`, or -1 where it lies on another rank.
+  std::vector<std::int32_t> local;
+  /// Per rank: the blocks whose target lies there, in block order.
+  std::vector<std::vector<std::int32_t>> sent;
+  /// Per rank: (local number in `to`, tag) of each block that rank sends here, in its order.
+  std::vector<std::vector<std::array<std::int32_t, 2>>> received;
+};
+
+/// BlockRoutes of `targets` (one per block of this rank, in order) into `to`; `what` names
+/// the caller in the error thrown when a target is no leaf of `to`.
+inline BlockRoutes route_blocks(const Forest& to, const std::vector<BlockTarget>& targets,
+                                const std::string& what) {
+  const auto key = [&to](int level, const std::array<std::int64_t, 3>& c) {
+    const auto n = to.blocks_per_direction(level);
+    return (static_cast<std::uint64_t>(level) << 58) |
+           static_cast<std::uint64_t>((c[2] * n[1] + c[1]) * n[0] + c[0]);
+  };
+  std::unordered_map<std::uint64_t, std::int32_t> mine;
+  for (int b = 0; b < to.local_blocks(); ++b) mine[key(to.block(b).level, to.block(b).coord)] = b;
+  const auto ranks = static_cast<std::size_t>(to.ranks());
+  BlockRoutes routes;
+  routes.local.assign(targets.size(), -1);
+  routes.sent.assign(ranks, {});
+  routes.received.assign(ranks, {});
+  using Header = std::array<std::int32_t, 5>;  // the target's level and coord, tag
+  std::vector<std::vector<Header>> headers(ranks);
+  for (std::size_t b = 0; b < targets.size(); ++b) {
+    const BlockTarget& t = targets[b];
+    if (const auto found = mine.find(key(t.level, t.coord)); found != mine.end()) {
+      routes.local[b] = found->second;
+      continue;
+    }
+    const int rank = to.owner_of(t.level, t.coord);
+    if (rank == to.rank()) throw std::logic_error(what + ": a block has no match");
+    routes.sent[static_cast<std::size_t>(rank)].push_back(static_cast<std::int32_t>(b));
+    headers[static_cast<std::size_t>(rank)].push_back(
+        {t.level, static_cast<std::int32_t>(t.coord[0]), static_cast<std::int32_t>(t.coord[1]),
+         static_cast<std::int32_t>(t.coord[2]), t.tag});
+  }
+  if (ranks == 1) return routes;
+  const auto received = exchange_headers(to.comm(), headers);
+  for (std::size_t r = 0; r < ranks; ++r)
+    for (const Header& h : received[r]) {
+      const auto found = mine.find(key(h[0], {h[1], h[2], h[3]}));
+      if (found == mine.end()) throw std::logic_error(what + ": a block has no match");
+      routes.received[r].push_back({found->second, h[4]});
+    }
+  return routes;
 }
 
 /// For every rank r: produce(item, out) packs each item of outgoing[r], in order, into
