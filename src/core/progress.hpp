@@ -18,6 +18,10 @@ class ProgressReporter {
 
   double elapsed_seconds() const;
   static std::string format_duration(double seconds);
+  /// The date and time now, in UTC ("2026-12-05 19:15:02 UTC"): run logs stamp their
+  /// start, restarts, checkpoints and end with it, so that a log read later says when
+  /// each part ran (its durations alone do not say whether a run was paused between).
+  static std::string wall_clock_stamp();
 
  private:
   std::ostream& out_;

@@ -549,7 +549,8 @@ std::int64_t steps_for(double duration, double dt) {
 std::string checkpoint_line(double time, std::int64_t steps, const ProgressReporter& progress) {
   std::ostringstream line;
   line << "checkpoint: t = " << std::setprecision(10) << time << " s, " << steps << " steps in "
-       << ProgressReporter::format_duration(progress.elapsed_seconds()) << "\n";
+       << ProgressReporter::format_duration(progress.elapsed_seconds()) << ", "
+       << ProgressReporter::wall_clock_stamp() << "\n";
   return line.str();
 }
 
@@ -626,7 +627,8 @@ RunSummary run_dem_case(const DemCase& c, const RunOptions& options, std::ostrea
     log.open(dir / "run.log", options.restart ? std::ios::app : std::ios::trunc);
     if (!log) throw InputError((dir / "run.log").string(), "", "cannot write the run log");
     log << (options.restart ? "\n--- restart from checkpoint at t = " : "sanguis ")
-        << (options.restart ? std::to_string(sim.time()) + " s" : std::string(kVersion)) << "\n"
+        << (options.restart ? std::to_string(sim.time()) + " s" : std::string(kVersion))
+        << (options.restart ? ", " : ", started ") << ProgressReporter::wall_clock_stamp() << "\n"
         << describe(c);
     if (decomposition) {
       log << "domain decomposition: " << ranks << " MPI processes, slabs along "
@@ -729,7 +731,8 @@ RunSummary run_dem_case(const DemCase& c, const RunOptions& options, std::ostrea
   done << "done: t = " << std::setprecision(10) << sim.time() << std::setprecision(4) << " s, "
        << summary.steps << " steps in " << ProgressReporter::format_duration(summary.wall_seconds)
        << " (" << (summary.wall_seconds > 0 ? particle_steps / summary.wall_seconds : 0.0)
-       << " particle-steps/s)" << (summary.settled ? ", settled" : "");
+       << " particle-steps/s), ended " << ProgressReporter::wall_clock_stamp()
+       << (summary.settled ? ", settled" : "");
   progress.finish(done.str());
   log << done.str() << "\n";
   console << "outputs:\n"

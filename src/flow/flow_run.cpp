@@ -186,9 +186,9 @@ FlowRunSummary run_flow_case(const FlowCase& c, const FlowRunOptions& options,
     log.open(dir / "run.log", options.restart ? std::ios::app : std::ios::trunc);
     if (!log) throw InputError((dir / "run.log").string(), "", "cannot write the run log");
     log << (options.restart
-                ? "\n--- restart from checkpoint at t = " + std::to_string(ns.time()) + " s"
-                : std::string("sanguis ") + kVersion)
-        << "\n"
+                ? "\n--- restart from checkpoint at t = " + std::to_string(ns.time()) + " s, "
+                : std::string("sanguis ") + kVersion + ", started ")
+        << ProgressReporter::wall_clock_stamp() << "\n"
         << describe(c) << "ranks " << forest.ranks() << "\n"
         << "multigrid blocks " << ns.solver_block_cells() << "^3"
         << (ns.solver_block_cells() != forest.block_cells()
@@ -300,7 +300,7 @@ FlowRunSummary run_flow_case(const FlowCase& c, const FlowRunOptions& options,
   done << "done: t = " << std::setprecision(10) << ns.time() << std::setprecision(4) << " s, "
        << summary.steps << " steps in " << ProgressReporter::format_duration(summary.wall_seconds)
        << " (" << (summary.wall_seconds > 0 ? cell_updates / summary.wall_seconds : 0.0)
-       << " cell-updates/s)";
+       << " cell-updates/s), ended " << ProgressReporter::wall_clock_stamp();
   if (c.adapt.enabled && summary.wall_seconds > 0) {
     done << "; " << static_cast<long long>(leaf_cells(forest)) << " cells at the end, regridding "
          << 100.0 * regrid_seconds / summary.wall_seconds << " % of the time";

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -208,6 +209,10 @@ max_m = [0.25, 0.6, 0.5]
   const auto dir = run_in_temp(c, "sanguis_flow_solid_test");
   const std::string log = read_bytes(dir / "run.log");
   EXPECT_NE(log.find("solid box"), std::string::npos);
+  // The start and the end carry the date (core/progress.hpp, wall_clock_stamp).
+  const std::string stamp = R"(\d{4}-\d{2}-\d{2} \d{2}:\d{2}:\d{2} UTC)";
+  EXPECT_TRUE(std::regex_search(log, std::regex("^sanguis \\S+, started " + stamp))) << log;
+  EXPECT_TRUE(std::regex_search(log, std::regex("cell-updates/s\\), ended " + stamp))) << log;
   std::filesystem::remove_all(dir);
 }
 

@@ -94,6 +94,13 @@ class EndOfCollapse(unittest.TestCase):
             self.assertFalse(db.ended_at_rest(d))
             fake_run(d, ["checkpoint: t = 0.05 s, 20000 steps in 0s"], [])
             self.assertFalse(db.ended_at_rest(d))
+            # The lines as stamped with the date since 2026-12-05.
+            fake_run(d, ["done: t = 4.7 s, 600000 steps in 35m50s (5.6e+05 particle-steps/s), "
+                         "ended 2026-12-05 21:11:40 UTC, settled"], [])
+            self.assertTrue(db.ended_at_rest(d))
+            fake_run(d, ["done: t = 4.75 s, 20000 steps in 1m2s (5.6e+05 particle-steps/s), "
+                         "ended 2026-12-05 21:11:40 UTC"], [])
+            self.assertFalse(db.ended_at_rest(d))
 
     def test_stopped_says_how_the_collapse_ended(self):
         with tempfile.TemporaryDirectory() as d:

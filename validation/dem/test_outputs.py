@@ -144,6 +144,23 @@ class RunSegments(unittest.TestCase):
             self.assertEqual(_outputs.wall_time(tmp, after=5.0), 1205 + 1320 + 660)
             self.assertEqual(_outputs.done_times(tmp), [5.0, 6.1])
 
+    def test_lines_stamped_with_the_date_read_the_same(self):
+        # Since 2026-12-05 run.log stamps its start, restarts, checkpoints and end in UTC.
+        with tempfile.TemporaryDirectory() as tmp:
+            write_run_log(tmp, [
+                "sanguis 0.1.0, started 2026-12-05 19:15:02 UTC",
+                "done: t = 5 s, 2000000 steps in 1h56m (2.92e+05 particle-steps/s), ended "
+                "2026-12-05 21:11:40 UTC",
+                "--- restart from checkpoint at t = 5.000000 s, 2026-12-05 21:20:00 UTC",
+                "checkpoint: t = 5.25 s, 100000 steps in 10m00s, 2026-12-05 21:30:00 UTC",
+                "--- restart from checkpoint at t = 5.250000 s, 2026-12-05 22:00:00 UTC",
+                "done: t = 6.1 s, 240000 steps in 22m00s (1e+05 particle-steps/s), ended "
+                "2026-12-05 22:22:00 UTC, settled"])
+            self.assertEqual(list(_outputs.finished_segments(tmp)),
+                             [(5.0, 6960), (5.25, 600), (6.1, 1320)])
+            self.assertEqual(_outputs.done_times(tmp), [5.0, 6.1])
+            self.assertEqual(_outputs.uncounted_spans(tmp), [])
+
     def test_a_span_run_before_checkpoint_lines_is_named_as_not_counted(self):
         with tempfile.TemporaryDirectory() as tmp:
             write_run_log(tmp, [
