@@ -424,10 +424,9 @@ TEST_F(CliTest, RunLogStampsItsStartCheckpointsAndEndWithTheDate) {
   ASSERT_EQ(r.code, 0) << r.err;
   const std::string log = read_file(out / "run.log");
   const std::string stamp = R"(\d{4}-\d{2}-\d{2} \d{2}:\d{2}:\d{2} UTC)";
-  EXPECT_TRUE(std::regex_search(log, std::regex("^sanguis \\S+, started " + stamp + "\n")))
-      << log;
-  EXPECT_TRUE(std::regex_search(log, std::regex("checkpoint: t = 0.008 s, 4000 steps in \\S+, " +
-                                                stamp + "\n")))
+  EXPECT_TRUE(std::regex_search(log, std::regex("^sanguis \\S+, started " + stamp + "\n"))) << log;
+  EXPECT_TRUE(std::regex_search(
+      log, std::regex("checkpoint: t = 0.008 s, 4000 steps in \\S+, " + stamp + "\n")))
       << log;
   EXPECT_TRUE(std::regex_search(
       log, std::regex("done: t = 0.02 s, 10000 steps in \\S+ \\([^)]*\\), ended " + stamp + "\n")))
