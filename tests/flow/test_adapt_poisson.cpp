@@ -66,11 +66,15 @@ TEST(AdaptPoisson, HelmholtzWithVariableCoefficientOnTheRefinedOctant) {
   // test of test_multigrid.cpp, here with the octant refined once): beta
   // varies across the coarse-fine faces normal to x, where the fine side's
   // beta sets the matched flux.
-  auto run = [](int level) {
+  struct Result {
+    double error, rate;
+    int cycles;
+  };
+  auto run = [](int level, bool refined) {
     ForestSpec spec;
     spec.level = level;
     Forest forest(spec);
-    testing::refine_where(forest, testing::in_refined_octant);
+    if (refined) testing::refine_where(forest, testing::in_refined_octant);
     ScalarBoundary bc;
     bc.kind = uniform_kinds(forest, BcKind::Dirichlet);
     for (auto& v : bc.value) v = testing::dirichlet_exact;
@@ -105,14 +109,23 @@ TEST(AdaptPoisson, HelmholtzWithVariableCoefficientOnTheRefinedOctant) {
     const auto report = mg.solve(x, testing::sample(forest, source), bc, options);
     EXPECT_TRUE(report.converged);
     EXPECT_GT(report.mean_reduction(), 10.0);  // as for Poisson (measured above 10)
-    std::printf(
-        "Helmholtz on the refined octant, base level %d: max error %.3e, %.1fx per V-cycle\n",
-        level, testing::max_error(forest, x, testing::dirichlet_exact), report.mean_reduction());
-    return testing::max_error(forest, x, testing::dirichlet_exact);
+    std::printf("Helmholtz %s, base level %d: max error %.3e, %.1fx per V-cycle (%d cycles)\n",
+                refined ? "on the refined octant" : "uniform", level,
+                testing::max_error(forest, x, testing::dirichlet_exact), report.mean_reduction(),
+                report.cycles);
+    return Result{testing::max_error(forest, x, testing::dirichlet_exact), report.mean_reduction(),
+                  report.cycles};
   };
-  const double coarse = run(1), fine = run(2);
+  const Result coarse = run(1, true), fine = run(2, true);
   // Second order as for Poisson (1.8: pre-asymptotic mix of two grid sizes).
-  EXPECT_GT(std::log2(coarse / fine), 1.8);
+  EXPECT_GT(std::log2(coarse.error / fine.error), 1.8);
+  // The viscous solver's rate per cycle against the uniform grid of the same finest cells
+  // (see CompositeCyclesConvergeAsFastAsUniformOnes for why that grid).
+  for (const auto& [composite, uniform] :
+       {std::pair{coarse, run(2, false)}, {fine, run(3, false)}}) {
+    EXPECT_GT(composite.rate, 0.95 * uniform.rate);
+    EXPECT_LE(composite.cycles, uniform.cycles);
+  }
 }
 
 /// Periodic Poisson on 4^3 blocks of 8^3 cells with the level-2 blocks at
@@ -179,6 +192,13 @@ TEST(AdaptPoisson, CompositeCyclesConvergeAsFastAsUniformOnes) {
   // Gauss-Seidel in the cells beside finer blocks (MultigridOptions::beside_finer_relaxation)
   // 0.97-1.06 and 0.85-0.98 (measured 2026-12-05; the results are the same bits on every run
   // and thread count, so the bounds only catch a regression).
+  // Those shares are taken against the uniform base grid, one level coarser than the
+  // composite grid's finest. A uniform grid's own V-cycle converges more slowly the finer it
+  // is (31.6x, 27.6x, 25.4x per cycle at 32^3, 64^3, 128^3 at 1.25), so the uniform grid the
+  // composite one stands for, its finest resolution with the same depth of levels, is the
+  // reference that holds the grid's size fixed: against it the composite cycles reach
+  // 0.98-1.14 of the rate at both relaxations (docs/performance.md, "The composite V-cycle
+  // against the uniform grid of its finest cells").
   std::printf("periodic Poisson, V(2,2), uniform against composite grids:\n");
   const std::vector<std::array<std::int64_t, 3>> blob{{0, 1, 2}, {1, 0, 1}, {1, 0, 2}, {1, 1, 1},
                                                       {1, 1, 2}, {2, 1, 1}, {2, 1, 2}};
@@ -199,6 +219,9 @@ TEST(AdaptPoisson, CompositeCyclesConvergeAsFastAsUniformOnes) {
     for (const Grid& grid : grids) {
       const auto uniform = solve_with_refined_blocks({}, "uniform", omega, true, grid.base_level);
       ASSERT_TRUE(uniform.converged);
+      const auto uniform_finest = solve_with_refined_blocks({}, "uniform at the finest cells",
+                                                            omega, true, grid.base_level + 1);
+      ASSERT_TRUE(uniform_finest.converged);
       const auto by_block =
           solve_with_refined_blocks(grid.refined, grid.name, omega, false, grid.base_level);
       const auto by_level =
@@ -206,6 +229,8 @@ TEST(AdaptPoisson, CompositeCyclesConvergeAsFastAsUniformOnes) {
       ASSERT_TRUE(by_block.converged);
       ASSERT_TRUE(by_level.converged);
       EXPECT_GT(by_level.mean_reduction(), share * uniform.mean_reduction()) << grid.name;
+      EXPECT_GT(by_level.mean_reduction(), 0.95 * uniform_finest.mean_reduction()) << grid.name;
+      EXPECT_LE(by_level.cycles, uniform_finest.cycles) << grid.name;
       EXPECT_GT(by_level.mean_reduction(), by_block.mean_reduction()) << grid.name;
       EXPECT_LE(by_level.cycles, uniform.cycles + 1) << grid.name;
       if (omega > 1.2) {  // the cells beside finer blocks over-relaxed as the rest: slower
@@ -252,9 +277,8 @@ TEST(AdaptPoisson, ARebuiltMultigridSolvesAsANewOne) {
   // rebuilt (three levels: a chain of two coarsened forests).
   forest.adapt(
       [](const Block& block) {
-        return block.level == 3 && block.coord[0] == 0 && block.coord[1] == 0
-                   ? AdaptFlag::Refine
-                   : AdaptFlag::Keep;
+        return block.level == 3 && block.coord[0] == 0 && block.coord[1] == 0 ? AdaptFlag::Refine
+                                                                              : AdaptFlag::Keep;
       },
       {});
   ASSERT_EQ(forest.max_level(), 4);
