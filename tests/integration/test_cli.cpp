@@ -413,26 +413,6 @@ TEST_F(CliTest, RunLogGivesTheEndTimeToMoreThanFourDigits) {
   EXPECT_NE(log.find("done: t = 0.012346 s, 6173 steps"), std::string::npos) << log;
 }
 
-TEST_F(CliTest, RunLogStampsItsStartCheckpointsAndEndWithTheDate) {
-  // Durations alone do not say when a part of a run ran, or whether it was paused
-  // between: the log's start, checkpoint and done lines carry the date in UTC.
-  const fs::path file = dir_ / "falling.toml";
-  write_file(file, replaced(kFallingCase, "interval_s = 0.005",
-                            "interval_s = 0.005\ncheckpoint_interval_s = 0.008"));
-  const fs::path out = dir_ / "out";
-  const Result r = sanguis("run " + quoted(file.string()) + " -o " + quoted(out.string()) + " -q");
-  ASSERT_EQ(r.code, 0) << r.err;
-  const std::string log = read_file(out / "run.log");
-  const std::string stamp = R"(\d{4}-\d{2}-\d{2} \d{2}:\d{2}:\d{2} UTC)";
-  EXPECT_TRUE(std::regex_search(log, std::regex("^sanguis \\S+, started " + stamp + "\n"))) << log;
-  EXPECT_TRUE(std::regex_search(
-      log, std::regex("checkpoint: t = 0.008 s, 4000 steps in \\S+, " + stamp + "\n")))
-      << log;
-  EXPECT_TRUE(std::regex_search(
-      log, std::regex("done: t = 0.02 s, 10000 steps in \\S+ \\([^)]*\\), ended " + stamp + "\n")))
-      << log;
-}
-
 TEST_F(CliTest, RunLogRecordsEachCheckpointWrittenOnTheWay) {
   // A killed run continues from its last checkpoint: scripts read these lines to know
   // how far it got and what that part cost (validation/dem/_outputs.py).
@@ -447,6 +427,16 @@ TEST_F(CliTest, RunLogRecordsEachCheckpointWrittenOnTheWay) {
   EXPECT_NE(log.find("checkpoint: t = 0.016 s, 8000 steps in "), std::string::npos) << log;
   EXPECT_EQ(count_of(log, "checkpoint: "), 2u) << log;
   EXPECT_LT(log.find("checkpoint: t = 0.016"), log.find("done: t = 0.02 s"));
+  // Durations alone do not say when a part of a run ran, or whether it was paused
+  // between: the start, checkpoint and done lines carry the date in UTC.
+  const std::string stamp = R"(\d{4}-\d{2}-\d{2} \d{2}:\d{2}:\d{2} UTC)";
+  EXPECT_TRUE(std::regex_search(log, std::regex("^sanguis \\S+, started " + stamp + "\n"))) << log;
+  EXPECT_TRUE(std::regex_search(
+      log, std::regex("checkpoint: t = 0.008 s, 4000 steps in \\S+, " + stamp + "\n")))
+      << log;
+  EXPECT_TRUE(std::regex_search(
+      log, std::regex("done: t = 0.02 s, 10000 steps in \\S+ \\([^)]*\\), ended " + stamp + "\n")))
+      << log;
 }
 
 // --- A blow-up -----------------------------------------------------------------------
