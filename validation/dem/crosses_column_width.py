@@ -48,9 +48,12 @@ docs/validation/figures/crosses_column_width.png. The runs go two at a time, one
 each (hours: a pour and a collapse of 1000 crosses about 2 h, of 3000 crosses several);
 a run stopped on the way is continued from its checkpoint by the same command, so the
 six runs may span several sessions. `--sizes small` (or `--quick`) runs and reports the
-small columns only; `--reuse` analyses the finished runs on disk.
+small columns only; `--reuse` analyses the finished runs on disk, and with
+`--finished-only` reports those that have finished while the others go on (it names them;
+the contrast between the sizes is then taken over the packings there are).
 Usage: /usr/bin/python3 validation/dem/crosses_column_width.py [--build build]
-           [--sizes small large] [--seeds 1 2 3] [--reuse] [--without-table31] [--quick]
+           [--sizes small large] [--seeds 1 2 3] [--reuse [--finished-only]]
+           [--without-table31] [--quick]
 """
 import argparse
 import math
@@ -190,6 +193,33 @@ def highest_point(points, l0, count=5):
     return float(points[top, 0].mean() / l0)
 
 
+def collapse_finished(size, seed, tangential=(KT, GAMMA_T)):
+    """Whether the pour and the collapse (tangential None: Table 3.1) of this size and seed
+    have both finished."""
+    pour, out, out31 = folders(size, seed)
+    if not os.path.exists(os.path.join(pour, "diagnostics.csv")):
+        return False
+    opening = diagnostics(pour)[-1]["time_s"]
+    return finished(out if tangential else out31, tangential, opening)
+
+
+def finished_only(keys, with_table31):
+    """The keys (size, seed) whose calibrated collapse has finished, the Table 3.1 ones
+    whose own has, and a sentence naming what is left out (None when nothing is)."""
+    done = [key for key in keys if collapse_finished(*key)]
+    done31 = [key for key in with_table31 if collapse_finished(*key, tangential=None)]
+    left = [f"{SIZES[size].count} crosses, seed {seed}" for size, seed in keys
+            if (size, seed) not in done]
+    left += [f"{SIZES[size].count} crosses, seed {seed}, Table 3.1" for size, seed in with_table31
+             if (size, seed) not in done31]
+    note = None
+    if left:
+        note = ("Not finished when this report was written, so left out (the runs go on from "
+                "their checkpoints with the same command without --finished-only): "
+                + "; ".join(left) + ".")
+    return done, done31, note
+
+
 def measure(exe, size, seed, tangential=(KT, GAMMA_T)):
     """The analysed figures of one finished collapse (tangential None: Table 3.1)."""
     pour, out, out31 = folders(size, seed)
@@ -231,9 +261,10 @@ def table_row(label, r, pour):
 
 
 def contrast_checks(results, seeds):
-    """The thesis' contrast between the sizes, on the means over the packings."""
+    """The thesis' contrast between the sizes, on the means over the packings (those of
+    `seeds` that `results` holds: a report of the finished runs may lack some)."""
     def mean(size, key):
-        values = [results[(size, x)][key] for x in seeds]
+        values = [results[(size, x)][key] for x in seeds if (size, x) in results]
         return sum(values) / len(values)
 
     small = {k: mean("small", k) for k in ("peak", "below", "x_top")}
@@ -289,6 +320,8 @@ def draw(results, table31, sizes, seeds):
     styles = ["-", "--", ":"]
     for size in sizes:
         for k, seed in enumerate(seeds):
+            if (size, seed) not in results:
+                continue
             t, v = results[(size, seed)]["curve"]
             ax.plot(t, v, color=colours[size], ls=styles[k % 3],
                     label=f"{SIZES[size].count} crosses, seed {seed}")
@@ -301,7 +334,10 @@ def draw(results, table31, sizes, seeds):
     ax.set_xlim(0, 16)
     ax.set_title(f"a = {ASPECT}, kt {KT:g} N/m, γt {GAMMA_T:g} 1/s", fontsize=9)
     for k, size in enumerate(sizes):
-        snapshot(fig.add_subplot(2, 2, 2 * (k + 1)), size, seeds[0], results[(size, seeds[0])])
+        shown = [seed for seed in seeds if (size, seed) in results]
+        if shown:
+            snapshot(fig.add_subplot(2, 2, 2 * (k + 1)), size, shown[0],
+                     results[(size, shown[0])])
     fig.tight_layout()
     os.makedirs(os.path.dirname(FIGURE), exist_ok=True)
     fig.savefig(FIGURE, dpi=130)
@@ -316,7 +352,11 @@ def main():
     ap.add_argument("--without-table31", action="store_true",
                     help="leave out the Table 3.1 collapse of each size's first packing")
     ap.add_argument("--quick", action="store_true", help="the small columns only")
+    ap.add_argument("--finished-only", action="store_true",
+                    help="with --reuse: report the runs that have finished, naming the others")
     args = ap.parse_args()
+    if args.finished_only and not args.reuse:
+        ap.error("--finished-only reports runs on disk: give --reuse as well")
     if args.quick:
         args.sizes = ["small"]
     if len(set(args.seeds)) != len(args.seeds) or min(args.seeds) < 0:
@@ -327,10 +367,17 @@ def main():
     with_table31 = [] if args.without_table31 else [(size, first) for size in args.sizes]
     if not args.reuse:
         run_all_jobs(exe, keys, with_table31)
+    left_out = None
+    if args.finished_only:
+        keys, with_table31, left_out = finished_only(keys, with_table31)
+        if not keys:
+            sys.exit("no collapse has finished yet: nothing to report")
     results = {key: measure(exe, *key) for key in keys}
     table31 = {key: measure(exe, *key, tangential=None) for key in with_table31}
 
     checks, rows, notes = [], [], []
+    if left_out:
+        notes.append(left_out)
     for (size, seed), r in results.items():
         label = f"{SIZES[size].count} crosses, seed {seed}"
         checks += SIZES[size].checks(label, r["peak"], r["peak_t"], r["below"])
@@ -349,13 +396,21 @@ def main():
         rows.append(table_row(label, r, "(as above)"))
         notes.append(f"{sentence(label)}: the collapse from the same packing "
                      f"{r['stopped']}.")
-    if set(args.sizes) == set(SIZES):
+    if all(any(key[0] == size for key in results) for size in SIZES):
         checks += contrast_checks(results, args.seeds)
     notes.append("The thesis' sphere curves of Fig. 3.9a are checked by dam_break_scaling "
                  "(its column of a = 3.2); they are drawn here in grey when its runs are on "
                  "disk.")
     paused = paused_minutes(RUNS)
-    if paused:
+    if paused and left_out:
+        # The pause list covers every run of the case, without dates: it cannot be split
+        # between the runs reported and those still going.
+        notes.append(f"The wall times include stops (SIGSTOP, while other work used the "
+                     f"cores) of the runs reported here: results/runs/crosses_column_width/"
+                     f"PAUSES.txt lists {paused:.1f} min for all the case's runs, those not "
+                     "finished included, so the run time is given with the stops in it.")
+        paused = None
+    elif paused:
         notes.append(f"The wall times include {paused:.1f} min in which the runs were "
                      "stopped (SIGSTOP) while other work used the cores (listed in "
                      "results/runs/crosses_column_width/PAUSES.txt); the run time leaves "
@@ -381,7 +436,8 @@ def main():
                       else " --sizes " + " ".join(args.sizes))
                    + ("" if args.seeds == list(SEEDS)
                       else " --seeds " + " ".join(map(str, args.seeds)))
-                   + (" --without-table31" if args.without_table31 else ""),
+                   + (" --without-table31" if args.without_table31 else "")
+                   + (" --reuse --finished-only" if args.finished_only else ""),
         "figures": ["docs/validation/figures/crosses_column_width.png"],
         "checks": checks,
         "tables": [{"caption": "Per run (`sanguis analyze`; the top's x at 3 τc).",

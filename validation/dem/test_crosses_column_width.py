@@ -53,6 +53,30 @@ class Checks(unittest.TestCase):
         self.assertEqual([c["pass"] for c in checks], [True, False, True])
         self.assertEqual(checks[0]["measured"], "0.225 against 0.250")
 
+    def test_contrast_checks_take_the_packings_there_are(self):
+        results = {("small", 1): {"peak": 0.3, "below": 7.0, "x_top": 0.9},
+                   ("small", 2): {"peak": 0.2, "below": 6.0, "x_top": 0.7},
+                   ("large", 2): {"peak": 0.1, "below": 9.0, "x_top": 0.2}}
+        checks = cw.contrast_checks(results, [1, 2, 3])
+        self.assertEqual(checks[0]["measured"], "0.100 against 0.250")
+        self.assertEqual([c["pass"] for c in checks], [True, True, True])
+
+    def test_finished_only_keeps_the_finished_runs_and_names_the_others(self):
+        done = {("small", 1, True), ("small", 2, True), ("large", 1, True), ("small", 1, False)}
+        saved = cw.collapse_finished
+        cw.collapse_finished = lambda size, seed, tangential=(1, 1): \
+            (size, seed, tangential is not None) in done
+        try:
+            keys = [(size, seed) for size in ("small", "large") for seed in (1, 2)]
+            kept, kept31, note = cw.finished_only(keys, [("small", 1), ("large", 1)])
+            everything = cw.finished_only([("small", 1), ("large", 1)], [("small", 1)])
+        finally:
+            cw.collapse_finished = saved
+        self.assertEqual(kept, [("small", 1), ("small", 2), ("large", 1)])
+        self.assertEqual(kept31, [("small", 1)])
+        self.assertIn("3000 crosses, seed 2; 3000 crosses, seed 1, Table 3.1.", note)
+        self.assertEqual(everything, ([("small", 1), ("large", 1)], [("small", 1)], None))
+
     def test_a_failed_job_cancels_the_jobs_not_yet_started(self):
         started = []
 
