@@ -82,18 +82,8 @@ CoarsenedBlocks::CoarsenedBlocks(const Forest& fine, const Forest& coarse)
                                                                 ((q[2] & 1) << 2))}
                         : BlockTarget{block.level, q, -1};
   }
-  const BlockRoutes routes = route_blocks(coarse, targets, "coarsened blocks");
-  const int ranks = fine.ranks();
-  local_.assign(D(fine.local_blocks()), Link{});
-  for (int f = 0; f < fine.local_blocks(); ++f)
-    local_[D(f)] = Link{f, routes.local[D(f)], targets[D(f)].tag};
-  send_.assign(D(ranks), {});
-  receive_.assign(D(ranks), {});
-  for (int r = 0; r < ranks; ++r) {
-    for (const std::int32_t f : routes.sent[D(r)]) send_[D(r)].push_back(local_[D(f)]);
-    for (const auto& [coarse_block, octant] : routes.received[D(r)])
-      receive_[D(r)].push_back(Link{-1, coarse_block, octant});
-  }
+  route_entries(route_blocks(coarse, targets, "coarsened blocks"), targets, fine.ranks(), local_,
+                send_, receive_);
 }
 
 int CoarsenedBlocks::payload(const Link& link, Kind kind, int d) const {

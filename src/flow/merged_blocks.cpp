@@ -77,18 +77,8 @@ MergedBlocks::MergedBlocks(const Forest& fine, const Forest& merged)
     const auto& c = fine.block(blk).coord;
     targets[D(blk)] = {merged.max_level(), {c[0] >> 1, c[1] >> 1, c[2] >> 1}, octant_of(c)};
   }
-  const BlockRoutes routes = route_blocks(merged, targets, "merged blocks");
-  const int ranks = fine.ranks();
-  local_.assign(D(fine.local_blocks()), Child{-1, -1, 0});
-  for (int blk = 0; blk < fine.local_blocks(); ++blk)
-    local_[D(blk)] = Child{blk, routes.local[D(blk)], targets[D(blk)].tag};
-  send_.assign(D(ranks), {});
-  receive_.assign(D(ranks), {});
-  for (int r = 0; r < ranks; ++r) {
-    for (const std::int32_t blk : routes.sent[D(r)]) send_[D(r)].push_back(local_[D(blk)]);
-    for (const auto& [merged_block, octant] : routes.received[D(r)])
-      receive_[D(r)].push_back(Child{-1, merged_block, octant});
-  }
+  route_entries(route_blocks(merged, targets, "merged blocks"), targets, fine.ranks(), local_,
+                send_, receive_);
 }
 
 template <bool kToMerged>

@@ -116,6 +116,27 @@ inline BlockRoutes route_blocks(const Forest& to, const std::vector<BlockTarget>
   return routes;
 }
 
+/// The routes as lists of entries Entry{block, target, tag} (an aggregate of three
+/// integers): `local` has one per block of this rank (target -1 where it lies on another
+/// rank), send[r] those of the blocks whose target rank r holds, in block order, and
+/// receive[r] those rank r sends here ({-1, local target, tag}), in its order.
+template <typename Entry>
+void route_entries(const BlockRoutes& routes, const std::vector<BlockTarget>& targets, int ranks,
+                   std::vector<Entry>& local, std::vector<std::vector<Entry>>& send,
+                   std::vector<std::vector<Entry>>& receive) {
+  local.assign(targets.size(), Entry{-1, -1, -1});
+  for (std::size_t b = 0; b < targets.size(); ++b)
+    local[b] = Entry{static_cast<std::int32_t>(b), routes.local[b], targets[b].tag};
+  send.assign(static_cast<std::size_t>(ranks), {});
+  receive.assign(static_cast<std::size_t>(ranks), {});
+  for (std::size_t r = 0; r < static_cast<std::size_t>(ranks); ++r) {
+    for (const std::int32_t b : routes.sent[r])
+      send[r].push_back(local[static_cast<std::size_t>(b)]);
+    for (const auto& [target, tag] : routes.received[r])
+      receive[r].push_back(Entry{-1, target, tag});
+  }
+}
+
 /// For every rank r: produce(item, out) packs each item of outgoing[r], in order, into
 /// size(item) values; consume(item, in) unpacks each item of incoming[r] from as many.
 template <typename Item, typename Size, typename Produce, typename Consume>
