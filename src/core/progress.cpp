@@ -5,6 +5,9 @@
 #include <ctime>
 #include <ostream>
 
+#include "core/error.hpp"
+#include "core/version.hpp"
+
 namespace sanguis {
 
 ProgressReporter::ProgressReporter(std::ostream& out, bool interactive, double log_interval_s)
@@ -25,6 +28,18 @@ std::string ProgressReporter::wall_clock_stamp() {
   char buf[32];
   std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M:%S UTC", &utc);
   return buf;
+}
+
+std::ofstream open_run_log(const std::filesystem::path& dir, bool restart, double time_s) {
+  std::ofstream log(dir / "run.log", restart ? std::ios::app : std::ios::trunc);
+  if (!log) throw InputError((dir / "run.log").string(), "", "cannot write the run log");
+  if (restart) {
+    log << "\n--- restart from checkpoint at t = " << std::to_string(time_s) << " s, ";
+  } else {
+    log << "sanguis " << kVersion << ", started ";
+  }
+  log << ProgressReporter::wall_clock_stamp() << "\n";
+  return log;
 }
 
 std::string ProgressReporter::format_duration(double seconds) {

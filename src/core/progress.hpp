@@ -3,6 +3,8 @@
 // log (CI, nohup) it prints a new line at most every `log_interval` seconds.
 #include <chrono>
 #include <cstdint>
+#include <filesystem>
+#include <fstream>
 #include <iosfwd>
 #include <string>
 
@@ -30,5 +32,11 @@ class ProgressReporter {
   std::chrono::steady_clock::time_point start_, last_print_;
   bool printed_ = false;
 };
+
+/// A run's `run.log` in `dir`, opened (appended to on a restart) with the first line of
+/// this segment written: "sanguis VERSION, started DATE" for a new run, or after a blank
+/// line "--- restart from checkpoint at t = T s, DATE" (DEM and flow runs alike; scripts
+/// read these lines). Throws InputError when the file cannot be written.
+std::ofstream open_run_log(const std::filesystem::path& dir, bool restart, double time_s);
 
 }  // namespace sanguis

@@ -17,7 +17,6 @@
 #include "core/io/csv.hpp"
 #include "core/io/vtk.hpp"
 #include "core/progress.hpp"
-#include "core/version.hpp"
 #include "dem/body_contacts.hpp"
 #include "dem/domain_decomposition.hpp"
 
@@ -311,9 +310,8 @@ std::vector<ContactRecord> touching_contacts(const DemSimulation& sim) {
                                   double stored_twist, ContactRecord& r) {
     ContactHistory h = stored;
     double twist = stored_twist;
-    const ElementResponse e = element_contact_response(law, ec, patch, x[i], v[i], w[i],
-                                                       other_velocity, other_omega, other_centre,
-                                                       h, twist, 0.0);
+    const ElementResponse e = element_contact_response(
+        law, ec, patch, x[i], v[i], w[i], other_velocity, other_omega, other_centre, h, twist, 0.0);
     r.point = e.point;
     r.first_centre = x[i];
     r.second_centre = other_centre != nullptr ? *other_centre : e.point;
@@ -624,12 +622,8 @@ RunSummary run_dem_case(const DemCase& c, const RunOptions& options, std::ostrea
   // run.log: resolved parameters first, then events (first process only).
   std::ofstream log;
   if (root) {
-    log.open(dir / "run.log", options.restart ? std::ios::app : std::ios::trunc);
-    if (!log) throw InputError((dir / "run.log").string(), "", "cannot write the run log");
-    log << (options.restart ? "\n--- restart from checkpoint at t = " : "sanguis ")
-        << (options.restart ? std::to_string(sim.time()) + " s" : std::string(kVersion))
-        << (options.restart ? ", " : ", started ") << ProgressReporter::wall_clock_stamp() << "\n"
-        << describe(c);
+    log = open_run_log(dir, options.restart, sim.time());
+    log << describe(c);
     if (decomposition) {
       log << "domain decomposition: " << ranks << " MPI processes, slabs along "
           << "xyz"[decomposition->axis()] << "\n";

@@ -51,15 +51,9 @@ std::array<int, 3> child_faces(int b, int d, int octant) {
 }  // namespace
 
 std::unique_ptr<Forest> coarsen_finest_level(const Forest& fine) {
-  if (fine.max_level() == 0) throw std::invalid_argument("coarsen_finest_level: only trees");
   auto coarse = std::make_unique<Forest>(fine.spec());
   coarse->assign_coarsened_finest_level(fine);
   return coarse;
-}
-
-void coarsen_finest_level(const Forest& fine, Forest& coarse) {
-  if (fine.max_level() == 0) throw std::invalid_argument("coarsen_finest_level: only trees");
-  coarse.assign_coarsened_finest_level(fine);
 }
 
 CoarsenedBlocks::CoarsenedBlocks(const Forest& fine, const Forest& coarse)
@@ -82,8 +76,8 @@ CoarsenedBlocks::CoarsenedBlocks(const Forest& fine, const Forest& coarse)
                                                                 ((q[2] & 1) << 2))}
                         : BlockTarget{block.level, q, -1};
   }
-  route_entries(route_blocks(coarse, targets, "coarsened blocks"), targets, fine.ranks(), local_,
-                send_, receive_);
+  route_entries(route_blocks(coarse, targets, "coarsened blocks"), targets, local_, send_,
+                receive_);
 }
 
 int CoarsenedBlocks::payload(const Link& link, Kind kind, int d) const {

@@ -51,11 +51,9 @@ inline WeightedSum trilinear_sum(const BlockField& coarse, const BlockField* act
 }
 
 /// The forest `fine` with every family of its finest level coarsened (same spec and
-/// ranks; 2:1 balanced as `fine` is). `fine` must have blocks below its trees' level.
+/// ranks; 2:1 balanced as `fine` is), a new one (Forest::assign_coarsened_finest_level
+/// makes an existing forest so). `fine` must have blocks below its trees' level.
 std::unique_ptr<Forest> coarsen_finest_level(const Forest& fine);
-/// The same into `coarse`, a forest of fine's spec (the last coarsened forest of a
-/// regridded `fine`, whose solver is then rebuilt; Forest::assign_coarsened_finest_level).
-void coarsen_finest_level(const Forest& fine, Forest& coarse);
 
 /// Transfers between a composite forest and coarsen_finest_level() of it.
 class CoarsenedBlocks {

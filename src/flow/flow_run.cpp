@@ -17,7 +17,6 @@
 #include "core/io/csv.hpp"
 #include "core/io/vtk.hpp"
 #include "core/progress.hpp"
-#include "core/version.hpp"
 #include "flow/adapt_criterion.hpp"
 #include "flow/flow_output.hpp"
 
@@ -183,13 +182,8 @@ FlowRunSummary run_flow_case(const FlowCase& c, const FlowRunOptions& options,
 
   std::ofstream log;
   if (root) {
-    log.open(dir / "run.log", options.restart ? std::ios::app : std::ios::trunc);
-    if (!log) throw InputError((dir / "run.log").string(), "", "cannot write the run log");
-    log << (options.restart
-                ? "\n--- restart from checkpoint at t = " + std::to_string(ns.time()) + " s, "
-                : std::string("sanguis ") + kVersion + ", started ")
-        << ProgressReporter::wall_clock_stamp() << "\n"
-        << describe(c) << "ranks " << forest.ranks() << "\n"
+    log = open_run_log(dir, options.restart, ns.time());
+    log << describe(c) << "ranks " << forest.ranks() << "\n"
         << "multigrid blocks " << ns.solver_block_cells() << "^3"
         << (ns.solver_block_cells() != forest.block_cells()
                 ? " (the grid's blocks merged by families of 8: docs/theory/flow.md)"

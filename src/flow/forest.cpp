@@ -19,6 +19,12 @@ namespace sanguis::flow {
 
 namespace {
 
+/// Index of the tree at brick position pos in Forest::P4estObjects::tree_at (x fastest).
+std::size_t tree_slot(const ForestSpec& s, const std::array<std::int64_t, 3>& pos) {
+  return static_cast<std::size_t>(pos[0] +
+                                  s.trees[0] * (pos[1] + std::int64_t{s.trees[1]} * pos[2]));
+}
+
 void check_spec(const ForestSpec& s) {
   for (int d = 0; d < 3; ++d) {
     if (s.trees[static_cast<std::size_t>(d)] < 1) {
@@ -56,11 +62,8 @@ Forest::Forest(const ForestSpec& spec) : spec_(spec), p4est_(std::make_unique<P4
   families_partitioned_ = ranks_ == 1;
   const p8est_connectivity_t& conn = *p4est_->connectivity;
   p4est_->tree_at.assign(static_cast<std::size_t>(conn.num_trees), 0);
-  for (p4est_topidx_t t = 0; t < conn.num_trees; ++t) {
-    const auto pos = tree_position(conn, t);
-    p4est_->tree_at[static_cast<std::size_t>(
-        pos[0] + spec_.trees[0] * (pos[1] + std::int64_t{spec_.trees[1]} * pos[2]))] = t;
-  }
+  for (p4est_topidx_t t = 0; t < conn.num_trees; ++t)
+    p4est_->tree_at[tree_slot(spec_, tree_position(conn, t))] = t;
   rebuild_tables();
 }
 
@@ -74,8 +77,7 @@ int Forest::owner_of(int level, const std::array<std::int64_t, 3>& coord) const 
     const auto within = static_cast<p4est_qcoord_t>(coord[d] - (tree[d] << level));
     (d == 0 ? q.x : d == 1 ? q.y : q.z) = within << shift;
   }
-  const auto t = p4est_->tree_at[static_cast<std::size_t>(
-      tree[0] + spec_.trees[0] * (tree[1] + std::int64_t{spec_.trees[1]} * tree[2]))];
+  const auto t = p4est_->tree_at[tree_slot(spec_, tree)];
   return p8est_comm_find_owner(p4est_->forest.get(), t, &q, rank_);
 }
 

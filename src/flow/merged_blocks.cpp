@@ -77,8 +77,7 @@ MergedBlocks::MergedBlocks(const Forest& fine, const Forest& merged)
     const auto& c = fine.block(blk).coord;
     targets[D(blk)] = {merged.max_level(), {c[0] >> 1, c[1] >> 1, c[2] >> 1}, octant_of(c)};
   }
-  route_entries(route_blocks(merged, targets, "merged blocks"), targets, fine.ranks(), local_,
-                send_, receive_);
+  route_entries(route_blocks(merged, targets, "merged blocks"), targets, local_, send_, receive_);
 }
 
 template <bool kToMerged>

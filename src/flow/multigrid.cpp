@@ -928,7 +928,7 @@ void Multigrid::rebuild() {
       coarsened_->solver = std::make_unique<Multigrid>(*coarsened_->forest, kinds_, merge_blocks_,
                                                        true, gathered_blocks_limit_);
     } else {
-      coarsen_finest_level(forest_, *coarsened_->forest);
+      coarsened_->forest->assign_coarsened_finest_level(forest_);
       coarsened_->solver->rebuild();
     }
     Coarsened& c = *coarsened_;

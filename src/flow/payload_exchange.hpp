@@ -121,15 +121,16 @@ inline BlockRoutes route_blocks(const Forest& to, const std::vector<BlockTarget>
 /// rank), send[r] those of the blocks whose target rank r holds, in block order, and
 /// receive[r] those rank r sends here ({-1, local target, tag}), in its order.
 template <typename Entry>
-void route_entries(const BlockRoutes& routes, const std::vector<BlockTarget>& targets, int ranks,
+void route_entries(const BlockRoutes& routes, const std::vector<BlockTarget>& targets,
                    std::vector<Entry>& local, std::vector<std::vector<Entry>>& send,
                    std::vector<std::vector<Entry>>& receive) {
+  const std::size_t ranks = routes.sent.size();
   local.assign(targets.size(), Entry{-1, -1, -1});
   for (std::size_t b = 0; b < targets.size(); ++b)
     local[b] = Entry{static_cast<std::int32_t>(b), routes.local[b], targets[b].tag};
-  send.assign(static_cast<std::size_t>(ranks), {});
-  receive.assign(static_cast<std::size_t>(ranks), {});
-  for (std::size_t r = 0; r < static_cast<std::size_t>(ranks); ++r) {
+  send.assign(ranks, {});
+  receive.assign(ranks, {});
+  for (std::size_t r = 0; r < ranks; ++r) {
     for (const std::int32_t b : routes.sent[r])
       send[r].push_back(local[static_cast<std::size_t>(b)]);
     for (const auto& [target, tag] : routes.received[r])

@@ -84,11 +84,11 @@ TEST(CoarsenedBlocks, ACoarsenedForestAdaptedInPlaceHasTheLeavesOfANewOne) {
   testing::refine_where(fine,
                         [](const Vec3& c) { return c.x < 0.125 && c.y < 0.125 && c.z < 0.5; });
   ASSERT_EQ(fine.max_level(), 4);
-  coarsen_finest_level(fine, *reused);
+  reused->assign_coarsened_finest_level(fine);
   EXPECT_EQ(leaves(*reused), leaves(*coarsen_finest_level(fine)));
   EXPECT_EQ(reused->max_level(), 3);
   testing::refine_where(fine, [](const Vec3& c) { return c.x > 0.75; });
-  coarsen_finest_level(fine, *reused);
+  reused->assign_coarsened_finest_level(fine);
   EXPECT_EQ(leaves(*reused), leaves(*coarsen_finest_level(fine)));
 }
 
