@@ -704,7 +704,8 @@ RunSummary run_dem_case(const DemCase& c, const RunOptions& options, std::ostrea
   } catch (const SimulationError& e) {
     // Keep what the run had: a last snapshot to look at, and the reason in the log.
     record();
-    log << "ERROR: " << e.what() << "\n";
+    log << "ERROR: " << e.what() << "\nended by this error, "
+        << ProgressReporter::wall_clock_stamp() << "\n";
     throw;
   }
   // A last record at the end time if it is off the output grid; not when stopping early

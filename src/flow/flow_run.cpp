@@ -272,7 +272,10 @@ FlowRunSummary run_flow_case(const FlowCase& c, const FlowRunOptions& options,
       }
     }
   } catch (const SimulationError& e) {
-    if (root) log << "ERROR: " << e.what() << "\n";
+    if (root) {
+      log << "ERROR: " << e.what() << "\nended by this error, "
+          << ProgressReporter::wall_clock_stamp() << "\n";
+    }
     throw;
   }
   const double since_output = ns.time() - (next_output - c.output_interval);

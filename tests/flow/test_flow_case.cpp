@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/config.hpp"
+#include "core/error.hpp"
 #include "flow/flow_case.hpp"
 #include "flow/flow_run.hpp"
 
@@ -213,6 +214,25 @@ max_m = [0.25, 0.6, 0.5]
   const std::string stamp = R"(\d{4}-\d{2}-\d{2} \d{2}:\d{2}:\d{2} UTC)";
   EXPECT_TRUE(std::regex_search(log, std::regex("^sanguis \\S+, started " + stamp))) << log;
   EXPECT_TRUE(std::regex_search(log, std::regex("cell-updates/s\\), ended " + stamp))) << log;
+  std::filesystem::remove_all(dir);
+}
+
+TEST(FlowCase, ASolverThatFailsStopsTheRunWithTheReasonAndTheDateInTheLog) {
+  // One V-cycle cannot reach a relative tolerance of 1e-12: the first solve fails, the run
+  // stops with SimulationError, and run.log keeps the reason and when it happened.
+  const FlowCase c = parse(kChannel + "\n[flow.solver]\ntolerance = 1e-12\nmax_cycles = 1\n");
+  const auto dir = std::filesystem::temp_directory_path() / "sanguis_flow_error_test";
+  std::filesystem::remove_all(dir);
+  FlowRunOptions options;
+  options.output_dir = dir;
+  options.quiet = true;
+  std::ostringstream console;
+  EXPECT_THROW(run_flow_case(c, options, console), SimulationError);
+  const std::string log = read_bytes(dir / "run.log");
+  EXPECT_NE(log.find("ERROR: navier-stokes: "), std::string::npos) << log;
+  EXPECT_TRUE(std::regex_search(
+      log, std::regex(R"(\nended by this error, \d{4}-\d{2}-\d{2} \d{2}:\d{2}:\d{2} UTC\n$)")))
+      << log;
   std::filesystem::remove_all(dir);
 }
 

@@ -464,6 +464,10 @@ TEST_F(CliTest, UnstableTimeStepExitsWithCode1AndKeepsASnapshot) {
   EXPECT_NE(log.find("kn = "), std::string::npos) << log;
   EXPECT_NE(log.find("ERROR: step "), std::string::npos) << log;
   EXPECT_NE(log.find("exceeds the bound"), std::string::npos) << log;
+  // The date says when a run broke off, which durations alone cannot.
+  EXPECT_TRUE(std::regex_search(
+      log, std::regex(R"(\nended by this error, \d{4}-\d{2}-\d{2} \d{2}:\d{2}:\d{2} UTC\n)")))
+      << log;
   const std::vector<std::string> csv = lines_of(read_file(out / "diagnostics.csv"));
   ASSERT_GE(csv.size(), 3u);
   EXPECT_EQ(csv[0], kDiagnosticsHeader);
