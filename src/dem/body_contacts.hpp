@@ -226,9 +226,9 @@ inline std::optional<geometry::ContactPatch> element_obstacle_patch(
   const ObstacleMotion& m = obstacle.motion;
   bool formed = false;
   if (const auto* plane = std::get_if<PlaneShape>(&obstacle.shape)) {
-    formed = geometry::face_plane_patch(face, m.point_at(t, plane->point),
-                                        m.direction_to_space(t, plane->normal), crust,
-                                        patch.emplace());
+    formed =
+        geometry::face_plane_patch(face, m.point_at(t, plane->point),
+                                   m.direction_to_space(t, plane->normal), crust, patch.emplace());
   } else {
     bool faced = false;
     if (const auto* box = std::get_if<AxisAlignedBoxShape>(&obstacle.shape)) {
@@ -241,8 +241,8 @@ inline std::optional<geometry::ContactPatch> element_obstacle_patch(
                                         m.rotation_at(t) * e.orientation};
       faced = geometry::facing_face(e.shape, element_pose, -ec.normal, other);
     }
-    formed = faced && geometry::face_pair_patch(face, other, ec.normal, crust, 0.0,
-                                                patch.emplace());
+    formed =
+        faced && geometry::face_pair_patch(face, other, ec.normal, crust, 0.0, patch.emplace());
   }
   if (!formed || !detail::patch_holds_the_contact(*patch, ec)) patch.reset();
   return patch;
@@ -250,10 +250,10 @@ inline std::optional<geometry::ContactPatch> element_obstacle_patch(
 
 // What one element contact does to its first body.
 struct ElementResponse {
-  ContactResponse response;  // force and rolling torque on the first body
-  Vec3 point;                // where the force acts: the contact point or the patch's
-                             // centre of pressure
-  double overlap = 0.0;      // the point's, or the patch's weighted mean
+  ContactResponse response;    // force and rolling torque on the first body
+  Vec3 point;                  // where the force acts: the contact point or the patch's
+                               // centre of pressure
+  double overlap = 0.0;        // the point's, or the patch's weighted mean
   Vec3 arm_first, arm_second;  // from the bodies' centres to `point`
   Vec3 twist_torque;           // the patch's torsional resistance, on the first body [N m]
 };
@@ -274,13 +274,16 @@ struct ElementResponse {
 // point at its centre does not do.
 //
 // A patch also resists twisting about the normal, which the tangential spring at its
-// centre does not see: a torsional spring-dashpot with memory `twist` (the relative
-// rotation about the normal), as if each corner had the tangential spring and dashpot
-// of §2.3 with the corner's weight, M = -(kt theta + eta_t dtheta/dt) sum(w r^2), r the
-// corner's distance from the centre, bounded by mu_c |Fn| sum(w r) (a disc of radius R
-// pressed evenly slips at 2/3 mu_c |Fn| R) and kept continuous through slipping as
-// eq. 2.8 does; the rolling resistance then acts on the relative rotation less its
-// twist. A single point has no twist: `twist` is zeroed.
+// centre does not see: a torsional spring-dashpot with memory, as if the tangential
+// spring and dashpot of §2.3 were spread over the patch with its pressure. Its stiffness
+// and damping are kt J and eta_t J, J = <r^2> the pressure's second moment about the
+// centre (geometry::pressure_arms), and it slips at mu_c |Fn| <|r|> (an evenly pressed
+// disc of radius R at 2/3 mu_c |Fn| R). The memory `twist_moment` is the spring's moment
+// about n [N m], grown by -kt J dtheta each step as the rolling spring of eq. 2.10 is, so
+// a patch that grows or shrinks without turning gains no torque, and one with no spread
+// (a vertex on a face, J = 0) keeps none; on slipping it holds the slip moment less the
+// dashpot's, kept continuous as eq. 2.8 does. The rolling resistance then acts on the
+// relative rotation less its twist. A single point has no twist: `twist_moment` is zeroed.
 //
 // `other_velocity(x)` is the second body's velocity at the space point x;
 // `other_centre` its centre, or null for an obstacle (no lever arm: the arm is zero).
@@ -290,7 +293,7 @@ ElementResponse element_contact_response(const ContactParameters& params, const 
                                          const Vec3& vi, const Vec3& wi,
                                          OtherVelocity&& other_velocity, const Vec3& other_omega,
                                          const Vec3* other_centre, ContactHistory& h,
-                                         double& twist, double dt) {
+                                         double& twist_moment, double dt) {
   ElementResponse out;
   const auto kinematics_at = [&](const Vec3& point, double overlap) {
     out.point = point;
@@ -312,7 +315,7 @@ ElementResponse element_contact_response(const ContactParameters& params, const 
   }
   if (!(weights > 0.0)) {
     out.response = evaluate_contact(params, kinematics_at(ec.point, ec.overlap), h, dt);
-    twist = 0.0;
+    twist_moment = 0.0;
     return out;
   }
   double fn = 0.0, overlap = 0.0;
@@ -335,24 +338,15 @@ ElementResponse element_contact_response(const ContactParameters& params, const 
   c.relative_angular_velocity -= spin * ec.normal;
   out.response = contact_response_for_normal_force(params, c, h, dt, fn);
 
-  double second_moment = 0.0, mean_arm = 0.0;
-  for (int k = 0; k < patch->count; ++k) {
-    const double w = patch->overlap[k] * patch->perimeter_share[k] / weights;
-    const Vec3 r = patch->point[k] - centre;
-    const double r2 = norm2(r - dot(r, ec.normal) * ec.normal);
-    second_moment += w * r2;
-    mean_arm += w * std::sqrt(r2);
-  }
-  twist += dt * spin;
-  double moment =
-      -(params.tangential_stiffness * twist + params.tangential_damping * spin) * second_moment;
-  const double moment_max = params.friction * fn * mean_arm;
+  const geometry::PatchArms arms = geometry::pressure_arms(*patch, centre, ec.normal);
+  const double stiffness = params.tangential_stiffness * arms.second_moment;
+  const double damping = params.tangential_damping * arms.second_moment;
+  twist_moment -= stiffness * dt * spin;
+  double moment = twist_moment - damping * spin;
+  const double moment_max = params.friction * fn * arms.mean_arm;
   if (std::abs(moment) > moment_max) {
     moment = std::copysign(moment_max, moment);
-    twist = params.tangential_stiffness > 0.0 && second_moment > 0.0
-                ? -(moment / second_moment + params.tangential_damping * spin) /
-                      params.tangential_stiffness
-                : 0.0;
+    twist_moment = moment + damping * spin;
   }
   out.twist_torque = moment * ec.normal;
   return out;

@@ -94,9 +94,9 @@ struct BodyContactList {
   std::vector<std::uint16_t> element_first, element_second;
   std::vector<ContactHistory> history;
   std::vector<geometry::GjkWarmStart> warm;  // last GJK simplex: the next call starts there
-  // Twist held by the contact patch's torsional spring (body_contacts.hpp): the relative
-  // rotation of the first body about the normal since the spring was last unloaded [rad].
-  // The same number seen from either body, so it is not turned round with the pair.
+  // Moment held by the contact patch's torsional spring (body_contacts.hpp), on the first
+  // body about the normal [N m]. The same number seen from either body (the normal and
+  // the body turn round together), so it is not turned round with the pair.
   std::vector<double> twist;
 
   std::size_t size() const { return first.size(); }

@@ -301,20 +301,19 @@ void DemSimulation::compute_forces() {
     }
   };
   // The patch or point response of an element contact, on both bodies (body_contacts.hpp).
-  const auto element_response = [&](std::size_t i, const ElementContact& ec,
-                                    const geometry::ContactPatch* patch,
-                                    const auto& other_velocity, const Vec3& other_omega,
-                                    const Vec3* other_centre, const ContactParameters& params,
-                                    ContactHistory& h, double& twist, ContactOutcome& out) {
-    const ElementResponse r = element_contact_response(params, ec, patch, x[i], v[i], w[i],
-                                                       other_velocity, other_omega, other_centre,
-                                                       h, twist, dt);
-    const Vec3 couple = r.response.rolling_torque + r.twist_torque;
-    out.force = r.response.force;
-    out.torque_first = cross(r.arm_first, r.response.force) + couple;
-    out.torque_second = -(cross(r.arm_second, r.response.force) + couple);
-    out.touching = true;
-  };
+  const auto element_response =
+      [&](std::size_t i, const ElementContact& ec, const geometry::ContactPatch* patch,
+          const auto& other_velocity, const Vec3& other_omega, const Vec3* other_centre,
+          const ContactParameters& params, ContactHistory& h, double& twist, ContactOutcome& out) {
+        const ElementResponse r =
+            element_contact_response(params, ec, patch, x[i], v[i], w[i], other_velocity,
+                                     other_omega, other_centre, h, twist, dt);
+        const Vec3 couple = r.response.rolling_torque + r.twist_torque;
+        out.force = r.response.force;
+        out.torque_first = cross(r.arm_first, r.response.force) + couple;
+        out.torque_second = -(cross(r.arm_second, r.response.force) + couple);
+        out.touching = true;
+      };
   std::int64_t deep = 0;
   const auto body_pair_outcome = [&](std::size_t k) {
     ContactOutcome out;
@@ -366,11 +365,11 @@ void DemSimulation::compute_forces() {
       forget(h, body_walls_.twist[k]);
       return out;
     }
-    const auto patch = setup_.contact_patches
-                           ? element_obstacle_patch(obstacle, body_walls_.element_second[k], now,
-                                                    *a.core, {a.position, a.orientation}, a.crust,
-                                                    ec)
-                           : std::nullopt;
+    const auto patch =
+        setup_.contact_patches
+            ? element_obstacle_patch(obstacle, body_walls_.element_second[k], now, *a.core,
+                                     {a.position, a.orientation}, a.crust, ec)
+            : std::nullopt;
     const ObstacleMotion& m = obstacle.motion;
     const auto wall_velocity = [&](const Vec3& point) {
       return m.is_static() ? Vec3{} : m.velocity_at(now, point);
@@ -1187,7 +1186,10 @@ void DemSimulation::replace_particles(ParticleStore particles, std::vector<std::
 
 namespace {
 
-constexpr char kMagic[16] = "SANGUIS-DEM-CK3";
+constexpr char kMagic[16] = "SANGUIS-DEM-CK4";
+// The twist memory of body contacts as an angle (until 2026-12-05): read and dropped,
+// since a moment cannot be formed from it without the patch; the moments start at zero.
+constexpr char kMagicWithTwistAngles[16] = "SANGUIS-DEM-CK3";
 // Before the contact patches: no twist memory on body contacts (read as zero twist).
 constexpr char kMagicWithoutTwist[16] = "SANGUIS-DEM-CK2";
 // Before the storage sort: no sort keys (particles in the order of their creation), no
@@ -1335,10 +1337,12 @@ void DemSimulation::load_checkpoint(const std::filesystem::path& file) {
     in.read(magic, sizeof(magic));
     const bool without_keys =
         in && std::memcmp(magic, kMagicWithoutSortKeys, sizeof(kMagicWithoutSortKeys)) == 0;
-    const bool without_twist =
-        without_keys ||
-        (in && std::memcmp(magic, kMagicWithoutTwist, sizeof(kMagicWithoutTwist)) == 0);
-    if (!in || (!without_twist && std::memcmp(magic, kMagic, sizeof(kMagic)) != 0)) {
+    const bool without_twist = without_keys || (in && std::memcmp(magic, kMagicWithoutTwist,
+                                                                  sizeof(kMagicWithoutTwist)) == 0);
+    const bool twist_angles =
+        in && std::memcmp(magic, kMagicWithTwistAngles, sizeof(kMagicWithTwistAngles)) == 0;
+    if (!in ||
+        (!without_twist && !twist_angles && std::memcmp(magic, kMagic, sizeof(kMagic)) != 0)) {
       throw std::runtime_error("not a sanguis DEM checkpoint");
     }
     double dt = 0.0;
@@ -1392,6 +1396,10 @@ void DemSimulation::load_checkpoint(const std::filesystem::path& file) {
       if (body_pairs_.twist.size() != body_pairs_.size() ||
           body_walls_.twist.size() != body_walls_.size()) {
         throw std::runtime_error("checkpoint contact list is inconsistent");
+      }
+      if (twist_angles) {
+        body_pairs_.twist.assign(body_pairs_.size(), 0.0);
+        body_walls_.twist.assign(body_walls_.size(), 0.0);
       }
     }
     choose_threads();

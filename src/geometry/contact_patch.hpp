@@ -66,4 +66,18 @@ bool face_pair_patch(const SpaceFace& a, const SpaceFace& b, const Vec3& n, doub
 bool face_plane_patch(const SpaceFace& a, const Vec3& plane_point, const Vec3& plane_normal,
                       double crust, ContactPatch& out);
 
+// Arms of a patch's pressure about `centre`, measured in the plane normal to `normal`:
+// <r^2> and <|r|> over the patch area, the pressure taken as the overlap, which is linear
+// over the patch (the faces are planes). They are what a tangential spring spread over
+// the patch with that pressure would give against twisting (dem/body_contacts.hpp): an
+// evenly pressed square of side a gives a^2/6 and 0.383 a, a strip of length L L^2/12
+// and L/4. Integrated over the triangles between each edge and the centre in polar form
+// (exact for <r^2>, within 1 % for <|r|>); a patch of no area (corners on a line) along
+// its edges.
+struct PatchArms {
+  double second_moment = 0.0;  // <r^2> [m^2]
+  double mean_arm = 0.0;       // <|r|> [m]
+};
+PatchArms pressure_arms(const ContactPatch& patch, const Vec3& centre, const Vec3& normal);
+
 }  // namespace sanguis::geometry

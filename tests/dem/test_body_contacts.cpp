@@ -537,8 +537,8 @@ TEST(BodyContacts, PatchOnAnEdgeIsThePointLawAtTheMiddleOfTheEdge) {
   const ElementResponse r = respond(b, patch_law(), {}, h, twist, 1e-6);
   EXPECT_NEAR(r.response.normal_force, 4.5e5 * 1e-7, 1e-9 * 4.5e5 * 1e-7);
   EXPECT_NEAR(r.point.y, 2e-3, 1e-15);
-  const Vec3 edge = b.pose.position +
-                    rotate(b.pose.orientation, Vec3{4.8e-3, 0.0, -1.8e-3});  // lowest edge
+  const Vec3 edge =
+      b.pose.position + rotate(b.pose.orientation, Vec3{4.8e-3, 0.0, -1.8e-3});  // lowest edge
   EXPECT_NEAR(r.point.x, edge.x, 1e-9);
 }
 
@@ -561,28 +561,73 @@ TEST(BodyContacts, PatchDampsARockingFace) {
 }
 
 TEST(BodyContacts, PatchResistsTwistWithASpringThatSlipsAtTheCoulombMoment) {
-  // Spinning about the normal: M = -(kt theta + eta_t spin) J, J = a^2 + b^2 for a
-  // rectangle (a, b its half sides, four corners at that distance), until |M| reaches
-  // mu Fn sqrt(a^2 + b^2); then it stays there, and the spring is reset as in eq. 2.8.
+  // Spinning about the normal: the spring's moment grows by -kt J dtheta each step and
+  // the dashpot adds -eta_t J spin, J = <r^2> = (a^2 + b^2)/3 for an evenly pressed
+  // rectangle of half sides a, b, until |M| reaches mu Fn <|r|>; then it stays there,
+  // and the spring holds the slip moment less the dashpot's, as eq. 2.8 does.
   const BoxOnPlane b = box_on_plane(0.0, 1e-7);
   const ContactParameters law = patch_law();
-  const double a = 4.8e-3, half_width = 2.8e-3, j = a * a + half_width * half_width;
+  const double a = 4.8e-3, half_width = 2.8e-3, j = (a * a + half_width * half_width) / 3;
+  const int n = 400;  // cells per side of the midpoint sum of <|r|> below
   const double spin = 0.01, dt = 1e-3;
   ContactHistory h;
   double twist = 0.0;
   ElementResponse r = respond(b, law, {0.0, 0.0, spin}, h, twist, dt);
   // The relative rotation about the contact normal (-z) is -spin.
-  EXPECT_NEAR(twist, -spin * dt, 1e-18);
-  const double expected = (law.tangential_stiffness * spin * dt + law.tangential_damping * spin) * j;
+  EXPECT_NEAR(twist, law.tangential_stiffness * j * spin * dt, 1e-9 * twist);
+  const double expected =
+      (law.tangential_stiffness * spin * dt + law.tangential_damping * spin) * j;
   EXPECT_NEAR(r.twist_torque.z, -expected, 1e-9 * expected);
-  const double limit = law.friction * 4.5e5 * 1e-7 * std::sqrt(j);
-  for (int k = 0; k < 200000 && std::abs(r.twist_torque.z) < limit * (1.0 - 1e-12); ++k) {
+  // The slip moment, where the moment stops growing, against <|r|> of the rectangle by a
+  // midpoint sum, to the 1 % of geometry::pressure_arms.
+  double slip = 0.0;
+  for (int k = 0; k < 200000; ++k) {
+    const double before = r.twist_torque.z;
     r = respond(b, law, {0.0, 0.0, spin}, h, twist, dt);
+    if (r.twist_torque.z == before) {
+      slip = -r.twist_torque.z;
+      break;
+    }
   }
-  EXPECT_NEAR(r.twist_torque.z, -limit, 1e-9 * limit);
+  double rectangle_arm = 0.0;
+  for (int i = 0; i < n; ++i) {
+    for (int k = 0; k < n; ++k) {
+      rectangle_arm +=
+          std::hypot(2 * a * ((i + 0.5) / n - 0.5), 2 * half_width * ((k + 0.5) / n - 0.5));
+    }
+  }
+  rectangle_arm /= static_cast<double>(n) * n;
+  const double limit = law.friction * 4.5e5 * 1e-7 * rectangle_arm;
+  EXPECT_NEAR(slip, limit, 0.01 * limit);
   // Slipping: the spring holds what keeps the moment continuous once the spin stops.
   r = respond(b, law, {}, h, twist, dt);
-  EXPECT_NEAR(r.twist_torque.z, -limit + law.tangential_damping * spin * j, 1e-9 * limit);
+  EXPECT_NEAR(r.twist_torque.z, -slip + law.tangential_damping * spin * j, 1e-9 * slip);
+}
+
+TEST(BodyContacts, APatchThatGrowsWithoutTurningGainsNoTwist) {
+  // The spring's moment grows with the rotation times the patch's J at the time, as the
+  // rolling spring of eq. 2.10 does: a tiny patch (a corner just touching) spun for a
+  // long time holds almost nothing, and when the whole face then lands without turning
+  // the moment is still that, not the face's J times the accumulated angle.
+  BoxOnPlane tiny = box_on_plane(0.0, 1e-7);
+  const BoxOnPlane face = box_on_plane(0.0, 1e-7);
+  const Vec3 c = face.patch.point[0];
+  const double s = 1e-7;  // a 0.1 um square at a corner of the face
+  for (int k = 0; k < 4; ++k) {
+    tiny.patch.point[k] = c + Vec3{k == 1 || k == 2 ? s : 0.0, k >= 2 ? s : 0.0, 0.0};
+    tiny.patch.overlap[k] = 1e-7;
+    tiny.patch.perimeter_share[k] = s;
+  }
+  tiny.patch.count = 4;
+  const ContactParameters law = patch_law();
+  ContactHistory h;
+  double twist = 0.0;
+  for (int k = 0; k < 10000; ++k) respond(tiny, law, {0.0, 0.0, 1.0}, h, twist, 1e-4);
+  const double held = std::abs(twist);
+  EXPECT_GT(held, 0.0);
+  EXPECT_LT(held, law.friction * 4.5e5 * 1e-7 * s);  // at most the tiny patch's slip
+  const ElementResponse r = respond(face, law, {}, h, twist, 1e-4);
+  EXPECT_NEAR(std::abs(r.twist_torque.z), held, 1e-12 * held + 1e-30);
 }
 
 TEST(BodyContacts, PatchLeavesTheTwistToTheTorsionalSpring) {

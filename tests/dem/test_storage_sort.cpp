@@ -299,18 +299,21 @@ TEST(StorageSort, SpaceKeysRunLayerByLayerAlongTheAxisAndInZOrderWithin) {
                                         3 * layer + 15, 0}));
 }
 
-// The bytes of `sim`'s checkpoint cut to an older format: CK2 (before the contact
-// patches) lacks the body contacts' twists, CK1 (before the storage sort) the sort keys
-// as well; both were written in the same order, so the older files are prefixes.
+// The bytes of `sim`'s checkpoint in an older format: CK3 held the twists as angles in
+// the place of today's moments; CK2 (before the contact patches) lacks the body
+// contacts' twists, CK1 (before the storage sort) the sort keys as well; all were
+// written in the same order, so CK2 and CK1 files are prefixes.
 std::string older_checkpoint(const DemSimulation& sim, const char* magic, bool keep_sort_keys) {
-  const auto file = std::filesystem::temp_directory_path() / "sanguis_ck3.ck";
+  const auto file = std::filesystem::temp_directory_path() / "sanguis_ck4.ck";
   sim.save_checkpoint(file);
   std::string bytes = file_bytes(file);
   std::filesystem::remove(file);
-  const std::size_t twists = 8 + 8 * sim.body_contacts().size() + 8 +
-                             8 * sim.body_wall_contacts().size();
+  const bool keep_twists = std::string(magic) == "SANGUIS-DEM-CK3";
+  const std::size_t twists =
+      keep_twists ? 0
+                  : 8 + 8 * sim.body_contacts().size() + 8 + 8 * sim.body_wall_contacts().size();
   const std::size_t keys = keep_sort_keys ? 0 : 8 + 8 * sim.particles().size();
-  EXPECT_EQ(bytes.substr(0, 15), "SANGUIS-DEM-CK3");
+  EXPECT_EQ(bytes.substr(0, 15), "SANGUIS-DEM-CK4");
   bytes.resize(bytes.size() - twists - keys);
   bytes.replace(0, 15, magic);
   return bytes;
@@ -351,28 +354,32 @@ TEST(StorageSort, CheckpointsWrittenBeforeSortKeysStillLoad) {
   EXPECT_TRUE(same_bits(from_ck1.particles().position, from_ck2.particles().position));
 }
 
-TEST(StorageSort, CheckpointsWrittenBeforeContactPatchesLoadWithZeroTwist) {
-  // CK2 had no twist memory on body contacts: it loads with every twist at zero and
+TEST(StorageSort, CheckpointsWrittenBeforeTwistMomentsLoadWithZeroTwist) {
+  // CK2 had no twist memory on body contacts, CK3 held it as an angle, from which no
+  // moment can be formed without the patch: both load with every twist at zero and
   // everything else as written. Saved once a cross lies on the floor with a twist held,
   // the continued run is then another run, close to the original.
-  DemSimulation original(crosses_and_spheres(1, 0, IntegratorKind::kLeapfrog));
-  const auto twisted = [](const BodyContactList& list) {
-    return std::any_of(list.twist.begin(), list.twist.end(), [](double t) { return t != 0.0; });
-  };
-  for (int k = 0; k < 40000 && !twisted(original.body_wall_contacts()); ++k) original.step();
-  ASSERT_TRUE(twisted(original.body_wall_contacts()));
-  DemSimulation restarted = restarted_from(original, "SANGUIS-DEM-CK2", true);
-  EXPECT_EQ(restarted.particles().sort_key, original.particles().sort_key);
-  EXPECT_TRUE(same_bits(original.particles().position, restarted.particles().position));
-  ASSERT_EQ(restarted.body_wall_contacts().size(), original.body_wall_contacts().size());
-  for (double t : restarted.body_contacts().twist) EXPECT_EQ(t, 0.0);
-  for (double t : restarted.body_wall_contacts().twist) EXPECT_EQ(t, 0.0);
-  for (int k = 0; k < 100; ++k) {
-    original.step();
-    restarted.step();
-  }
-  for (std::size_t i = 0; i < original.particles().size(); ++i) {
-    EXPECT_LT(norm(original.particles().position[i] - restarted.particles().position[i]), 1e-6);
+  for (const char* magic : {"SANGUIS-DEM-CK2", "SANGUIS-DEM-CK3"}) {
+    SCOPED_TRACE(magic);
+    DemSimulation original(crosses_and_spheres(1, 0, IntegratorKind::kLeapfrog));
+    const auto twisted = [](const BodyContactList& list) {
+      return std::any_of(list.twist.begin(), list.twist.end(), [](double t) { return t != 0.0; });
+    };
+    for (int k = 0; k < 40000 && !twisted(original.body_wall_contacts()); ++k) original.step();
+    ASSERT_TRUE(twisted(original.body_wall_contacts()));
+    DemSimulation restarted = restarted_from(original, magic, true);
+    EXPECT_EQ(restarted.particles().sort_key, original.particles().sort_key);
+    EXPECT_TRUE(same_bits(original.particles().position, restarted.particles().position));
+    ASSERT_EQ(restarted.body_wall_contacts().size(), original.body_wall_contacts().size());
+    for (double t : restarted.body_contacts().twist) EXPECT_EQ(t, 0.0);
+    for (double t : restarted.body_wall_contacts().twist) EXPECT_EQ(t, 0.0);
+    for (int k = 0; k < 100; ++k) {
+      original.step();
+      restarted.step();
+    }
+    for (std::size_t i = 0; i < original.particles().size(); ++i) {
+      EXPECT_LT(norm(original.particles().position[i] - restarted.particles().position[i]), 1e-6);
+    }
   }
 }
 

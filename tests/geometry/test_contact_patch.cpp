@@ -7,7 +7,9 @@
 #include "geometry/convex_hull.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <initializer_list>
 #include <numbers>
 
 namespace sanguis::geometry {
@@ -166,6 +168,79 @@ TEST(ContactPatch, PerimeterSharesCarryOnWhenACornerCrossesAnEdge) {
     previous_count = p.count;
   }
   EXPECT_GT(changes, 0) << "no corner crossed an edge";
+}
+
+// A patch of the given corners (in the plane z = 0.3 mm) and overlaps.
+ContactPatch patch_of(std::initializer_list<std::array<double, 3>> corners) {
+  ContactPatch p;
+  for (const auto& [x, y, overlap] : corners) {
+    p.point[p.count] = {x, y, 3e-4};
+    p.overlap[p.count] = overlap;
+    p.perimeter_share[p.count] = 1.0;
+    ++p.count;
+  }
+  return p;
+}
+
+// <r^2> and <|r|> of the overlap over the rectangle [0, a] x [0, b] (overlap
+// d0 + dx x + dy y) about (cx, cy), by the midpoint rule on a fine grid.
+std::array<double, 2> fine_arms(double a, double b, double d0, double dx, double dy, double cx,
+                                double cy) {
+  const int n = 1000;
+  double weight = 0.0, arm = 0.0, arm2 = 0.0;
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      const double x = (i + 0.5) * a / n, y = (j + 0.5) * b / n;
+      const double w = d0 + dx * x + dy * y, r2 = (x - cx) * (x - cx) + (y - cy) * (y - cy);
+      weight += w;
+      arm += w * std::sqrt(r2);
+      arm2 += w * r2;
+    }
+  }
+  return {arm2 / weight, arm / weight};
+}
+
+TEST(ContactPatch, PressureArmsAreTheMomentsOfTheOverlapOverThePatch) {
+  const Vec3 z{0.0, 0.0, 1.0};
+  // An evenly pressed square of side s about its centre: <r^2> = s^2/6 (exact),
+  // <|r|> = s (sqrt(2) + asinh(1))/6 = 0.3826 s.
+  const double s = 2e-3;
+  PatchArms arms = pressure_arms(patch_of({{0, 0, 1e-6}, {s, 0, 1e-6}, {s, s, 1e-6}, {0, s, 1e-6}}),
+                                 {s / 2, s / 2, 3e-4}, z);
+  EXPECT_NEAR(arms.second_moment, s * s / 6, 1e-12 * s * s);
+  EXPECT_NEAR(arms.mean_arm, s * (std::sqrt(2.0) + std::asinh(1.0)) / 6, 0.002 * s);
+  // The same about a corner, the normal pointing the other way (corners clockwise).
+  arms = pressure_arms(patch_of({{0, 0, 1e-6}, {s, 0, 1e-6}, {s, s, 1e-6}, {0, s, 1e-6}}),
+                       {0, 0, 3e-4}, -1.0 * z);
+  EXPECT_NEAR(arms.second_moment, 2 * s * s / 3, 1e-12 * s * s);
+  // A cross's arm face (27 x 2 mm) with the overlap tilted across and along it, about a
+  // point off its centre.
+  const double a = 27e-3, b = 2e-3, dx = 3e-5, dy = 4e-4;
+  arms = pressure_arms(patch_of({{0, 0, 1e-6},
+                                 {a, 0, 1e-6 + dx * a},
+                                 {a, b, 1e-6 + dx * a + dy * b},
+                                 {0, b, 1e-6 + dy * b}}),
+                       {0.6 * a, 0.3 * b, 3e-4}, z);
+  const auto fine = fine_arms(a, b, 1e-6, dx, dy, 0.6 * a, 0.3 * b);
+  EXPECT_NEAR(arms.second_moment, fine[0], 1e-5 * fine[0]);
+  EXPECT_NEAR(arms.mean_arm, fine[1], 0.01 * fine[1]);
+  // An edge on a face: a sliver whose far side has no overlap tends to the line,
+  // <r^2> = L^2/12 and <|r|> = L/4 about its middle for an even overlap along it.
+  arms = pressure_arms(patch_of({{0, 0, 1e-6}, {a, 0, 1e-6}, {a, 1e-8, 0}, {0, 1e-8, 0}}),
+                       {a / 2, 1e-8 / 3, 3e-4}, z);
+  EXPECT_NEAR(arms.second_moment, a * a / 12, 1e-6 * a * a);
+  EXPECT_NEAR(arms.mean_arm, a / 4, 0.0025 * a);
+  // Corners on a line (no area): the same along the edges.
+  arms = pressure_arms(patch_of({{0, 0, 1e-6}, {a, 0, 1e-6}}), {a / 2, 0, 3e-4}, z);
+  EXPECT_NEAR(arms.second_moment, a * a / 12, 1e-9 * a * a);
+  EXPECT_NEAR(arms.mean_arm, a / 4, 1e-9 * a);
+  // Overlap at one end only, about the centre of pressure (a third of the way): L^2/18.
+  arms = pressure_arms(patch_of({{0, 0, 1e-6}, {a, 0, 0}}), {a / 3, 0, 3e-4}, z);
+  EXPECT_NEAR(arms.second_moment, a * a / 18, 1e-9 * a * a);
+  // Nothing pressed, or a single corner: no arms.
+  arms = pressure_arms(patch_of({{0, 0, 0}, {s, 0, 0}, {s, s, 0}}), {}, z);
+  EXPECT_EQ(arms.second_moment, 0.0);
+  EXPECT_EQ(pressure_arms(patch_of({{0, 0, 1e-6}}), {0, 0, 3e-4}, z).mean_arm, 0.0);
 }
 
 }  // namespace

@@ -385,7 +385,7 @@ TEST_F(CliTest, SmallCaseRunsAndWritesItsOutputs) {
   EXPECT_NE(log.find("glass - steel (wall)"), std::string::npos) << log;
   EXPECT_NE(log.find("time step       2e-06 s"), std::string::npos) << log;
   EXPECT_NE(log.find("done: t = 0.02 s"), std::string::npos) << log;
-  EXPECT_EQ(read_file(out / "checkpoint.bin").substr(0, 15), "SANGUIS-DEM-CK3");
+  EXPECT_EQ(read_file(out / "checkpoint.bin").substr(0, 15), "SANGUIS-DEM-CK4");
 }
 
 TEST_F(CliTest, VtkCanBeSwitchedOff) {

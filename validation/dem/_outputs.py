@@ -136,6 +136,28 @@ def _segments(lines):
     return out
 
 
+# The contact patches' torsional spring changed at this time (UTC; docs/theory/dem.md,
+# "The torsional spring until 2026-12-05 evening"): run segments started later use the
+# spread spring with its moment as memory (checkpoints CK4), earlier ones the corners'.
+TWIST_MOMENT_FROM = "2026-12-05 22:25:00"
+# What the change did where it was measured (2026-12-05, 22:54-23:04 UTC, AMD EPYC VM).
+TWIST_MOMENT_EFFECT = (
+    "Measured on the three 300-cross pours of crosses_tangential_packings (Table 3.1, 0.5 s "
+    "after the opening, both models from the same checkpoints): the height lost was 3.4, 1.1 "
+    "and 1.4 % of H0 against 4.4, 1.0 and 1.2 % before, region 3 on each either way, and a "
+    "step cost 5-7 % more.")
+
+
+def segment_starts(run):
+    """The UTC dates ("YYYY-MM-DD HH:MM:SS") at which segments of the run started: its
+    run.log's dated start and restart lines (dated since 2026-12-05); undated ones are left
+    out."""
+    stamp = r"(\d{4}-\d{2}-\d{2} \d{2}:\d{2}:\d{2}) UTC"
+    return [m.group(1) for m in (re.search(r"(?:, started |^--- restart from checkpoint at "
+                                           r"t = \S+ s, )" + stamp, line)
+                                 for line in _log_lines(run)) if m]
+
+
 def uncounted_spans(run):
     """(from, to) simulated times [s] the run went through with no wall time on record: a
     segment stopped before run.log recorded checkpoints (logs written before 2026-12-03)

@@ -66,7 +66,8 @@ import matplotlib
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import (paused_minutes, pool_span, read_arrays, read_pvd,  # noqa: E402
+from _outputs import (TWIST_MOMENT_EFFECT, TWIST_MOMENT_FROM, paused_minutes,  # noqa: E402
+                      pool_span, read_arrays, read_pvd, segment_starts,
                       read_summary, regime_name, speed_landmarks, wall_time, write_summary)
 from crosses_calibrated_gates import (GAMMA_T, KT, collapse, finished,  # noqa: E402
                                       seed_settings)
@@ -343,6 +344,27 @@ def draw(results, table31, sizes, seeds):
     fig.savefig(FIGURE, dpi=130)
 
 
+def twist_model_note(keys, with_table31):
+    """Which of the reported runs used which torsional spring of the contact patches: the
+    model changed at _outputs.TWIST_MOMENT_FROM, and a run restarted across the change is
+    made of both."""
+    before, across, after = [], [], []
+    for size, seed in keys:
+        pour, out, out31 = folders(size, seed)
+        for folder in [pour, out] + ([out31] if (size, seed) in with_table31 else []):
+            with open(os.path.join(folder, "run.log")) as f:
+                segments = sum(1 for line in f if ", started " in line or
+                               line.startswith("--- restart from checkpoint"))
+            later = sum(1 for t in segment_starts(folder) if t >= TWIST_MOMENT_FROM)
+            name = os.path.basename(folder)
+            (before if later == 0 else after if later == segments else across).append(name)
+    parts = [f"{label} {', '.join(names)}" for label, names in
+             (("before it:", before), ("partly after it:", across), ("after it:", after)) if names]
+    return (f"The contact patches' torsional spring changed at {TWIST_MOMENT_FROM[:16]} UTC "
+            "(docs/theory/dem.md, \"The torsional spring until 2026-12-05 evening\"); the runs "
+            "reported here ran " + "; ".join(parts) + ". " + TWIST_MOMENT_EFFECT)
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--build", default="build")
@@ -398,6 +420,7 @@ def main():
                      f"{r['stopped']}.")
     if all(any(key[0] == size for key in results) for size in SIZES):
         checks += contrast_checks(results, args.seeds)
+    notes.append(twist_model_note(keys, with_table31))
     notes.append("The thesis' sphere curves of Fig. 3.9a are checked by dam_break_scaling "
                  "(its column of a = 3.2); they are drawn here in grey when its runs are on "
                  "disk.")
