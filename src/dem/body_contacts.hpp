@@ -338,15 +338,21 @@ ElementResponse element_contact_response(const ContactParameters& params, const 
   c.relative_angular_velocity -= spin * ec.normal;
   out.response = contact_response_for_normal_force(params, c, h, dt, fn);
 
-  const geometry::PatchArms arms = geometry::pressure_arms(*patch, centre, ec.normal);
+  const geometry::PatchArms arms = geometry::pressure_arms(*patch, centre, ec.normal, false);
   const double stiffness = params.tangential_stiffness * arms.second_moment;
   const double damping = params.tangential_damping * arms.second_moment;
   twist_moment -= stiffness * dt * spin;
   double moment = twist_moment - damping * spin;
-  const double moment_max = params.friction * fn * arms.mean_arm;
-  if (std::abs(moment) > moment_max) {
-    moment = std::copysign(moment_max, moment);
-    twist_moment = moment + damping * spin;
+  // <|r|> >= <r^2> / (the farthest corner): a moment below 0.9 mu_c |Fn| of that (0.9 for
+  // the quadrature's 1 %) holds for sure, and <|r|> is integrated only above it.
+  const double held = arms.farthest > 0.0 ? 0.9 * arms.second_moment / arms.farthest : 0.0;
+  if (std::abs(moment) > params.friction * fn * held) {
+    const double moment_max =
+        params.friction * fn * geometry::pressure_arms(*patch, centre, ec.normal).mean_arm;
+    if (std::abs(moment) > moment_max) {
+      moment = std::copysign(moment_max, moment);
+      twist_moment = moment + damping * spin;
+    }
   }
   out.twist_torque = moment * ec.normal;
   return out;

@@ -74,10 +74,14 @@ bool face_plane_patch(const SpaceFace& a, const Vec3& plane_point, const Vec3& p
 // and L/4. Integrated over the triangles between each edge and the centre in polar form
 // (exact for <r^2>, within 1 % for <|r|>); a patch of no area (corners on a line) along
 // its edges.
+// `mean_arm` false leaves <|r|>, the part that takes square roots, at 0: the second moment
+// and the farthest corner bound it, <|r|> >= <r^2> / farthest.
 struct PatchArms {
   double second_moment = 0.0;  // <r^2> [m^2]
   double mean_arm = 0.0;       // <|r|> [m]
+  double farthest = 0.0;       // the largest corner distance from the centre [m]
 };
-PatchArms pressure_arms(const ContactPatch& patch, const Vec3& centre, const Vec3& normal);
+PatchArms pressure_arms(const ContactPatch& patch, const Vec3& centre, const Vec3& normal,
+                        bool mean_arm = true);
 
 }  // namespace sanguis::geometry
