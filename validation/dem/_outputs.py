@@ -145,7 +145,7 @@ TWIST_MOMENT_EFFECT = (
     "Measured on the three 300-cross pours of crosses_tangential_packings (Table 3.1, 0.5 s "
     "after the opening, both models from the same checkpoints): the height lost was 3.4, 1.1 "
     "and 1.4 % of H0 against 4.4, 1.0 and 1.2 % before, region 3 on each either way, and a "
-    "step cost 5-7 % more.")
+    "step cost 5-7 % more (less since: docs/performance.md, \"The spread torsional spring\").")
 
 
 def segment_starts(run):
