@@ -198,7 +198,11 @@ def main():
                   "commit f4aaf9e), the case's seed gave H0 17.9 cm, 6.31 touching "
                   "neighbours and 8.03 contact points per cross, and the ratio 8.9. With the "
                   "contact patches of flat faces (docs/theory/dem.md, from 2026-12-02 "
-                  f"evening) it gives H0 {100 * h0:.1f} cm, {zp:.2f} touching neighbours and "
+                  "evening) it gave H0 17.8 cm, 6.23 touching neighbours and 8.03 contact "
+                  "points per cross, and the ratio 11 (2026-12-02 18:07, commit 826b1db); "
+                  "with their torsional spring spread over the patch (\"The torsional spring "
+                  "until 2026-12-05 evening\"), pour and continuations rerun, "
+                  f"H0 {100 * h0:.1f} cm, {zp:.2f} touching neighbours and "
                   f"{zc:.2f} contact points per cross, and the ratio {ratio:.2g}.",
                   "Coordination: this column of 300 crosses is 3.9 cm long, one and a half "
                   "cross lengths: many crosses touch the back wall, the gate, a side wall "
