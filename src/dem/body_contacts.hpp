@@ -277,7 +277,7 @@ struct ElementResponse {
 // centre does not see: a torsional spring-dashpot with memory, as if the tangential
 // spring and dashpot of §2.3 were spread over the patch with its pressure. Its stiffness
 // and damping are kt J and eta_t J, J = <r^2> the pressure's second moment about the
-// centre (geometry::pressure_arms), and it slips at mu_c |Fn| <|r|> (an evenly pressed
+// centre (geometry::PatchPressure), and it slips at mu_c |Fn| <|r|> (an evenly pressed
 // disc of radius R at 2/3 mu_c |Fn| R). The memory `twist_moment` is the spring's moment
 // about n [N m], grown by -kt J dtheta each step as the rolling spring of eq. 2.10 is, so
 // a patch that grows or shrinks without turning gains no torque, and one with no spread
@@ -338,17 +338,17 @@ ElementResponse element_contact_response(const ContactParameters& params, const 
   c.relative_angular_velocity -= spin * ec.normal;
   out.response = contact_response_for_normal_force(params, c, h, dt, fn);
 
-  const geometry::PatchArms arms = geometry::pressure_arms(*patch, centre, ec.normal, false);
-  const double stiffness = params.tangential_stiffness * arms.second_moment;
-  const double damping = params.tangential_damping * arms.second_moment;
+  const geometry::PatchPressure pressure(*patch, centre, ec.normal);
+  const double stiffness = params.tangential_stiffness * pressure.second_moment();
+  const double damping = params.tangential_damping * pressure.second_moment();
   twist_moment -= stiffness * dt * spin;
   double moment = twist_moment - damping * spin;
   // <|r|> >= <r^2> / (the farthest corner): a moment below 0.9 mu_c |Fn| of that (0.9 for
   // the quadrature's 1 %) holds for sure, and <|r|> is integrated only above it.
-  const double held = arms.farthest > 0.0 ? 0.9 * arms.second_moment / arms.farthest : 0.0;
+  const double held =
+      pressure.farthest() > 0.0 ? 0.9 * pressure.second_moment() / pressure.farthest() : 0.0;
   if (std::abs(moment) > params.friction * fn * held) {
-    const double moment_max =
-        params.friction * fn * geometry::pressure_arms(*patch, centre, ec.normal).mean_arm;
+    const double moment_max = params.friction * fn * pressure.mean_arm();
     if (std::abs(moment) > moment_max) {
       moment = std::copysign(moment_max, moment);
       twist_moment = moment + damping * spin;

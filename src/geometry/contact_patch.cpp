@@ -252,23 +252,6 @@ bool face_plane_patch(const SpaceFace& a, const Vec3& plane_point, const Vec3& p
 
 namespace {
 
-// Overlap-weighted sums of 1, |r| and r^2 at quadrature points (r from the centre); the
-// |r| sum, the only one that takes square roots, only if asked for.
-struct ArmSums {
-  bool with_arm = true;
-  double weight = 0.0, arm = 0.0, arm2 = 0.0;
-  void add(double area_weight, double arm_weight, double arm2_weight, const Vec3& r) {
-    const double r2 = norm2(r);
-    weight += area_weight;
-    if (with_arm) arm += arm_weight * std::sqrt(r2);
-    arm2 += arm2_weight * r2;
-  }
-  PatchArms arms(double farthest) const {
-    if (!(weight > 0.0)) return {};
-    return {arm2 / weight, arm / weight, farthest};
-  }
-};
-
 constexpr double kGauss = 0.211324865405187;  // two-point Gauss-Legendre on [0, 1]
 
 // The parameter in [0, 1] of the point of the segment p + u e nearest the origin: where
@@ -278,91 +261,115 @@ double foot_on(const Vec3& p, const Vec3& e) {
   return e2 > 0.0 ? std::clamp(-dot(p, e) / e2, 0.0, 1.0) : 0.0;
 }
 
+// Calls f(u, w) at the two-point Gauss nodes of [0, 1] cut at `foot`, w the node's weight.
+template <typename F>
+void gauss_either_side(double foot, F&& f) {
+  for (const auto& [from, to] : {std::pair{0.0, foot}, std::pair{foot, 1.0}}) {
+    for (const double t : {kGauss, 1.0 - kGauss}) f(from + t * (to - from), 0.5 * (to - from));
+  }
+}
+
 }  // namespace
 
-PatchArms pressure_arms(const ContactPatch& patch, const Vec3& centre, const Vec3& normal,
-                        bool mean_arm) {
-  const int n = patch.count;
-  if (n < 2) return {};
-  // Corners relative to the centre, in the plane normal to n.
-  std::array<Vec3, ContactPatch::kCapacity> r;
+PatchPressure::PatchPressure(const ContactPatch& patch, const Vec3& centre, const Vec3& normal)
+    : n_(patch.count), overlap_(patch.overlap), normal_(normal) {
+  if (n_ < 2) return;
   double farthest2 = 0.0;
-  for (int k = 0; k < n; ++k) {
+  for (int k = 0; k < n_; ++k) {
     const Vec3 x = patch.point[k] - centre;
-    r[k] = x - dot(x, normal) * normal;
-    farthest2 = std::max(farthest2, norm2(r[k]));
+    r_[k] = x - dot(x, normal) * normal;
+    farthest2 = std::max(farthest2, norm2(r_[k]));
   }
-  const double farthest = std::sqrt(farthest2);
-  const auto next = [n](int k) { return k + 1 == n ? 0 : k + 1; };  // no modulo: a division
-  const auto depth = [&](int k) { return patch.overlap[k]; };
+  farthest_ = std::sqrt(farthest2);
   Vec3 mid, turn;
   double mid_overlap = 0.0, edges2 = 0.0;
-  for (int k = 0; k < n; ++k) {
-    mid += r[k];
-    mid_overlap += depth(k);
-    edges2 += norm2(r[next(k)] - r[k]);
-    turn += cross(r[k], r[next(k)]);
+  for (int k = 0; k < n_; ++k) {
+    mid += r_[k];
+    mid_overlap += overlap_[k];
+    edges2 += norm2(r_[next(k)] - r_[k]);
+    turn += cross(r_[k], r_[next(k)]);
   }
-  mid = mid / static_cast<double>(n);
-  mid_overlap /= n;                             // a linear overlap's value at the corners' mean
+  mid = mid / static_cast<double>(n_);
+  mid_overlap /= n_;                            // a linear overlap's value at the corners' mean
   const double twice_area = dot(turn, normal);  // signed: the corners' sense about n
-  ArmSums sums;
-  sums.with_arm = mean_arm;
-  if (n > 2 && std::abs(twice_area) > 1e-9 * edges2) {
-    // The overlap's gradient in the plane (divergence theorem: the integral of grad d over
-    // the area is that of d times the outward normal around it), hence its value at the
-    // centre.
-    Vec3 gradient;
-    for (int k = 0; k < n; ++k) {
-      gradient += 0.5 * (depth(k) + depth(next(k))) * cross(r[next(k)] - r[k], normal);
-    }
-    const double dc = mid_overlap - dot(gradient, mid) / (0.5 * twice_area);
-    // Triangle (centre, P, Q) in polar form: x = s w(u), w = (1 - u) P + u Q, dA = s |P x Q|
-    // ds du, overlap (1 - s) dc + s dw(u), dw = (1 - u) dP + u dQ. Over s exactly: dc/6 +
-    // dw/3 for the area, dc/12 + dw/4 for |r| and dc/20 + dw/5 for r^2. Over u the area
-    // and r^2 in closed form (polynomials); |r|, if asked for, by two-point Gauss on each
-    // side of the foot of the centre on the edge, where |w| has its kink.
-    double area = 0.0, second = 0.0;  // 6 and 60 times the integrals
-    for (int k = 0; k < n; ++k) {
-      const Vec3 &p = r[k], &q = r[next(k)];
-      const double size = std::abs(dot(cross(p, q), normal));
-      if (!(size > 0.0)) continue;
-      const double dp = depth(k), dq = depth(next(k));
-      const double pp = norm2(p), pq = dot(p, q), qq = norm2(q);
-      area += size * (dc + dp + dq);
-      second +=
-          size * (dc * (pp + pq + qq) + dp * (3 * pp + 2 * pq + qq) + dq * (pp + 2 * pq + 3 * qq));
-      if (!mean_arm) continue;
-      const Vec3 edge = q - p;
-      const double foot = foot_on(p, edge);
-      for (const auto& [from, to] : {std::pair{0.0, foot}, std::pair{foot, 1.0}}) {
-        for (const double t : {kGauss, 1.0 - kGauss}) {
-          const double u = from + t * (to - from), w = 0.5 * (to - from) * size;
-          const double dw = (1.0 - u) * dp + u * dq;
-          sums.add(w * (2 * dc + 4 * dw), w * (dc + 3 * dw), 0.0, p + u * edge);  // x 12
-        }
-      }
-    }
-    if (!(area > 0.0)) return {};
-    return {0.1 * second / area, mean_arm ? sums.arm / sums.weight : 0.0, farthest};
+  flat_ = n_ > 2 && std::abs(twice_area) > 1e-9 * edges2;
+  if (!flat_) {
+    line_integrals();
+    return;
   }
-  // No area: the corners lie on a line through the centre, and the pressure acts along
-  // it: each edge (a two-corner patch's one edge; otherwise each twice, which the ratios
-  // do not see), cut at the centre's foot, two-point Gauss on each piece (exact: |r| is
-  // linear on each).
-  for (int k = 0; k < (n == 2 ? 1 : n); ++k) {
-    const Vec3& p = r[k];
-    const Vec3 edge = r[next(k)] - p;
-    const double length = std::sqrt(norm2(edge)), foot = foot_on(p, edge);
-    for (const auto& [from, to] : {std::pair{0.0, foot}, std::pair{foot, 1.0}}) {
-      for (const double t : {kGauss, 1.0 - kGauss}) {
-        const double u = from + t * (to - from), w = 0.5 * (to - from) * length;
-        const double d = (1.0 - u) * depth(k) + u * depth(next(k));
-        sums.add(w * d, w * d, w * d, p + u * edge);
-      }
-    }
+  // The overlap's gradient in the plane (divergence theorem: the integral of grad d over
+  // the area is that of d times the outward normal around it), hence its value at the
+  // centre.
+  Vec3 gradient;
+  for (int k = 0; k < n_; ++k) {
+    gradient += 0.5 * (overlap_[k] + overlap_[next(k)]) * cross(r_[next(k)] - r_[k], normal);
   }
-  return sums.arms(farthest);
+  centre_overlap_ = mid_overlap - dot(gradient, mid) / (0.5 * twice_area);
+  // Triangle (centre, P, Q) in polar form: x = s w(u), w = (1 - u) P + u Q, dA = s |P x Q|
+  // ds du, overlap (1 - s) dc + s dw(u), dw = (1 - u) dP + u dQ. Over s exactly: dc/6 +
+  // dw/3 for the area, dc/12 + dw/4 for |r| and dc/20 + dw/5 for r^2; over u the area and
+  // r^2 here in closed form (polynomials), |r| in mean_arm.
+  const double dc = centre_overlap_;
+  double area = 0.0, second = 0.0;  // 6 and 60 times the integrals
+  for (int k = 0; k < n_; ++k) {
+    const Vec3 &p = r_[k], &q = r_[next(k)];
+    const double size = std::abs(dot(cross(p, q), normal));
+    const double dp = overlap_[k], dq = overlap_[next(k)];
+    const double pp = norm2(p), pq = dot(p, q), qq = norm2(q);
+    area += size * (dc + dp + dq);
+    second +=
+        size * (dc * (pp + pq + qq) + dp * (3 * pp + 2 * pq + qq) + dq * (pp + 2 * pq + 3 * qq));
+  }
+  if (area > 0.0) second_moment_ = 0.1 * second / area;
+}
+
+// No area: the corners lie on a line through the centre, and the pressure acts along it:
+// each edge (a two-corner patch's one edge; otherwise each twice, which the ratios do not
+// see), cut at the centre's foot, two-point Gauss on each piece (exact: |r| is linear on
+// each).
+void PatchPressure::line_integrals() {
+  double weight = 0.0, arm = 0.0, arm2 = 0.0;
+  for (int k = 0; k < (n_ == 2 ? 1 : n_); ++k) {
+    const Vec3& p = r_[k];
+    const Vec3 edge = r_[next(k)] - p;
+    const double length = std::sqrt(norm2(edge));
+    gauss_either_side(foot_on(p, edge), [&](double u, double w) {
+      const double d = w * length * ((1.0 - u) * overlap_[k] + u * overlap_[next(k)]);
+      const double r2 = norm2(p + u * edge);
+      weight += d;
+      arm += d * std::sqrt(r2);
+      arm2 += d * r2;
+    });
+  }
+  if (weight > 0.0) {
+    second_moment_ = arm2 / weight;
+    line_mean_arm_ = arm / weight;
+  }
+}
+
+double PatchPressure::mean_arm() const {
+  if (!flat_ || !(second_moment_ > 0.0)) return line_mean_arm_;
+  // Two-point Gauss on each side of the foot of the centre on each edge, where |w| has its
+  // kink; the weights 12 times those of the constructor's comment.
+  const double dc = centre_overlap_;
+  double weight = 0.0, arm = 0.0;
+  for (int k = 0; k < n_; ++k) {
+    const Vec3 &p = r_[k], &q = r_[next(k)];
+    const double size = std::abs(dot(cross(p, q), normal_));
+    if (!(size > 0.0)) continue;
+    const Vec3 edge = q - p;
+    gauss_either_side(foot_on(p, edge), [&](double u, double w) {
+      const double dw = (1.0 - u) * overlap_[k] + u * overlap_[next(k)];
+      weight += w * size * (2 * dc + 4 * dw);
+      arm += w * size * (dc + 3 * dw) * std::sqrt(norm2(p + u * edge));
+    });
+  }
+  return arm / weight;
+}
+
+PatchArms pressure_arms(const ContactPatch& patch, const Vec3& centre, const Vec3& normal) {
+  const PatchPressure pressure(patch, centre, normal);
+  return {pressure.second_moment(), pressure.mean_arm()};
 }
 
 }  // namespace sanguis::geometry

@@ -66,22 +66,38 @@ bool face_pair_patch(const SpaceFace& a, const SpaceFace& b, const Vec3& n, doub
 bool face_plane_patch(const SpaceFace& a, const Vec3& plane_point, const Vec3& plane_normal,
                       double crust, ContactPatch& out);
 
-// Arms of a patch's pressure about `centre`, measured in the plane normal to `normal`:
-// <r^2> and <|r|> over the patch area, the pressure taken as the overlap, which is linear
-// over the patch (the faces are planes). They are what a tangential spring spread over
-// the patch with that pressure would give against twisting (dem/body_contacts.hpp): an
-// evenly pressed square of side a gives a^2/6 and 0.383 a, a strip of length L L^2/12
-// and L/4. Integrated over the triangles between each edge and the centre in polar form
-// (exact for <r^2>, within 1 % for <|r|>); a patch of no area (corners on a line) along
-// its edges.
-// `mean_arm` false leaves <|r|>, the part that takes square roots, at 0: the second moment
-// and the farthest corner bound it, <|r|> >= <r^2> / farthest.
+// The pressure over a patch about `centre`, measured in the plane normal to `normal`: the
+// overlap, which is linear over the patch (the faces are planes), and its moments <r^2>
+// and <|r|>. They are what a tangential spring spread over the patch with that pressure
+// would give against twisting (dem/body_contacts.hpp): an evenly pressed square of side
+// a gives a^2/6 and 0.383 a, a strip of length L L^2/12 and L/4. Integrated over the
+// triangles between each edge and the centre in polar form, <r^2> exactly in the
+// constructor, <|r|> (square roots) on demand, within 1 %; a patch of no area (corners on
+// a line) along its edges. <|r|> >= <r^2> / farthest() bounds it from below.
+class PatchPressure {
+ public:
+  PatchPressure(const ContactPatch& patch, const Vec3& centre, const Vec3& normal);
+  double second_moment() const { return second_moment_; }  // <r^2> [m^2]
+  double farthest() const { return farthest_; }            // the largest corner distance [m]
+  double mean_arm() const;                                 // <|r|> [m]
+
+ private:
+  int next(int k) const { return k + 1 == n_ ? 0 : k + 1; }  // no modulo: a division
+  void line_integrals();
+
+  int n_ = 0;
+  std::array<Vec3, ContactPatch::kCapacity> r_;  // corners from the centre, in the plane
+  std::array<double, ContactPatch::kCapacity> overlap_;
+  Vec3 normal_;
+  bool flat_ = false;  // an area; else corners on a line
+  double centre_overlap_ = 0.0, second_moment_ = 0.0, farthest_ = 0.0, line_mean_arm_ = 0.0;
+};
+
 struct PatchArms {
   double second_moment = 0.0;  // <r^2> [m^2]
   double mean_arm = 0.0;       // <|r|> [m]
-  double farthest = 0.0;       // the largest corner distance from the centre [m]
 };
-PatchArms pressure_arms(const ContactPatch& patch, const Vec3& centre, const Vec3& normal,
-                        bool mean_arm = true);
+// Both moments at once (PatchPressure).
+PatchArms pressure_arms(const ContactPatch& patch, const Vec3& centre, const Vec3& normal);
 
 }  // namespace sanguis::geometry

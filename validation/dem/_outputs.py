@@ -149,13 +149,15 @@ TWIST_MOMENT_EFFECT = (
 
 
 def segment_starts(run):
-    """The UTC dates ("YYYY-MM-DD HH:MM:SS") at which segments of the run started: its
-    run.log's dated start and restart lines (dated since 2026-12-05); undated ones are left
-    out."""
-    stamp = r"(\d{4}-\d{2}-\d{2} \d{2}:\d{2}:\d{2}) UTC"
-    return [m.group(1) for m in (re.search(r"(?:, started |^--- restart from checkpoint at "
-                                           r"t = \S+ s, )" + stamp, line)
-                                 for line in _log_lines(run)) if m]
+    """When each segment of the run started, from its run.log's start and restart lines:
+    the UTC date ("YYYY-MM-DD HH:MM:SS") where the line has one (since 2026-12-05), else
+    None."""
+    out = []
+    for line in _log_lines(run):
+        if ", started " in line or line.startswith("--- restart from checkpoint"):
+            m = re.search(r"(\d{4}-\d{2}-\d{2} \d{2}:\d{2}:\d{2}) UTC", line)
+            out.append(m.group(1) if m else None)
+    return out
 
 
 def uncounted_spans(run):

@@ -352,12 +352,10 @@ def twist_model_note(keys, with_table31):
     for size, seed in keys:
         pour, out, out31 = folders(size, seed)
         for folder in [pour, out] + ([out31] if (size, seed) in with_table31 else []):
-            with open(os.path.join(folder, "run.log")) as f:
-                segments = sum(1 for line in f if ", started " in line or
-                               line.startswith("--- restart from checkpoint"))
-            later = sum(1 for t in segment_starts(folder) if t >= TWIST_MOMENT_FROM)
+            starts = segment_starts(folder)
+            later = sum(1 for t in starts if t and t >= TWIST_MOMENT_FROM)
             name = os.path.basename(folder)
-            (before if later == 0 else after if later == segments else across).append(name)
+            (before if later == 0 else after if later == len(starts) else across).append(name)
     parts = [f"{label} {', '.join(names)}" for label, names in
              (("before it:", before), ("partly after it:", across), ("after it:", after)) if names]
     return (f"The contact patches' torsional spring changed at {TWIST_MOMENT_FROM[:16]} UTC "

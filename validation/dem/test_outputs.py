@@ -183,7 +183,7 @@ class RunSegments(unittest.TestCase):
 
 
 class SegmentStarts(unittest.TestCase):
-    def test_the_dated_start_and_restart_lines_give_when_segments_began(self):
+    def test_the_start_and_restart_lines_give_when_segments_began(self):
         with tempfile.TemporaryDirectory() as tmp:
             write_run_log(tmp, [
                 "sanguis 0.1.0, started 2026-12-05 21:56:08 UTC",
@@ -192,8 +192,9 @@ class SegmentStarts(unittest.TestCase):
                 "--- restart from checkpoint at t = 4.850000 s",
                 "--- restart from checkpoint at t = 4.900000 s, 2026-12-05 23:10:00 UTC"])
             starts = _outputs.segment_starts(tmp)
-            self.assertEqual(starts, ["2026-12-05 21:56:08", "2026-12-05 23:10:00"])
-            self.assertEqual([t >= _outputs.TWIST_MOMENT_FROM for t in starts], [False, True])
+            self.assertEqual(starts, ["2026-12-05 21:56:08", None, "2026-12-05 23:10:00"])
+            self.assertEqual([t >= _outputs.TWIST_MOMENT_FROM for t in starts if t],
+                             [False, True])
             self.assertEqual(_outputs.segment_starts(os.path.join(tmp, "none")), [])
 
 
