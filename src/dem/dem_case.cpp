@@ -558,6 +558,9 @@ DemCase load_dem_case(const ConfigTable& cfg, const std::filesystem::path& sourc
   if (sort_steps < 0) sim.fail("storage_sort_steps", "must be >= 0 (0: never sort)");
   s.storage_sort_interval = sort_steps;
   s.contact_patches = sim.get_choice("flat_contacts", {"patch", "point"}, "patch") == "patch";
+  if (sim.has("forget_contact_memory_at_s")) {
+    s.forget_contact_memory_at = sim.get_non_negative("forget_contact_memory_at_s", 0.0);
+  }
   const bool allow_large_dt = sim.get_bool("allow_large_time_step", false);
   const bool dt_given = sim.has("time_step_s");
   const double dt_value = dt_given ? sim.get_positive("time_step_s") : 0.0;
@@ -806,6 +809,10 @@ std::string describe(const DemCase& c) {
       << (s.contact_patches ? "patch (spring-dashpots at the patch corners)"
                             : "point (one per element pair, thesis §2.3)")
       << "\n";
+  }
+  if (std::isfinite(s.forget_contact_memory_at)) {
+    o << "contact memory  forgotten at t = " << s.forget_contact_memory_at
+      << " s (every tangential, rolling and twist spring set to zero)\n";
   }
   o << "integrator      " << to_string(s.integrator) << " (order " << order_of(s.integrator)
     << ")\n";

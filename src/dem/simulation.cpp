@@ -103,9 +103,31 @@ void DemSimulation::refresh_forces() {
   compute_forces();
 }
 
+void DemSimulation::forget_contact_memory() {
+  for (ContactList* list : {&pairs_, &walls_}) {
+    for (ContactHistory& h : list->history) {
+      h.tangential_displacement = {};
+      h.rolling_spring_torque = {};
+    }
+  }
+  for (BodyContactList* list : {&body_pairs_, &body_walls_}) {
+    for (ContactHistory& h : list->history) {
+      h.tangential_displacement = {};
+      h.rolling_spring_torque = {};
+    }
+    std::fill(list->twist.begin(), list->twist.end(), 0.0);
+  }
+}
+
 void DemSimulation::step() {
   const double dt = setup_.time_step;
   ParticleStore& p = setup_.particles;
+  // On the step grid, so a restart from a checkpoint written at that step forgets too,
+  // and one written later does not forget again.
+  if (std::isfinite(setup_.forget_contact_memory_at) &&
+      step_ == std::llround(setup_.forget_contact_memory_at / dt)) {
+    forget_contact_memory();
+  }
   if (!setup_.pour.empty()) pour_particles();
   integrator_.advance(p, setup_.gravity, dt);
   ++step_;

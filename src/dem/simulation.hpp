@@ -3,6 +3,7 @@
 // Verlet lists are stale), contact forces with memory, integration.
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <random>
 #include <span>
 #include <string>
@@ -87,6 +88,11 @@ struct DemSetup {
   // (body_contacts.hpp); false: at one point per element pair as in thesis §2.3 and
   // Grains3D (GJK's closest points; the overlap-weighted face centre against planes).
   bool contact_patches = true;
+  // At the start of the step from this time every contact forgets its memory (the
+  // tangential and rolling springs, a patch's twist): the contacts go on, their springs
+  // start again from zero, as in a run reloaded from positions and velocities alone (a
+  // pour saved without its contact history). Infinity: never.
+  double forget_contact_memory_at = std::numeric_limits<double>::infinity();
   std::vector<std::string> material_names;
   ContactTable contacts;
   std::vector<Obstacle> obstacles;
@@ -192,6 +198,9 @@ class DemSimulation {
 
   // Recomputes forces at the current state (after the state was edited by hand).
   void refresh_forces();
+  // Sets every contact's memory to zero (DemSetup::forget_contact_memory_at does it
+  // during a run): tangential springs, rolling springs and the patches' twist moments.
+  void forget_contact_memory();
 
   // Domain decomposition (particle_exchange.hpp). The exchange is not owned; nullptr: alone.
   void set_exchange(ParticleExchange* exchange) { exchange_ = exchange; }

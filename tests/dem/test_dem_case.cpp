@@ -276,7 +276,8 @@ gravity_m_s2 = [0.0, -1.0, 0.0]
 skin_m = 2e-4
 abort_overlap_ratio = 0.2
 storage_sort_steps = 0
-flat_contacts = "point")");
+flat_contacts = "point"
+forget_contact_memory_at_s = 0.004)");
   text += R"(
 [output]
 interval_s = 0.002
@@ -296,6 +297,10 @@ check_after_s = 0.003
   EXPECT_EQ(load(kValidCase).setup.storage_sort_interval, 2000);  // the default
   EXPECT_FALSE(c.setup.contact_patches);
   EXPECT_TRUE(load(kValidCase).setup.contact_patches);  // the default
+  EXPECT_EQ(c.setup.forget_contact_memory_at, 0.004);
+  EXPECT_NE(describe(c).find("contact memory  forgotten at t = 0.004 s"), std::string::npos);
+  EXPECT_TRUE(std::isinf(load(kValidCase).setup.forget_contact_memory_at));  // never
+  EXPECT_EQ(describe(load(kValidCase)).find("contact memory"), std::string::npos);
   EXPECT_EQ(c.output.interval, 0.002);
   EXPECT_FALSE(c.output.vtk);
   EXPECT_EQ(c.output.checkpoint_interval, 0.005);
@@ -411,6 +416,11 @@ TEST(DemCaseErrors, NegativeStorageSortInterval) {
 TEST(DemCaseErrors, UnknownFlatContactModel) {
   expect_case_error(replaced(kValidCase, "seed = 3", "seed = 3\nflat_contacts = \"manifold\""),
                     "simulation.flat_contacts", "patch");
+}
+
+TEST(DemCaseErrors, NegativeTimeToForgetTheContactMemory) {
+  expect_case_error(replaced(kValidCase, "seed = 3", "seed = 3\nforget_contact_memory_at_s = -1.0"),
+                    "simulation.forget_contact_memory_at_s", "must be >= 0");
 }
 
 TEST(DemCaseErrors, NegativeOrZeroRadius) {

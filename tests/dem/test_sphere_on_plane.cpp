@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <limits>
 #include <numbers>
 
 #include "dem/parameter_procedure.hpp"
@@ -21,6 +23,7 @@ struct PlaneCase {
   double rolling_friction = 0.0;
   bool memory = true;  // false: kt = kr = 0 (dashpots only)
   Vec3 velocity, angular_velocity;
+  double forget_memory_at = std::numeric_limits<double>::infinity();  // [s]
 };
 
 DemSimulation make_sphere_on_plane(const PlaneCase& pc) {
@@ -46,6 +49,7 @@ DemSimulation make_sphere_on_plane(const PlaneCase& pc) {
   const double theta = pc.incline_deg * kPi / 180.0;
   s.gravity = {kG * std::sin(theta), 0.0, -kG * std::cos(theta)};
   s.time_step = r.recommended_time_step;
+  s.forget_contact_memory_at = pc.forget_memory_at;
   s.material_names = {"sphere", "plane"};
   s.contacts = ContactTable(2);
   s.contacts.set(0, 0, p);
@@ -76,6 +80,62 @@ TEST(SphereOnPlane, CreepsWithoutMemory) {
   const Vec3 start = sim.particles().position[0];
   sim.run_until(1.0);
   EXPECT_GT(norm(sim.particles().position[0] - start), 1e-6);
+}
+
+// DemSetup::forget_contact_memory_at: the sphere at rest on the incline holds its weight's
+// slope component in its tangential spring (and rolling spring). Forgetting the memory
+// empties both, so the sphere gives way until the springs carry the load again, and then
+// rests again with the same spring loads.
+TEST(SphereOnPlane, ForgettingTheMemoryEmptiesTheSpringsAndTheSphereGivesWayUntilTheyReload) {
+  PlaneCase pc{20.0, 0.5, 0.45, true, {}, {}};
+  pc.forget_memory_at = 0.5;
+  DemSimulation sim = make_sphere_on_plane(pc);
+  sim.run_until(0.5);
+  ASSERT_EQ(sim.wall_contacts().size(), 1u);
+  const ContactHistory loaded = sim.wall_contacts().history[0];
+  const double spring = norm(loaded.tangential_displacement);
+  ASSERT_GT(spring, 0.0);
+  ASSERT_GT(norm(loaded.rolling_spring_torque), 0.0);
+  const Vec3 rest = sim.particles().position[0];
+  EXPECT_LT(norm(sim.particles().velocity[0]), 1e-10);
+
+  sim.step();  // the step from t = 0.5 s starts by forgetting
+  const ContactHistory emptied = sim.wall_contacts().history[0];
+  EXPECT_LT(norm(emptied.tangential_displacement), 1e-3 * spring);
+  EXPECT_LT(norm(emptied.rolling_spring_torque), 1e-3 * norm(loaded.rolling_spring_torque));
+
+  sim.run_until(1.5);
+  const ContactHistory reloaded = sim.wall_contacts().history[0];
+  EXPECT_NEAR(norm(reloaded.tangential_displacement) / spring, 1.0, 0.01);
+  EXPECT_LT(norm(sim.particles().velocity[0]), 1e-10);
+  // It gave way by about the spring's stretch (the contact point moved by that much).
+  const double moved = norm(sim.particles().position[0] - rest);
+  EXPECT_GT(moved, 0.3 * spring);
+  EXPECT_LT(moved, 3.0 * spring);
+}
+
+// The forgetting is tied to the step grid, so a restart from the step it falls on
+// forgets and one from a later step does not forget again: a run stopped and restarted
+// there gives the bits of the run that went through.
+TEST(SphereOnPlane, ARestartForgetsTheMemoryAtTheSameStepOnly) {
+  PlaneCase pc{20.0, 0.5, 0.45, true, {}, {}};
+  pc.forget_memory_at = 0.2;
+  DemSimulation through = make_sphere_on_plane(pc);
+  through.run_until(0.4);
+  for (const double stop : {0.2, 0.3}) {
+    DemSimulation first = make_sphere_on_plane(pc);
+    first.run_until(stop);
+    const auto file = std::filesystem::temp_directory_path() / "sanguis_forget_memory_ck.bin";
+    first.save_checkpoint(file);
+    DemSimulation second = make_sphere_on_plane(pc);
+    second.load_checkpoint(file);
+    second.run_until(0.4);
+    std::filesystem::remove(file);
+    EXPECT_EQ(second.particles().position[0], through.particles().position[0])
+        << "restarted at " << stop << " s";
+    EXPECT_EQ(second.wall_contacts().history[0].tangential_displacement,
+              through.wall_contacts().history[0].tangential_displacement);
+  }
 }
 
 TEST(SphereOnPlane, SlidesWithTheCoulombAcceleration) {
