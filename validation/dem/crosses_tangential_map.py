@@ -83,6 +83,15 @@ def by_id(path):
     return a["id"][order], a["Points"][order]
 
 
+def region_of(collapsed, height_loss, bottom_move_mm, base_reference_mm):
+    """Fig. 3.17's region: 3 when the column stands (not collapsed by `sanguis analyze`, or
+    under 5 % of H0 lost), 1 when its base moved at least BASE_DRIVEN_SHARE of the sphere
+    column's base in one tau_c, 2 otherwise."""
+    if not collapsed or height_loss < 0.05:
+        return 3
+    return 1 if bottom_move_mm >= BASE_DRIVEN_SHARE * base_reference_mm else 2
+
+
 def classify(run, base_reference_mm, gate_time=GATE_TIME):
     """Region of Fig. 3.17 and the measures it rests on; `base_reference_mm`: how far the
     sphere column's bottom quarter moved one tau_c after its opening (None: the sphere
@@ -101,15 +110,21 @@ def classify(run, base_reference_mm, gate_time=GATE_TIME):
     moved = np.linalg.norm(x1 - x0, axis=1)
     top_move, bottom_move = float(moved[top].mean()), float(moved[bottom].mean())
     height_loss = (z0.max() - xe[:, 2].max()) / s["H0_m"]
-    if base_reference_mm is None:
-        region = None
-    elif int(s["regime"]) == 0 or height_loss < 0.05:
-        region = 3
-    else:
-        region = 1 if 1e3 * bottom_move >= BASE_DRIVEN_SHARE * base_reference_mm else 2
+    region = None if base_reference_mm is None else region_of(
+        int(s["regime"]) != 0, height_loss, 1e3 * bottom_move, base_reference_mm)
     return {"region": region, "top_move_mm": 1e3 * top_move, "bottom_move_mm": 1e3 * bottom_move,
             "height_loss": height_loss, "runout_ratio": s["runout_ratio"],
             "regime": regime_name(s)}
+
+
+def sphere_reference(exe):
+    """The sphere column's measures (classify's, without a region), its run made first
+    when it has not reached its end: the yardstick of a base-driven collapse."""
+    gate = gate_removal_time(SPHERE_CASE)
+    run_pour([exe, "run", SPHERE_CASE, "--output", SPHERE_RUN, "--quiet", "--threads", "1"],
+             SPHERE_RUN, gate + DURATION)
+    subprocess.run([exe, "analyze", SPHERE_RUN], check=True, stdout=subprocess.DEVNULL)
+    return classify(SPHERE_RUN, None, gate)
 
 
 def main():
@@ -120,11 +135,7 @@ def main():
     args = ap.parse_args()
     exe = os.path.join(ROOT, args.build, "app", "sanguis")
     run_pour([exe, "run", CASE, "--output", POUR, "--quiet", "--threads", "1"], POUR, GATE_TIME)
-    sphere_end = gate_removal_time(SPHERE_CASE) + DURATION
-    run_pour([exe, "run", SPHERE_CASE, "--output", SPHERE_RUN, "--quiet", "--threads", "1"],
-             SPHERE_RUN, sphere_end)
-    subprocess.run([exe, "analyze", SPHERE_RUN], check=True, stdout=subprocess.DEVNULL)
-    spheres = classify(SPHERE_RUN, None, gate_removal_time(SPHERE_CASE))
+    spheres = sphere_reference(exe)
     base_reference = spheres["bottom_move_mm"]
     print(f"sphere column: top {spheres['top_move_mm']:.2f} mm, bottom {base_reference:.2f} mm "
           "one tau_c after the opening", flush=True)

@@ -37,7 +37,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from _outputs import (pour_command, read_summary, two_at_a_time_span, wall_time,  # noqa: E402
                       write_summary)
 from crosses_tangential_map import (CASE, GATE_TIME, RESULTS, ROOT,  # noqa: E402
-                                    TABLE_31, classify, settings)
+                                    TABLE_31, classify, settings, sphere_reference)
 
 RUNS = os.path.join(RESULTS, "runs", "crosses_tangential_packings")
 FIGURE = os.path.join(ROOT, "docs", "validation", "figures", "crosses_tangential_packings.png")
@@ -106,12 +106,13 @@ def main():
             jobs.append(([exe, "run", CASE, "--output", d, "--restart", "--quiet", "--threads",
                           "1"] + settings(kt, g), d))
     run_two_at_a_time(jobs)
+    base_reference = sphere_reference(exe)["bottom_move_mm"]
     results = {}
     for seed in SEEDS:
         for kt, g in points:
             d = os.path.join(RUNS, f"seed_{seed}_kt_{kt:g}_gamma_{g:g}")
             subprocess.run([exe, "analyze", d], check=True, stdout=subprocess.DEVNULL)
-            results[(seed, kt, g)] = classify(d)
+            results[(seed, kt, g)] = classify(d, base_reference)
     elapsed = time.time() - t0 + two_at_a_time_span(reused)
     previous = os.path.join(RESULTS, "crosses_tangential_packings.json")
     if args.reuse and os.path.exists(previous):  # keep the time the runs took
