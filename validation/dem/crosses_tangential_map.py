@@ -83,6 +83,12 @@ def by_id(path):
     return a["id"][order], a["Points"][order]
 
 
+def span_mm(results, region):
+    """The range of the bottom quarter's displacements [mm] over the runs of a region."""
+    values = [r["bottom_move_mm"] for r in results if r["region"] == region]
+    return f"{min(values):.1f}-{max(values):.1f}" if values else "none"
+
+
 def region_of(collapsed, height_loss, bottom_move_mm, base_reference_mm):
     """Fig. 3.17's region: 3 when the column stands (not collapsed by `sanguis analyze`, or
     under 5 % of H0 lost), 1 when its base moved at least BASE_DRIVEN_SHARE of the sphere
@@ -216,8 +222,6 @@ def main():
 
     ok = all(c["pass"] for c in checks if c["pass"] is not None)
     packing = read_summary(os.path.join(RUNS, f"kt_{TABLE_31[0]:g}_gamma_{TABLE_31[1]:g}"))
-    stable = ", ".join(f"kt {r['kt']:g} γt {r['gamma']:g}" for r in results
-                       if r["region"] == 3) or "none"
     summary = {
         "name": "crosses_tangential_map",
         "title": "Cross column: flow regime against kt and γt",
@@ -247,26 +251,53 @@ def main():
                     "rows": [[f"{spheres['top_move_mm']:.2f}", f"{spheres['bottom_move_mm']:.2f}",
                               f"{spheres['height_loss']:.3f}", f"{spheres['runout_ratio']:.2f}",
                               spheres["regime"]]]}],
-        "notes": ["The thesis map has 36 points (kt 1e1-1e6, γt 1e0-1e5); this one has a 3 x 3 "
-                  "grid over the same ranges and a finer 3 x 3 around the Table 3.1 point "
-                  "(kt 1e2-1e3, γt 3e2-3e3); one packing for all runs.",
-                  "Limit of the classification: one τc after the opening the top of a tall "
-                  "column has travelled farther than its base in any collapse, so a base-driven "
-                  "collapse (region 1) is hard to tell from a top-driven one by displacements "
-                  "alone; look at the frames. A run of 0.5 s (about 3.7 τc) also cuts short a "
+        "notes": ["The grid: the 36 points of Fig. 3.17 (every decade of kt from 1e1 to 1e6 N/m "
+                  "and of γt from 1e0 to 1e5 1/s) and a finer 3 x 3 around the Table 3.1 point "
+                  "(kt 1e2-1e3, γt 3e2-3e3), all from one pour (crosses_memory's, H0 "
+                  f"{100 * packing['H0_m']:.1f} cm, {packing['pair_coordination']:.2f} touching "
+                  "neighbours per cross). Until 2026-12-06 the coarse grid had 3 x 3 points "
+                  "(kt 1e1, 3e2, 1e5; γt 1e0, 1e3, 1e5), and a collapse was called top-driven "
+                  "when its top quarter had moved more than its bottom quarter one τc after the "
+                  "opening, which the top of any tall collapsing column does, spheres included "
+                  "(below): region 1 could not be found.",
+                  "Region 1 against spheres: the same column filled with 800 spheres of the "
+                  "crosses' volume (cases/dem/dam-break-sphere-column.toml, H0 18.2 cm) moves "
+                  f"its bottom quarter {spheres['bottom_move_mm']:.1f} mm and its top quarter "
+                  f"{spheres['top_move_mm']:.1f} mm in one τc. The cross columns whose base "
+                  f"moves at least {BASE_DRIVEN_SHARE:g} of that are region 1 (here "
+                  f"{span_mm(results, 1)} mm); the top-driven ones move theirs "
+                  f"{span_mm(results, 2)} mm.",
+                  "Reading: the three regions of Fig. 3.17 are there. Base-driven collapses at "
+                  "small kt and γt, and wherever γt is 1e5 below kt 1e5 (the dashpot alone then "
+                  "reaches μc Fn at sliding speeds near 0.1 mm/s, so contacts slide at the "
+                  "Coulomb force instead of sticking); standing columns from kt 1e3 at "
+                  "moderate γt and from kt 1e4 on; and between them a band of top-driven "
+                  "collapses about a decade wide, from kt 1e1 with γt 1e3-1e4 through kt 1e2 "
+                  "to kt 1e3 with small γt (and kt 1e5-1e6 with γt 1e5). The thesis finds its "
+                  "physical region narrow and at kt ≈ 3e2 N/m, γt ≈ 1e3 1/s; here the Table "
+                  f"3.1 point (height loss {table[TABLE_31]['height_loss']:.2f}, region "
+                  f"{table[TABLE_31]['region']}) is on the stable side of the band, whose "
+                  "edge passes between it and its neighbours a factor 3 lower in kt or in γt "
+                  "(kt 1e2 with γt 1e3, kt 3e2 with γt 3e2: regions "
+                  f"{table[(1e2, 1e3)]['region']} and {table[(3e2, 3e2)]['region']}). So this "
+                  "model has the thesis' narrow band, shifted by about a factor of 3 towards "
+                  "lower kt and γt on this pour, as the dam breaks read it (crosses_recalibrated: "
+                  "γt 1910 1/s at kt 1e2 gives the 4 cm gate's run-out).",
+                  "Limits: one packing for all runs (the Table 3.1 point on three other pours: "
+                  "crosses_tangential_packings); a run of 0.5 s (about 3.7 τc) cuts short a "
                   "slow top-driven collapse (the thesis' large cross systems move until about "
-                  "10 τc).",
-                  # Measured 2026-11-25 on the pour of crosses_memory to its opening at
-                  # t = 3.0 s (at rest: 3e-5 m/s); the earlier runs' readings are quoted
-                  # from this file's notes of 2026-11-23/24.
+                  "10 τc); the share 0.5 of the spheres' base is this code's reading of \"like "
+                  "convex particles\", which the thesis gives no number for.",
+                  "Earlier runs, with the 3 x 3 grid and the rule before 2026-12-06 (regions 2 "
+                  "and 3 only), are described below.",
                   "With the contact patches of flat faces (docs/theory/dem.md, from "
-                  "2026-12-02 evening) the pour stands at H0 "
-                  f"{100 * packing['H0_m']:.1f} cm with {packing['pair_coordination']:.2f} "
-                  "touching neighbours per cross; the Table 3.1 point loses "
-                  f"{100 * table[TABLE_31]['height_loss']:.1f} % of H0 in {DURATION} s "
-                  f"(region {table[TABLE_31]['region']}); the points that stand (region 3): "
-                  f"{stable}. The reading below is that of the runs with one contact point "
-                  "per element pair.",
+                  "2026-12-02 evening), on the pour of 2026-12-02 (H0 17.8 cm, 6.23 touching "
+                  "neighbours per cross), the Table 3.1 point lost 2.7 % of H0 in 0.5 s "
+                  "(region 3) and the points of the 3 x 3 grids that stood were kt 300 γt "
+                  "1000, kt 100000 γt 1 and 1000, kt 300 γt 3000, kt 1000 γt 300, 1000 and "
+                  "3000, each of which stands in this run too. The reading below is that of "
+                  "the runs with "
+                  "one contact point per element pair.",
                   "The map is a property of the packing as much as of kt and γt, and it needs "
                   "the column at rest when the gate opens. Since 2026-11-25 it is (the "
                   "opening moved from t = 2.4 s, when the pour's last crosses were still "
