@@ -507,6 +507,23 @@ TEST_F(CliTest, ParamsJsonIsParseable) {
   EXPECT_NE(text.out.find("kn [N/m]"), std::string::npos) << text.out;
 }
 
+// `--steps 0` times the multigrid and the smoother alone, with no flow solver built: the
+// line stays valid JSON (no step figures divided by zero) and carries the triad it is
+// measured against.
+TEST_F(CliTest, BenchFlowCavityWithoutStepsPrintsTheSmootherAgainstTheTriad) {
+  const Result r = sanguis("bench flow-cavity --cells-per-side 16 --steps 0");
+  ASSERT_EQ(r.code, 0) << r.err;
+  JsonReader json(r.out.substr(r.out.rfind('{')));
+  ASSERT_TRUE(json.parse()) << r.out;
+  const auto& n = json.numbers();
+  EXPECT_EQ(n.at("steps"), 0.0);
+  EXPECT_EQ(n.at("cell_updates_per_s"), 0.0);
+  EXPECT_GT(n.at("stream_triad_GB_s"), 0.0);
+  EXPECT_GE(n.at("stream_triad_array_MiB"), 32.0);
+  EXPECT_GT(n.at("smoother_bandwidth_fraction"), 0.0);
+  EXPECT_GT(n.at("multigrid_reduction_per_cycle"), 1.0);
+}
+
 TEST(JsonReaderSelfTest, RejectsInvalidJson) {
   EXPECT_TRUE(JsonReader(R"({"a":{"b":[1,2.5e3,-0.1]},"c":"x","d":true})").parse());
   EXPECT_FALSE(JsonReader(R"({"a":1,})").parse());
