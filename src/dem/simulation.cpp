@@ -104,17 +104,17 @@ void DemSimulation::refresh_forces() {
 }
 
 void DemSimulation::forget_contact_memory() {
-  for (ContactList* list : {&pairs_, &walls_}) {
-    for (ContactHistory& h : list->history) {
+  // The stored normal stays: it only turns the (now zero) springs into the next plane.
+  const auto unload = [](std::vector<ContactHistory>& histories) {
+    for (ContactHistory& h : histories) {
       h.tangential_displacement = {};
       h.rolling_spring_torque = {};
     }
-  }
+  };
+  unload(pairs_.history);
+  unload(walls_.history);
   for (BodyContactList* list : {&body_pairs_, &body_walls_}) {
-    for (ContactHistory& h : list->history) {
-      h.tangential_displacement = {};
-      h.rolling_spring_torque = {};
-    }
+    unload(list->history);
     std::fill(list->twist.begin(), list->twist.end(), 0.0);
   }
 }
