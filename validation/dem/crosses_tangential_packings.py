@@ -201,7 +201,19 @@ def main():
                   "until 2026-12-05 evening\"), from the pours made before (their twist "
                   "moments start at zero at the opening). With the corners' spring the Table "
                   "3.1 point lost 1.0-4.4 % of H0 and the lower point 26-61 %, the same "
-                  "regions."],
+                  "regions. With the spread spring, on those pours (AMD EPYC VM), the Table "
+                  "3.1 point lost 1.1-3.4 % on every pour (region 3) and the lower point "
+                  "26-55 % (region 2).",
+                  "Rerun on 2026-12-06 on an Intel Xeon VM, pours included: a build for "
+                  "another processor rounds otherwise (-march=native), so the same seeds give "
+                  "other packings. On them the Table 3.1 point collapses top-driven on one "
+                  "pour of three and stands on the others; with the earlier pours (none of "
+                  "three collapsed on 2026-12-05, the case's own pour collapsed on "
+                  "2026-11-25) and the pours of crosses_tangential_map (standing), it sits on "
+                  "the border of regions 2 and 3, on the standing side more often than not. "
+                  "Regions since 2026-12-06 by the rule of crosses_tangential_map that "
+                  "measures the base against a column of spheres: every collapse here moves "
+                  "its base under 3.2 mm, far from the spheres' 17 mm, so region 2."],
     }
     write_summary(summary, RESULTS, elapsed, args.quick, ok)
     print(f"{'PASS' if ok else 'FAIL'}: Table 3.1 regions {table31}, lower point {lower}, "
