@@ -15,7 +15,8 @@ is the convex reference. Each run is classified as in Fig. 3.17:
   region 2 "top-driven"  it collapses with a base that moves less (the top falls first,
                          the base stays nearly static, as in the experiments).
 Checks: the Table 3.1 point (kt = 3e2 N/m, gamma_t = 1e3 1/s) is top-driven (the
-thesis' physical region), and the grid shows at least two different regions.
+thesis' physical region), and the 6 x 6 grid shows all three regions; the points of
+region 2 on it are reported.
 
 Writes validation/dem/results/crosses_tangential_map.json and
 docs/validation/figures/crosses_tangential_map.png.
