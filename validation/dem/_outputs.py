@@ -160,6 +160,15 @@ def segment_starts(run):
     return out
 
 
+def span(values, fmt):
+    """'a-b' for the smallest and largest of the values ('a to b' when a is negative, which
+    a dash would garble), or 'a' when they print alike."""
+    low, high = format(min(values), fmt), format(max(values), fmt)
+    if low == high:
+        return low
+    return f"{low} to {high}" if min(values) < 0 else f"{low}-{high}"
+
+
 def uncounted_spans(run):
     """(from, to) simulated times [s] the run went through with no wall time on record: a
     segment stopped before run.log recorded checkpoints (logs written before 2026-12-03)

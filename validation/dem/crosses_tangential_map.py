@@ -38,7 +38,7 @@ import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from _outputs import (gate_removal_time, read_arrays, read_pvd, read_summary,  # noqa: E402
-                      regime_name, run_pour, write_summary)
+                      regime_name, run_pour, span, write_summary)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 CASE = os.path.join(ROOT, "cases", "dem", "dam-break-crosses-memory.toml")
@@ -87,7 +87,7 @@ def by_id(path):
 def span_mm(results, region):
     """The range of the bottom quarter's displacements [mm] over the runs of a region."""
     values = [r["bottom_move_mm"] for r in results if r["region"] == region]
-    return f"{min(values):.1f}-{max(values):.1f}" if values else "none"
+    return span(values, ".1f") if values else "none"
 
 
 def region_of(collapsed, height_loss, bottom_move_mm, base_reference_mm):

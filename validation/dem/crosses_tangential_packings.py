@@ -34,8 +34,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import (pour_command, read_summary, two_at_a_time_span, wall_time,  # noqa: E402
-                      write_summary)
+from _outputs import (pour_command, read_summary, span, two_at_a_time_span,  # noqa: E402
+                      wall_time, write_summary)
 from crosses_tangential_map import (CASE, GATE_TIME, RESULTS, ROOT,  # noqa: E402
                                     TABLE_31, classify, settings, sphere_reference)
 
@@ -56,15 +56,6 @@ def run_two_at_a_time(jobs):
         proc, d = running.pop(0)
         if proc.wait() != 0:
             sys.exit(f"run failed: {d}")
-
-
-def span(values, fmt):
-    """'a-b' for the smallest and largest of the values ('a to b' when a is negative, which
-    a dash would garble), or 'a' when they print alike."""
-    low, high = format(min(values), fmt), format(max(values), fmt)
-    if low == high:
-        return low
-    return f"{low} to {high}" if min(values) < 0 else f"{low}-{high}"
 
 
 def main():

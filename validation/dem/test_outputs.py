@@ -337,5 +337,17 @@ class Continuation(unittest.TestCase):
         self.assertIn("t = 5.5 s", self.log_of_out())
 
 
+class Span(unittest.TestCase):
+    def test_a_range_of_positive_values_takes_a_dash(self):
+        self.assertEqual(_outputs.span([2.5, 0.98, 16.34], ".2f"), "0.98-16.34")
+
+    def test_a_range_from_a_negative_value_is_written_out(self):
+        self.assertEqual(_outputs.span([-0.15, 2.48, 0.11], ".2f"), "-0.15 to 2.48")
+
+    def test_values_that_print_alike_give_one(self):
+        self.assertEqual(_outputs.span([3.001, 3.004], ".1f"), "3.0")
+        self.assertEqual(_outputs.span([7], "d"), "7")
+
+
 if __name__ == "__main__":
     unittest.main()
