@@ -68,6 +68,11 @@ DemSimulation::DemSimulation(DemSetup setup)
   if (!(setup_.time_step > 0.0)) throw std::invalid_argument("time step must be > 0");
   for (const PourSource& src : setup_.pour) has_bodies_ |= src.species >= 0;
   pour_rng_.seed(setup_.pour_seed);
+  // On the step grid, so a restart from a checkpoint written at that step forgets too,
+  // and one written later does not forget again.
+  if (std::isfinite(setup_.forget_contact_memory_at)) {
+    forget_memory_step_ = std::llround(setup_.forget_contact_memory_at / setup_.time_step);
+  }
   // Default skin: 10% of the smallest diameter.
   const auto [r_min, r_max] = radius_bounds(setup_);
   if (setup_.skin <= 0.0) setup_.skin = 0.2 * r_min;
@@ -122,12 +127,7 @@ void DemSimulation::forget_contact_memory() {
 void DemSimulation::step() {
   const double dt = setup_.time_step;
   ParticleStore& p = setup_.particles;
-  // On the step grid, so a restart from a checkpoint written at that step forgets too,
-  // and one written later does not forget again.
-  if (std::isfinite(setup_.forget_contact_memory_at) &&
-      step_ == std::llround(setup_.forget_contact_memory_at / dt)) {
-    forget_contact_memory();
-  }
+  if (step_ == forget_memory_step_) forget_contact_memory();
   if (!setup_.pour.empty()) pour_particles();
   integrator_.advance(p, setup_.gravity, dt);
   ++step_;

@@ -256,6 +256,8 @@ class DemSimulation {
   std::vector<std::uint32_t> incident_offset_, incident_, incident_fill_, wall_offset_;
   // Contacts involving non-spherical bodies, element by element (body_contacts.hpp).
   bool has_bodies_ = false;
+  // The step DemSetup::forget_contact_memory_at falls on; -1: never.
+  std::int64_t forget_memory_step_ = -1;
   BodyContactList body_pairs_, body_walls_;
   std::vector<ContactOutcome> body_pair_buffer_, body_wall_buffer_;
   // Per slot: whether the contact touched this step (written for the contacts of shared
