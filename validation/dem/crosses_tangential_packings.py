@@ -1,27 +1,29 @@
 #!/usr/bin/python3
-"""The Table 3.1 point of the tangential map on several packings (thesis §3.4.3, Fig. 3.17).
+"""The 3 x 3 around the Table 3.1 point of the tangential map on five packings (thesis
+§3.4.3, Fig. 3.17).
 
 crosses_tangential_map classifies every (kt, gamma_t) on one settled 300-cross column,
-the pour of the case's own seed; that pour can be an outlier (on 2026-11-24, when the
-gate still opened at 2.4 s on a column settling, the seed-5 pour stood at H0 20.9 cm
-and every point of the map collapsed). This case pours
-the same column with seeds 1, 2 and 3 (cases/dem/dam-break-crosses-memory.toml to the
-gate's opening, Table 3.1 parameters, one thread, two pours at a time) and continues
-each with two tangential settings, classified as in crosses_tangential_map:
-  the Table 3.1 point, kt = 3e2 N/m, gamma_t = 1e3 1/s (the thesis: region 2, a
-  top-driven collapse, as in the experiments);
-  both three times lower, kt = 1e2 N/m, gamma_t = 3e2 1/s (where the map of
-  2026-11-23 found this model's substantial collapse).
-Check: the Table 3.1 point is top-driven (region 2) on every packing. Reported: the
-lower point's region and each packing's height and touching neighbours per cross.
+the pour of the case's own seed; where the edge of its band of top-driven collapses
+passes depends on that pour (on 2026-12-06 a factor 3 below Table 3.1 on the map's pour,
+a factor 3 above on another). This case pours the same column with seeds 1 to 5
+(cases/dem/dam-break-crosses-memory.toml to the gate's opening, Table 3.1 parameters,
+one thread, two runs at a time) and continues each with the 3 x 3 of the map around
+Table 3.1 (kt 1e2, 3e2, 1e3 N/m; gamma_t 3e2, 1e3, 3e3 1/s; both interactions),
+classified as in crosses_tangential_map.
+Check: the Table 3.1 point is top-driven (region 2) on every packing (the thesis: region
+2, as in the experiments). Reported: on how many pours each point collapses, and whether
+on every pour the standing points lie on one side of an edge (a point that stands has
+every point of larger or equal kt and gamma_t standing, as region 3 lies above the band in
+Fig. 3.17).
+Until 2026-12-06 this case ran two points (Table 3.1 and kt 1e2, gamma_t 3e2) on three
+pours. Runs are resumable: a pour or continuation that reached its end is kept.
 
 Writes validation/dem/results/crosses_tangential_packings.json and
 docs/validation/figures/crosses_tangential_packings.png.
 Usage: /usr/bin/python3 validation/dem/crosses_tangential_packings.py [--build build]
-       [--rerun-pours] [--reuse]
+       [--rerun-pours] [--rerun]
 """
 import argparse
-import json
 import os
 import shutil
 import subprocess
@@ -34,15 +36,15 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import (pour_command, read_summary, span, two_at_a_time_span,  # noqa: E402
-                      wall_time, write_summary)
-from crosses_tangential_map import (CASE, GATE_TIME, RESULTS, ROOT,  # noqa: E402
-                                    TABLE_31, classify, settings, sphere_reference)
+from _outputs import (continuation_command, pour_command, read_summary, span,  # noqa: E402
+                      two_at_a_time_span, wall_time, write_summary)
+from crosses_tangential_map import (CASE, GATE_TIME, LOCAL_GAMMA, LOCAL_KT, RESULTS,  # noqa: E402
+                                    ROOT, TABLE_31, classify, settings, sphere_reference)
 
 RUNS = os.path.join(RESULTS, "runs", "crosses_tangential_packings")
 FIGURE = os.path.join(ROOT, "docs", "validation", "figures", "crosses_tangential_packings.png")
-SEEDS = [1, 2, 3]
-LOWER = (1e2, 3e2)
+SEEDS = [1, 2, 3, 4, 5]
+POINTS = [(kt, g) for kt in LOCAL_KT for g in LOCAL_GAMMA]
 
 
 def run_two_at_a_time(jobs):
@@ -58,21 +60,74 @@ def run_two_at_a_time(jobs):
             sys.exit(f"run failed: {d}")
 
 
+def run_folder(seed, kt, g):
+    return os.path.join(RUNS, f"seed_{seed}_kt_{kt:g}_gamma_{g:g}")
+
+
+def stands_above_edge(regions):
+    """True when the standing points (region 3) of one pour's {(kt, gamma_t): region} lie on
+    one side of an edge: every point with kt and gamma_t both at least a standing point's
+    stands too."""
+    standing = [p for p, r in regions.items() if r == 3]
+    return all(regions[q] == 3 for p in standing for q in regions
+               if q[0] >= p[0] and q[1] >= p[1])
+
+
+def collapse_counts(results, seeds, points):
+    """{point: number of the seeds' pours on which it collapses (region 1 or 2)}."""
+    return {p: sum(results[(s, *p)]["region"] != 3 for s in seeds) for p in points}
+
+
+def draw(results, counts, seeds):
+    """Left: on how many pours each point collapses; right: each pour's height loss."""
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(10.0, 4.0),
+                                 gridspec_kw={"width_ratios": [1, 1.6]})
+    grid = [[counts[(kt, g)] for kt in LOCAL_KT] for g in LOCAL_GAMMA]
+    image = ax.imshow(grid, origin="lower", cmap="Reds", vmin=0, vmax=len(seeds))
+    for i, g in enumerate(LOCAL_GAMMA):
+        for j, kt in enumerate(LOCAL_KT):
+            ax.text(j, i, f"{counts[(kt, g)]}/{len(seeds)}", ha="center", va="center",
+                    fontsize=10, fontweight="bold" if (kt, g) == TABLE_31 else "normal")
+    j31, i31 = LOCAL_KT.index(TABLE_31[0]), LOCAL_GAMMA.index(TABLE_31[1])
+    ax.add_patch(plt.Rectangle((j31 - 0.5, i31 - 0.5), 1, 1, fill=False, lw=2.0, ec="k"))
+    ax.set_xticks(range(len(LOCAL_KT)), [f"{kt:g}" for kt in LOCAL_KT])
+    ax.set_yticks(range(len(LOCAL_GAMMA)), [f"{g:g}" for g in LOCAL_GAMMA])
+    ax.set_xlabel("kt [N/m]")
+    ax.set_ylabel("γt [1/s]")
+    ax.set_title("pours on which the column collapses\n(framed: Table 3.1)", fontsize=9)
+    fig.colorbar(image, ax=ax, shrink=0.8)
+    markers = {1: "s", 2: "o", 3: "^"}
+    for k, (kt, g) in enumerate(POINTS):
+        for s in seeds:
+            r = results[(s, kt, g)]
+            x = k + (s - (len(seeds) + 1) / 2) * 0.12
+            bx.scatter(x, 100 * r["height_loss"], marker=markers[r["region"]],
+                       color=f"C{s - 1}", s=28, label=f"seed {s}" if k == 0 else None)
+    bx.axhline(5.0, color="k", lw=0.8, ls=":")
+    bx.text(len(POINTS) - 0.5, 5.5, "5 %: region 3 below", ha="right", fontsize=7)
+    bx.set_xticks(range(len(POINTS)), [f"{kt:g}\n{g:g}" for kt, g in POINTS], fontsize=7)
+    bx.set_xlabel("kt [N/m] / γt [1/s]   (▲ region 3, ● region 2, ■ region 1)")
+    bx.set_ylabel("height lost / $H_0$ within 0.5 s [%]")
+    bx.legend(fontsize=7, ncol=len(seeds))
+    fig.suptitle("300 crosses, five pours (thesis: Table 3.1 is top-driven, region 2)",
+                 fontsize=10)
+    fig.tight_layout()
+    fig.savefig(FIGURE, dpi=130)
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--build", default="build")
-    ap.add_argument("--rerun-pours", action="store_true")
+    ap.add_argument("--rerun-pours", action="store_true", help="pour again")
+    ap.add_argument("--rerun", action="store_true", help="run every continuation again")
     ap.add_argument("--quick", action="store_true", help="same as the full run")
-    ap.add_argument("--reuse", action="store_true", help="classify the runs on disk")
     args = ap.parse_args()
     exe = os.path.join(ROOT, args.build, "app", "sanguis")
     t0 = time.time()
     pours = {seed: os.path.join(RUNS, f"pour_seed_{seed}") for seed in SEEDS}
-    reused = []  # wall times of pours kept from an earlier call: they count in the run time
+    reused = []  # wall times of runs kept from an earlier call: they count in the run time
     jobs = []
     for seed, d in pours.items():
-        if args.reuse:
-            continue
         cmd = pour_command([exe, "run", CASE, "--output", d, "--quiet", "--threads", "1",
                             "--seed", str(seed)], d, GATE_TIME, args.rerun_pours)
         if cmd:
@@ -86,63 +141,55 @@ def main():
         packing[seed] = read_summary(d)
 
     jobs = []
-    points = [TABLE_31, LOWER]
     for seed, pour in pours.items():
-        for kt, g in points:
-            d = os.path.join(RUNS, f"seed_{seed}_kt_{kt:g}_gamma_{g:g}")
-            if args.reuse:
-                continue
-            shutil.rmtree(d, ignore_errors=True)
-            shutil.copytree(pour, d)
-            jobs.append(([exe, "run", CASE, "--output", d, "--restart", "--quiet", "--threads",
-                          "1"] + settings(kt, g), d))
+        for kt, g in POINTS:
+            d = run_folder(seed, kt, g)
+            if args.rerun:
+                shutil.rmtree(d, ignore_errors=True)
+            cmd = continuation_command([exe, "run", CASE, "--output", d, "--restart", "--quiet",
+                                        "--threads", "1"] + settings(kt, g), d, pour, GATE_TIME)
+            if cmd:
+                jobs.append((cmd, d))
+            else:
+                reused.append(wall_time(d, GATE_TIME))
     run_two_at_a_time(jobs)
     base_reference = sphere_reference(exe)["bottom_move_mm"]
     results = {}
     for seed in SEEDS:
-        for kt, g in points:
-            d = os.path.join(RUNS, f"seed_{seed}_kt_{kt:g}_gamma_{g:g}")
+        for kt, g in POINTS:
+            d = run_folder(seed, kt, g)
             subprocess.run([exe, "analyze", d], check=True, stdout=subprocess.DEVNULL)
             results[(seed, kt, g)] = classify(d, base_reference)
     elapsed = time.time() - t0 + two_at_a_time_span(reused)
-    previous = os.path.join(RESULTS, "crosses_tangential_packings.json")
-    if args.reuse and os.path.exists(previous):  # keep the time the runs took
-        with open(previous) as f:
-            elapsed = json.load(f).get("run_time_s", elapsed)
 
+    counts = collapse_counts(results, SEEDS, POINTS)
     os.makedirs(os.path.dirname(FIGURE), exist_ok=True)
-    fig, ax = plt.subplots(figsize=(6.0, 3.8))
-    width = 0.38
-    for k, ((kt, g), colour) in enumerate(zip(points, ["tab:blue", "tab:green"])):
-        losses = [results[(seed, kt, g)]["height_loss"] for seed in SEEDS]
-        ax.bar([i + (k - 0.5) * width for i in range(len(SEEDS))], losses, width, color=colour,
-               label=f"kt {kt:g} N/m, γt {g:g} 1/s" + (" (Table 3.1)" if (kt, g) == TABLE_31
-                                                       else ""))
-    ax.axhline(0.05, color="k", lw=0.8, ls=":", label="5 %: below it, region 3 (stable)")
-    ax.set_xticks(range(len(SEEDS)), [f"seed {seed}" for seed in SEEDS])
-    ax.set_ylabel("height lost / $H_0$ within 0.5 s")
-    ax.set_title("300 crosses, three pours (thesis: Table 3.1 is top-driven, region 2)",
-                 fontsize=9)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(FIGURE, dpi=130)
+    draw(results, counts, SEEDS)
 
     max_collapse_base = max((r["bottom_move_mm"] for r in results.values() if r["region"] != 3),
                             default=0.0)
     table31 = [results[(seed, *TABLE_31)]["region"] for seed in SEEDS]
-    lower = [results[(seed, *LOWER)]["region"] for seed in SEEDS]
+    ordered = [stands_above_edge({p: results[(s, *p)]["region"] for p in POINTS})
+               for s in SEEDS]
+    seeds_text = ", ".join(map(str, SEEDS))
     checks = [
-        {"quantity": "Table 3.1 point (kt 3e2, γt 1e3): region on the packings of seeds 1, 2, 3",
+        {"quantity": f"Table 3.1 point (kt 3e2, γt 1e3): region on the packings of seeds "
+                     f"{seeds_text}",
          "measured": ", ".join(map(str, table31)),
          "thesis": "region 2 (top-driven, as the experiments)", "tolerance": "2 on every packing",
          "pass": all(r == 2 for r in table31)},
-        {"quantity": "kt 1e2, γt 3e2: region on the same packings", "measured":
-         ", ".join(map(str, lower)), "thesis": "—", "tolerance": "reported", "pass": None},
+        {"quantity": "pours on which each point collapses (kt [N/m], γt [1/s]: count)",
+         "measured": "; ".join(f"{kt:g}, {g:g}: {counts[(kt, g)]}" for kt, g in POINTS),
+         "thesis": "Table 3.1 in the band of top-driven collapses", "tolerance": "reported",
+         "pass": None},
+        {"quantity": "pours whose standing points lie above one edge (larger kt and γt stand)",
+         "measured": f"{sum(ordered)} of {len(SEEDS)}", "thesis": "region 3 above the band",
+         "tolerance": "reported", "pass": None},
     ]
     rows = []
     for seed in SEEDS:
         p = packing[seed]
-        for kt, g in points:
+        for kt, g in POINTS:
             r = results[(seed, kt, g)]
             rows.append([seed, f"{100 * p['H0_m']:.1f}", f"{p['pair_coordination']:.2f}",
                          f"{kt:g}", f"{g:g}", r["region"], r["regime"], f"{r['top_move_mm']:.2f}",
@@ -151,13 +198,14 @@ def main():
     ok = all(c["pass"] for c in checks if c["pass"] is not None)
     summary = {
         "name": "crosses_tangential_packings",
-        "title": "Cross column: the Table 3.1 point on three packings",
+        "title": "Cross column: the 3 x 3 around Table 3.1 on five packings",
         "thesis": "§3.4.3, Fig. 3.17",
         "description": (
-            "The 300-cross column of the memory case poured with seeds 1, 2 and 3 and "
-            "continued from the gate's opening with the Table 3.1 tangential parameters and "
-            "with both three times lower (both interactions); regions as in "
-            "crosses_tangential_map (3 stable: the highest particle lost less than 5 % of H0)."),
+            f"The 300-cross column of the memory case poured with seeds {seeds_text} and "
+            "continued from the gate's opening with the 3 x 3 tangential parameters of "
+            "crosses_tangential_map around Table 3.1 (kt 1e2, 3e2, 1e3 N/m; γt 3e2, 1e3, "
+            "3e3 1/s; both interactions); regions as in crosses_tangential_map (3 stable: "
+            "the highest particle lost less than 5 % of H0)."),
         "command": "/usr/bin/python3 validation/dem/crosses_tangential_packings.py --build BUILD",
         "figures": ["docs/validation/figures/crosses_tangential_packings.png"],
         "checks": checks,
@@ -167,51 +215,42 @@ def main():
                                "region", "regime", "top moved [mm]", "bottom moved [mm]",
                                "height loss / H0", "(L∞−L0)/L0"],
                     "rows": rows}],
-        "notes": ["Why this case: crosses_tangential_map uses one pour, and its reading changes "
-                  "with that pour (see its notes). Here three other pours of the same case "
-                  "decide the Table 3.1 point.",
+        "notes": ["Why this case: crosses_tangential_map uses one pour, and where the edge of "
+                  "its band of top-driven collapses passes changes with that pour. Here five "
+                  "other pours of the same case place the edge around the Table 3.1 point.",
                   # The runs of 2026-11-24 (pours to 2.4 s), quoted from this file's JSON then.
                   "Since 2026-11-25 the pours run to the gate's opening at t = 3.0 s, when the "
                   "column is at rest (before: 2.4 s, with the case's own seed still "
-                  "settling). For these three seeds it changed little: with the opening at "
+                  "settling). For seeds 1-3 it changed little: with the opening at "
                   "2.4 s they stood at H0 17.8-18.2 cm with 6.35-6.66 neighbours, the Table "
-                  "3.1 point lost 1.7-3.8 % (region 3) and the lower point 27-55 % (region 2); "
+                  "3.1 point lost 1.7-3.8 % (region 3) and kt 1e2, γt 3e2 27-55 % (region 2); "
                   "opened at 3.0 s, with one contact point per element pair (2026-11-25), "
                   "17.8-18.1 cm, 6.35-6.65, 1.2-3.1 % and 35-59 %. On the case's own seed, "
                   "settled, the Table 3.1 point collapsed then (23 %, crosses_tangential_map): "
                   "the point sat on the border of regions 2 and 3.",
-                  "With the contact patches of flat faces (docs/theory/dem.md, from "
-                  "2026-12-02 evening) the pours stand at H0 "
-                  f"{span([100 * packing[s]['H0_m'] for s in SEEDS], '.1f')} cm with "
-                  f"{span([packing[s]['pair_coordination'] for s in SEEDS], '.2f')} "
-                  "neighbours per cross; the Table 3.1 point loses "
-                  f"{span([100 * results[(s, *TABLE_31)]['height_loss'] for s in SEEDS], '.1f')} "
-                  "% of H0 and the lower point "
-                  f"{span([100 * results[(s, *LOWER)]['height_loss'] for s in SEEDS], '.0f')} %.",
                   # The collapses of 2026-12-05 23:16-23:26 UTC; the pours are older.
-                  "The collapses were rerun on 2026-12-05 evening with the torsional spring "
-                  "of the patches spread over them (docs/theory/dem.md, \"The torsional spring "
-                  "until 2026-12-05 evening\"), from the pours made before (their twist "
-                  "moments start at zero at the opening). With the corners' spring the Table "
-                  "3.1 point lost 1.0-4.4 % of H0 and the lower point 26-61 %, the same "
-                  "regions. With the spread spring, on those pours (AMD EPYC VM), the Table "
-                  "3.1 point lost 1.1-3.4 % on every pour (region 3) and the lower point "
-                  "26-55 % (region 2).",
-                  "Rerun on 2026-12-06 on an Intel Xeon VM, pours included: a build for "
-                  "another processor rounds otherwise (-march=native), so the same seeds give "
-                  "other packings. On them the Table 3.1 point collapses top-driven on "
-                  f"{table31.count(2)} pour(s) of {len(table31)}. With the contact patches it "
-                  "stood on the three earlier pours (2026-12-05) and on the pours of "
-                  "crosses_tangential_map (2026-12-02 and 12-06), so it sits on the border of "
-                  "regions 2 and 3, on the standing side more often than not. "
-                  "Regions since 2026-12-06 by the rule of crosses_tangential_map that "
-                  "measures the base against a column of spheres: the collapses here move "
-                  f"their base at most {max_collapse_base:.1f} mm in one τc, against the "
-                  f"spheres' {base_reference:.1f} mm."],
+                  "On 2026-12-05 evening (two points on three pours, AMD EPYC VM) with the "
+                  "torsional spring of the patches spread over them (docs/theory/dem.md, \"The "
+                  "torsional spring until 2026-12-05 evening\"): the Table 3.1 point lost "
+                  "1.1-3.4 % on every pour (region 3) and kt 1e2, γt 3e2 26-55 % (region 2); "
+                  "with the corners' spring before, 1.0-4.4 % and 26-61 %, the same regions.",
+                  "Since 2026-12-06 (an Intel Xeon VM: a build for another processor rounds "
+                  "otherwise with -march=native, so the same seeds pack otherwise) the pours "
+                  f"stand at H0 {span([100 * packing[s]['H0_m'] for s in SEEDS], '.1f')} cm "
+                  f"with {span([packing[s]['pair_coordination'] for s in SEEDS], '.2f')} "
+                  "touching neighbours per cross. The Table 3.1 point loses "
+                  f"{span([100 * results[(s, *TABLE_31)]['height_loss'] for s in SEEDS], '.1f')}"
+                  f" % of H0 and collapses top-driven on {table31.count(2)} pour(s) of "
+                  f"{len(SEEDS)}; kt 1e2, γt 3e2 loses "
+                  f"{span([100 * results[(s, 1e2, 3e2)]['height_loss'] for s in SEEDS], '.0f')}"
+                  " %. Regions by the rule of crosses_tangential_map that measures the base "
+                  "against a column of spheres: the collapses here move their base at most "
+                  f"{max_collapse_base:.1f} mm in one τc, against the spheres' "
+                  f"{base_reference:.1f} mm."],
     }
     write_summary(summary, RESULTS, elapsed, args.quick, ok)
-    print(f"{'PASS' if ok else 'FAIL'}: Table 3.1 regions {table31}, lower point {lower}, "
-          f"{elapsed:.0f} s")
+    print(f"{'PASS' if ok else 'FAIL'}: Table 3.1 regions {table31}, collapses per point "
+          f"{counts}, {elapsed:.0f} s")
     return 0 if ok else 1
 
 
