@@ -214,7 +214,17 @@ def main():
                     "header": ["seed", "H0 [cm]", "neighbours", "kt [N/m]", "γt [1/s]",
                                "region", "regime", "top moved [mm]", "bottom moved [mm]",
                                "height loss / H0", "(L∞−L0)/L0"],
-                    "rows": rows}],
+                    "rows": rows},
+                   {"caption": "Per pour: the packing at the opening and how many of the 9 "
+                               "points collapse on it.",
+                    "header": ["seed", "H0 [cm]", "neighbours", "points collapsing",
+                               "Table 3.1 region", "standing points above one edge"],
+                    "rows": [[s, f"{100 * packing[s]['H0_m']:.1f}",
+                              f"{packing[s]['pair_coordination']:.2f}",
+                              sum(results[(s, *p)]["region"] != 3 for p in POINTS),
+                              results[(s, *TABLE_31)]["region"],
+                              "yes" if edge else "no"]
+                             for s, edge in zip(SEEDS, ordered)]}],
         "notes": ["Why this case: crosses_tangential_map uses one pour, and where the edge of "
                   "its band of top-driven collapses passes changes with that pour. Here five "
                   "other pours of the same case place the edge around the Table 3.1 point.",
