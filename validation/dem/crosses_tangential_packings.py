@@ -109,7 +109,7 @@ def draw(results, counts, seeds):
     bx.set_xticks(range(len(POINTS)), [f"{kt:g}\n{g:g}" for kt, g in POINTS], fontsize=7)
     bx.set_xlabel("kt [N/m] / γt [1/s]   (▲ region 3, ● region 2, ■ region 1)")
     bx.set_ylabel("height lost / $H_0$ within 0.5 s [%]")
-    bx.legend(fontsize=7, ncol=len(seeds))
+    bx.legend(fontsize=7, ncol=3, loc="upper right")
     fig.suptitle("300 crosses, six pours (thesis: Table 3.1 is top-driven, region 2)",
                  fontsize=10)
     fig.tight_layout()
