@@ -51,15 +51,19 @@ import matplotlib
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from _outputs import (continuation_command, pour_command, read_pvd, read_summary,  # noqa: E402
-                      two_at_a_time_span, wall_time, write_summary)
+                      span, two_at_a_time_span, wall_time, write_summary)
 from crosses_dam_break import diagnostics, velocity_curve  # noqa: E402
 from crosses_tangential_map import CASE, GATE_TIME, RESULTS, ROOT, by_id, classify  # noqa: E402
 from crosses_tangential_packings import RUNS as POURS  # noqa: E402
-from crosses_tangential_packings import SEEDS, run_two_at_a_time, span  # noqa: E402
+from crosses_tangential_packings import run_two_at_a_time  # noqa: E402
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+
+# The packings the check was fixed on (crosses_tangential_packings pours more since
+# 2026-12-06; its pours of these seeds are shared).
+SEEDS = [1, 2, 3]
 
 RUNS = os.path.join(RESULTS, "runs", "crosses_gate_effect")
 FIGURE = os.path.join(ROOT, "docs", "validation", "figures", "crosses_gate_effect.png")
