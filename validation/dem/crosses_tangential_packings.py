@@ -119,7 +119,7 @@ def draw(results, counts, seeds):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--build", default="build")
-    ap.add_argument("--rerun-pours", action="store_true", help="pour again")
+    ap.add_argument("--rerun-pours", action="store_true", help="pour again (and run again)")
     ap.add_argument("--rerun", action="store_true", help="run every continuation again")
     ap.add_argument("--quick", action="store_true", help="same as the full run")
     args = ap.parse_args()
@@ -145,7 +145,7 @@ def main():
     for seed, pour in pours.items():
         for kt, g in POINTS:
             d = run_folder(seed, kt, g)
-            if args.rerun:
+            if args.rerun or args.rerun_pours:  # a new pour makes the old runs stale
                 shutil.rmtree(d, ignore_errors=True)
             cmd = continuation_command([exe, "run", CASE, "--output", d, "--restart", "--quiet",
                                         "--threads", "1"] + settings(kt, g), d, pour, GATE_TIME)
