@@ -9,6 +9,7 @@ import os
 import re
 import shutil
 import subprocess
+import sys
 import time
 import tomllib
 import xml.etree.ElementTree as ET
@@ -281,6 +282,21 @@ def pool_span(durations, workers=2):
         start = heapq.heappop(free)
         heapq.heappush(free, start + d)
     return max(free)
+
+
+def run_two_at_a_time(jobs, base):
+    """Runs the (command, folder) jobs two at a time, waiting on the older of the two
+    running, and names each as it starts by its folder relative to `base`; exits on the
+    first failure."""
+    running = []
+    while jobs or running:
+        while jobs and len(running) < 2:
+            cmd, d = jobs.pop(0)
+            print(f"started {os.path.relpath(d, base)}", flush=True)
+            running.append((subprocess.Popen(cmd, stdout=subprocess.DEVNULL), d))
+        proc, d = running.pop(0)
+        if proc.wait() != 0:
+            sys.exit(f"run failed: {d}")
 
 
 def two_at_a_time_span(durations):

@@ -51,11 +51,10 @@ import matplotlib
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from _outputs import (continuation_command, pour_command, read_pvd, read_summary,  # noqa: E402
-                      span, two_at_a_time_span, wall_time, write_summary)
+                      run_two_at_a_time, span, two_at_a_time_span, wall_time, write_summary)
 from crosses_dam_break import diagnostics, velocity_curve  # noqa: E402
 from crosses_tangential_map import CASE, GATE_TIME, RESULTS, ROOT, by_id, classify  # noqa: E402
 from crosses_tangential_packings import RUNS as POURS  # noqa: E402
-from crosses_tangential_packings import run_two_at_a_time  # noqa: E402
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -203,7 +202,7 @@ def main():
             jobs.append((cmd, d))
         elif not cmd:
             reused_pours.append(wall_time(d))
-    run_two_at_a_time(jobs)
+    run_two_at_a_time(jobs, POURS)
 
     jobs = []
     for seed in seeds if not args.reuse else []:
@@ -224,7 +223,7 @@ def main():
                 jobs.append((cmd, d))
             else:
                 reused_openings.append(wall_time(d, GATE_TIME))
-    run_two_at_a_time(jobs)
+    run_two_at_a_time(jobs, POURS)
 
     results = {}
     for seed in seeds:

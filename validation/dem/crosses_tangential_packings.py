@@ -37,8 +37,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import (continuation_command, pour_command, read_summary, span,  # noqa: E402
-                      two_at_a_time_span, wall_time, write_summary)
+from _outputs import (continuation_command, pour_command, read_summary,  # noqa: E402
+                      run_two_at_a_time, span, two_at_a_time_span, wall_time, write_summary)
 from crosses_tangential_map import (CASE, GATE_TIME, LOCAL_GAMMA, LOCAL_KT, RESULTS,  # noqa: E402
                                     ROOT, TABLE_31, classify, settings, sphere_reference)
 
@@ -46,19 +46,6 @@ RUNS = os.path.join(RESULTS, "runs", "crosses_tangential_packings")
 FIGURE = os.path.join(ROOT, "docs", "validation", "figures", "crosses_tangential_packings.png")
 SEEDS = [1, 2, 3, 4, 5, 6]
 POINTS = [(kt, g) for kt in LOCAL_KT for g in LOCAL_GAMMA]
-
-
-def run_two_at_a_time(jobs):
-    """Runs the (command, folder) jobs two at a time; stops on the first failure."""
-    running = []
-    while jobs or running:
-        while jobs and len(running) < 2:
-            cmd, d = jobs.pop(0)
-            print(f"started {os.path.relpath(d, RUNS)}", flush=True)
-            running.append((subprocess.Popen(cmd, stdout=subprocess.DEVNULL), d))
-        proc, d = running.pop(0)
-        if proc.wait() != 0:
-            sys.exit(f"run failed: {d}")
 
 
 def run_folder(seed, kt, g):
@@ -74,9 +61,14 @@ def stands_above_edge(regions):
                if q[0] >= p[0] and q[1] >= p[1])
 
 
+def collapses(result):
+    """Whether a classified run collapsed (region 1 or 2)."""
+    return result["region"] != 3
+
+
 def collapse_counts(results, seeds, points):
-    """{point: number of the seeds' pours on which it collapses (region 1 or 2)}."""
-    return {p: sum(results[(s, *p)]["region"] != 3 for s in seeds) for p in points}
+    """{point: number of the seeds' pours on which it collapses}."""
+    return {p: sum(collapses(results[(s, *p)]) for s in seeds) for p in points}
 
 
 def draw(results, counts, seeds):
@@ -135,7 +127,7 @@ def main():
             jobs.append((cmd, d))
         else:
             reused.append(wall_time(d))
-    run_two_at_a_time(jobs)
+    run_two_at_a_time(jobs, RUNS)
     packing = {}
     for seed, d in pours.items():
         subprocess.run([exe, "analyze", d], check=True, stdout=subprocess.DEVNULL)
@@ -153,7 +145,7 @@ def main():
                 jobs.append((cmd, d))
             else:
                 reused.append(wall_time(d, GATE_TIME))
-    run_two_at_a_time(jobs)
+    run_two_at_a_time(jobs, RUNS)
     base_reference = sphere_reference(exe)["bottom_move_mm"]
     results = {}
     for seed in SEEDS:
@@ -222,7 +214,7 @@ def main():
                                "Table 3.1 region", "standing points above one edge"],
                     "rows": [[s, f"{100 * packing[s]['H0_m']:.1f}",
                               f"{packing[s]['pair_coordination']:.2f}",
-                              sum(results[(s, *p)]["region"] != 3 for p in POINTS),
+                              sum(collapses(results[(s, *p)]) for p in POINTS),
                               results[(s, *TABLE_31)]["region"],
                               "yes" if edge else "no"]
                              for s, edge in zip(SEEDS, ordered)]}],
