@@ -320,7 +320,26 @@ std::vector<ContactRecord> touching_contacts(const DemSimulation& sim) {
     r.force = e.response.force;
     r.normal_force = e.response.normal_force;
   };
+  // With mean_element_contacts each element contact applied its share of the mean over the
+  // element contacts of its two bodies (simulation.cpp): records [from, end), consecutive
+  // per pair of bodies or body and obstacle (list order), divided by how many there are.
+  const auto share_the_mean = [&out, &s](std::size_t from) {
+    if (!s.mean_element_contacts) return;
+    for (std::size_t a = from; a < out.size();) {
+      std::size_t b = a + 1;
+      while (b < out.size() && out[b].first == out[a].first && out[b].second == out[a].second) {
+        ++b;
+      }
+      const double share = 1.0 / static_cast<double>(b - a);
+      for (std::size_t k = a; b - a > 1 && k < b; ++k) {
+        out[k].force *= share;
+        out[k].normal_force *= share;
+      }
+      a = b;
+    }
+  };
   const BodyContactList& body_pairs = sim.body_contacts();
+  const std::size_t body_pairs_from = out.size();
   for (std::size_t k = 0; k < body_pairs.size(); ++k) {
     const std::uint32_t i = body_pairs.first[k], j = body_pairs.second[k];
     if (!finite(i) || !finite(j) || sim.is_ghost(i)) continue;
@@ -346,7 +365,9 @@ std::vector<ContactRecord> touching_contacts(const DemSimulation& sim) {
     out.push_back(r);
   }
 
+  share_the_mean(body_pairs_from);
   const BodyContactList& body_walls = sim.body_wall_contacts();
+  const std::size_t body_walls_from = out.size();
   for (std::size_t k = 0; k < body_walls.size(); ++k) {
     const std::uint32_t i = body_walls.first[k];
     const Obstacle& obstacle = s.obstacles[body_walls.second[k]];
@@ -374,6 +395,7 @@ std::vector<ContactRecord> touching_contacts(const DemSimulation& sim) {
                    r);
     out.push_back(r);
   }
+  share_the_mean(body_walls_from);
   // A pair is reported from its particle of smaller id: the storage order, which orients
   // the lists, changes at each storage sort, and outputs must not flip with it.
   for (ContactRecord& r : out) {

@@ -252,6 +252,46 @@ inline ElementView element_view(const ParticleStore& p, const std::vector<Partic
   return {&el.core, centre + rotate(q, el.position), q * el.orientation, el.crust, el.reach};
 }
 
+// Hands use(k, outcome) the outcome of the element contacts index(0), ..., index(count - 1)
+// of `list`, in that order (indices in list order). With `mean`, the touching contacts of
+// one pair of bodies, or of a body and an obstacle (consecutive entries with the same
+// first and second: the list is sorted so), are divided by how many of them touch, as
+// Grains3D does for composite particles (each contact force times 1/nbContact).
+template <typename Index, typename Outcome, typename Use>
+void element_contact_outcomes(const BodyContactList& list, Index index, std::size_t count,
+                              bool mean, std::vector<ContactOutcome>& group, Outcome&& outcome,
+                              Use&& use) {
+  if (!mean) {
+    for (std::size_t e = 0; e < count; ++e) use(index(e), outcome(index(e)));
+    return;
+  }
+  for (std::size_t e = 0; e < count;) {
+    const std::size_t k0 = index(e);
+    std::size_t end = e + 1;
+    while (end < count && list.first[index(end)] == list.first[k0] &&
+           list.second[index(end)] == list.second[k0]) {
+      ++end;
+    }
+    group.clear();
+    int touching = 0;
+    for (std::size_t g = e; g < end; ++g) {
+      group.push_back(outcome(index(g)));
+      touching += group.back().touching ? 1 : 0;
+    }
+    const double share = 1.0 / std::max(touching, 1);
+    for (std::size_t g = e; g < end; ++g) {
+      ContactOutcome& o = group[g - e];
+      if (touching > 1) {
+        o.force *= share;
+        o.torque_first *= share;
+        o.torque_second *= share;
+      }
+      use(index(g), o);
+    }
+    e = end;
+  }
+}
+
 }  // namespace
 
 void DemSimulation::compute_forces() {
@@ -337,6 +377,7 @@ void DemSimulation::compute_forces() {
         out.touching = true;
       };
   std::int64_t deep = 0;
+  const bool mean = setup_.mean_element_contacts;
   const auto body_pair_outcome = [&](std::size_t k) {
     ContactOutcome out;
     const std::uint32_t i = body_pairs_.first[k], j = body_pairs_.second[k];
@@ -473,13 +514,16 @@ void DemSimulation::compute_forces() {
         [&](std::size_t k, const ContactOutcome& o) {
           add_sphere_pair(o, k, touching_pairs, worst);
         });
-    for (std::size_t k = 0; k < n_body_pairs; ++k) {
-      add_pair(body_pair_outcome(k), body_pairs_.first[k], body_pairs_.second[k]);
-    }
+    std::vector<ContactOutcome> group;
+    const auto in_order = [](std::size_t e) { return e; };
+    element_contact_outcomes(body_pairs_, in_order, n_body_pairs, mean, group, body_pair_outcome,
+                             [&](std::size_t k, const ContactOutcome& o) {
+                               add_pair(o, body_pairs_.first[k], body_pairs_.second[k]);
+                             });
     for (std::size_t k = 0; k < n_walls; ++k) add_wall(wall_outcome(k), walls_.first[k]);
-    for (std::size_t k = 0; k < n_body_walls; ++k) {
-      add_wall(body_wall_outcome(k), body_walls_.first[k]);
-    }
+    element_contact_outcomes(
+        body_walls_, in_order, n_body_walls, mean, group, body_wall_outcome,
+        [&](std::size_t k, const ContactOutcome& o) { add_wall(o, body_walls_.first[k]); });
   } else {
     // Threads: each block of particles (build_blocks) owns the contacts whose first
     // particle it holds. A particle whose contacts all lie in its block sums them there,
@@ -566,22 +610,29 @@ void DemSimulation::compute_forces() {
                 });
           }
         }
-        for (const std::uint32_t k : block_body_pairs_.of(bu)) {
-          const ContactOutcome o = body_pair_outcome(k);
-          tally(o, slab_pairs);
-          pair_step(o, body_pairs_.first[k], body_pairs_.second[k], body_pair_touching_[k],
-                    body_pair_buffer_[k]);
-        }
+        std::vector<ContactOutcome> group;
+        const std::span<const std::uint32_t> slab_body_pairs = block_body_pairs_.of(bu);
+        element_contact_outcomes(
+            body_pairs_, [&](std::size_t e) { return std::size_t{slab_body_pairs[e]}; },
+            slab_body_pairs.size(), mean, group, body_pair_outcome,
+            [&](std::size_t k, const ContactOutcome& o) {
+              tally(o, slab_pairs);
+              pair_step(o, body_pairs_.first[k], body_pairs_.second[k], body_pair_touching_[k],
+                        body_pair_buffer_[k]);
+            });
         for (const std::uint32_t k : block_walls_.of(bu)) {
           const ContactOutcome o = wall_outcome(k);
           tally(o, slab_walls);
           wall_step(o, walls_.first[k], wall_touching_[k], wall_buffer_[k]);
         }
-        for (const std::uint32_t k : block_body_walls_.of(bu)) {
-          const ContactOutcome o = body_wall_outcome(k);
-          tally(o, slab_walls);
-          wall_step(o, body_walls_.first[k], body_wall_touching_[k], body_wall_buffer_[k]);
-        }
+        const std::span<const std::uint32_t> slab_body_walls = block_body_walls_.of(bu);
+        element_contact_outcomes(
+            body_walls_, [&](std::size_t e) { return std::size_t{slab_body_walls[e]}; },
+            slab_body_walls.size(), mean, group, body_wall_outcome,
+            [&](std::size_t k, const ContactOutcome& o) {
+              tally(o, slab_walls);
+              wall_step(o, body_walls_.first[k], body_wall_touching_[k], body_wall_buffer_[k]);
+            });
       };
       if (blocks > nt) {
         // Several slabs per thread (bodies, build_blocks): each thread walks its own run

@@ -88,6 +88,13 @@ struct DemSetup {
   // (body_contacts.hpp); false: at one point per element pair as in thesis §2.3 and
   // Grains3D (GJK's closest points; the overlap-weighted face centre against planes).
   bool contact_patches = true;
+  // Two bodies that touch through several pairs of elements (two crosses: up to four
+  // element contacts, each with its own memory) get the sum of those contacts' forces and
+  // torques (false), or their mean (true): Grains3D, which ran the thesis' crosses (ch. 3),
+  // divides each element contact's force and torque by the number of element contacts
+  // between the two (Rakotonirina et al. 2019, composite particles). The same between a
+  // body and an obstacle. The memories are the contacts' own either way.
+  bool mean_element_contacts = false;
   // At the start of the step from this time every contact forgets its memory (the
   // tangential and rolling springs, a patch's twist): the contacts go on, their springs
   // start again from zero, as in a run reloaded from positions and velocities alone (a

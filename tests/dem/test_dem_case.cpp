@@ -277,6 +277,7 @@ skin_m = 2e-4
 abort_overlap_ratio = 0.2
 storage_sort_steps = 0
 flat_contacts = "point"
+element_contacts = "mean"
 forget_contact_memory_at_s = 0.004)");
   text += R"(
 [output]
@@ -297,6 +298,8 @@ check_after_s = 0.003
   EXPECT_EQ(load(kValidCase).setup.storage_sort_interval, 2000);  // the default
   EXPECT_FALSE(c.setup.contact_patches);
   EXPECT_TRUE(load(kValidCase).setup.contact_patches);  // the default
+  EXPECT_TRUE(c.setup.mean_element_contacts);
+  EXPECT_FALSE(load(kValidCase).setup.mean_element_contacts);  // the default: the sum
   EXPECT_EQ(c.setup.forget_contact_memory_at, 0.004);
   EXPECT_NE(describe(c).find("contact memory  forgotten at t = 0.004 s"), std::string::npos);
   EXPECT_TRUE(std::isinf(load(kValidCase).setup.forget_contact_memory_at));  // never
@@ -416,6 +419,11 @@ TEST(DemCaseErrors, NegativeStorageSortInterval) {
 TEST(DemCaseErrors, UnknownFlatContactModel) {
   expect_case_error(replaced(kValidCase, "seed = 3", "seed = 3\nflat_contacts = \"manifold\""),
                     "simulation.flat_contacts", "patch");
+}
+
+TEST(DemCaseErrors, UnknownElementContactRule) {
+  expect_case_error(replaced(kValidCase, "seed = 3", "seed = 3\nelement_contacts = \"average\""),
+                    "simulation.element_contacts", "mean");
 }
 
 TEST(DemCaseErrors, NegativeTimeToForgetTheContactMemory) {

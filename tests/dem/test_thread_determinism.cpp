@@ -128,9 +128,11 @@ namespace {
 
 // Crosses (element contacts by GJK, body-wall contacts) give the same bits too.
 // most_shared_fraction 1: every thread owns four slabs and takes others when done.
-std::vector<Vec3> crosses_after(int threads, double most_shared_fraction = 0.15) {
+std::vector<Vec3> crosses_after(int threads, double most_shared_fraction = 0.15,
+                                bool mean_element_contacts = false) {
   DemSetup s = testing::falling_crosses(threads, [](int n) { return n; });
   s.most_shared_fraction = most_shared_fraction;
+  s.mean_element_contacts = mean_element_contacts;
   DemSimulation sim(std::move(s));
   std::int64_t contacts_seen = 0;  // element-pair and element-floor contacts
   for (int k = 0; k < 3000; ++k) {
@@ -156,6 +158,18 @@ TEST(ThreadDeterminism, CrossesGiveIdenticalBitsOnOneTwoAndThreeThreads) {
   for (int threads : {2, 3}) {
     EXPECT_TRUE(bitwise_equal(one, crosses_after(threads))) << threads << " threads";
     EXPECT_TRUE(bitwise_equal(one, crosses_after(threads, 1.0)))
+        << threads << " threads, four slabs each";
+  }
+}
+
+TEST(ThreadDeterminism, CrossesWithTheMeanOfTheirElementContactsGiveIdenticalBits) {
+  // element_contacts = "mean": the element contacts of a pair of bodies are summed as a
+  // group before they reach the particles, on one thread as on several.
+  const std::vector<Vec3> one = crosses_after(1, 0.15, true);
+  EXPECT_FALSE(bitwise_equal(one, crosses_after(1))) << "the mean changed nothing";
+  for (int threads : {2, 3}) {
+    EXPECT_TRUE(bitwise_equal(one, crosses_after(threads, 0.15, true))) << threads << " threads";
+    EXPECT_TRUE(bitwise_equal(one, crosses_after(threads, 1.0, true)))
         << threads << " threads, four slabs each";
   }
 }
