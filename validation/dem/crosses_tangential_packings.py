@@ -48,8 +48,8 @@ SEEDS = [1, 2, 3, 4, 5, 6]
 POINTS = [(kt, g) for kt in LOCAL_KT for g in LOCAL_GAMMA]
 
 
-def run_folder(seed, kt, g):
-    return os.path.join(RUNS, f"seed_{seed}_kt_{kt:g}_gamma_{g:g}")
+def run_folder(seed, kt, g, runs=RUNS):
+    return os.path.join(runs, f"seed_{seed}_kt_{kt:g}_gamma_{g:g}")
 
 
 def stands_above_edge(regions):
@@ -71,7 +71,7 @@ def collapse_counts(results, seeds, points):
     return {p: sum(collapses(results[(s, *p)]) for s in seeds) for p in points}
 
 
-def draw(results, counts, seeds):
+def draw(results, counts, seeds, figure=FIGURE, rule="sum"):
     """Left: on how many pours each point collapses; right: each pour's height loss."""
     fig, (ax, bx) = plt.subplots(1, 2, figsize=(10.0, 4.0),
                                  gridspec_kw={"width_ratios": [1, 1.6]})
@@ -102,10 +102,11 @@ def draw(results, counts, seeds):
     bx.set_xlabel("kt [N/m] / γt [1/s]   (▲ region 3, ● region 2, ■ region 1)")
     bx.set_ylabel("height lost / $H_0$ within 0.5 s [%]")
     bx.legend(fontsize=7, ncol=3, loc="upper right")
-    fig.suptitle("300 crosses, six pours (thesis: Table 3.1 is top-driven, region 2)",
+    fig.suptitle("300 crosses, six pours (thesis: Table 3.1 is top-driven, region 2)"
+                 + ("; element contacts: the mean (Grains3D)" if rule == "mean" else ""),
                  fontsize=10)
     fig.tight_layout()
-    fig.savefig(FIGURE, dpi=130)
+    fig.savefig(figure, dpi=130)
 
 
 def main():
@@ -114,50 +115,70 @@ def main():
     ap.add_argument("--rerun-pours", action="store_true", help="pour again (and run again)")
     ap.add_argument("--rerun", action="store_true", help="run every continuation again")
     ap.add_argument("--quick", action="store_true", help="same as the full run")
+    ap.add_argument("--element-contacts", choices=["sum", "mean"], default="sum",
+                    help="how the element contacts of two crosses add up (simulation."
+                         "element_contacts): mean, as Grains3D, runs in its own folders and "
+                         "report (crosses_tangential_packings_mean)")
+    ap.add_argument("--table31-only", action="store_true",
+                    help="pour and run the Table 3.1 point only, print its regions, no report")
     args = ap.parse_args()
     exe = os.path.join(ROOT, args.build, "app", "sanguis")
+    mean = args.element_contacts == "mean"
+    name = "crosses_tangential_packings" + ("_mean" if mean else "")
+    runs = os.path.join(RESULTS, "runs", name)
+    figure = os.path.join(ROOT, "docs", "validation", "figures", name + ".png")
+    rule = ["--set", 'simulation.element_contacts="mean"'] if mean else []
     t0 = time.time()
-    pours = {seed: os.path.join(RUNS, f"pour_seed_{seed}") for seed in SEEDS}
+    pours = {seed: os.path.join(runs, f"pour_seed_{seed}") for seed in SEEDS}
     reused = []  # wall times of runs kept from an earlier call: they count in the run time
     jobs = []
     for seed, d in pours.items():
         cmd = pour_command([exe, "run", CASE, "--output", d, "--quiet", "--threads", "1",
-                            "--seed", str(seed)], d, GATE_TIME, args.rerun_pours)
+                            "--seed", str(seed)] + rule, d, GATE_TIME, args.rerun_pours)
         if cmd:
             jobs.append((cmd, d))
         else:
             reused.append(wall_time(d))
-    run_two_at_a_time(jobs, RUNS)
+    run_two_at_a_time(jobs, runs)
     packing = {}
     for seed, d in pours.items():
         subprocess.run([exe, "analyze", d], check=True, stdout=subprocess.DEVNULL)
         packing[seed] = read_summary(d)
 
     jobs = []
+    points = [TABLE_31] if args.table31_only else POINTS
     for seed, pour in pours.items():
-        for kt, g in POINTS:
-            d = run_folder(seed, kt, g)
+        for kt, g in points:
+            d = run_folder(seed, kt, g, runs)
             if args.rerun or args.rerun_pours:  # a new pour makes the old runs stale
                 shutil.rmtree(d, ignore_errors=True)
             cmd = continuation_command([exe, "run", CASE, "--output", d, "--restart", "--quiet",
-                                        "--threads", "1"] + settings(kt, g), d, pour, GATE_TIME)
+                                        "--threads", "1"] + rule + settings(kt, g), d, pour,
+                                       GATE_TIME)
             if cmd:
                 jobs.append((cmd, d))
             else:
                 reused.append(wall_time(d, GATE_TIME))
-    run_two_at_a_time(jobs, RUNS)
+    run_two_at_a_time(jobs, runs)
     base_reference = sphere_reference(exe)["bottom_move_mm"]
     results = {}
     for seed in SEEDS:
-        for kt, g in POINTS:
-            d = run_folder(seed, kt, g)
+        for kt, g in points:
+            d = run_folder(seed, kt, g, runs)
             subprocess.run([exe, "analyze", d], check=True, stdout=subprocess.DEVNULL)
             results[(seed, kt, g)] = classify(d, base_reference)
     elapsed = time.time() - t0 + two_at_a_time_span(reused)
+    if args.table31_only:
+        for seed in SEEDS:
+            r = results[(seed, *TABLE_31)]
+            print(f"seed {seed}: H0 {100 * packing[seed]['H0_m']:.1f} cm, neighbours "
+                  f"{packing[seed]['pair_coordination']:.2f}; Table 3.1 region {r['region']}, "
+                  f"height loss {100 * r['height_loss']:.1f} %, run-out {r['runout_ratio']:.2f}")
+        return 0
 
     counts = collapse_counts(results, SEEDS, POINTS)
     os.makedirs(os.path.dirname(FIGURE), exist_ok=True)
-    draw(results, counts, SEEDS)
+    draw(results, counts, SEEDS, figure, args.element_contacts)
 
     max_collapse_base = max((r["bottom_move_mm"] for r in results.values() if r["region"] != 3),
                             default=0.0)
