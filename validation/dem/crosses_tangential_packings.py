@@ -109,7 +109,65 @@ def draw(results, counts, seeds, figure=FIGURE, rule="sum"):
     fig.savefig(figure, dpi=130)
 
 
-def main():
+def sum_notes(results, packing, table31, max_collapse_base, base_reference):
+    """The report's notes for the summed element contacts (the model's default)."""
+    return ["Why this case: crosses_tangential_map uses one pour, and where the edge of "
+            "its band of top-driven collapses passes changes with that pour. Here six "
+            "pours of the same case place the edge around the Table 3.1 point; seed 5 is "
+            "the case's own, so its pour and its 3 x 3 are the map's (the same bits).",
+            # The runs of 2026-11-24 (pours to 2.4 s), quoted from this file's JSON then.
+            "Since 2026-11-25 the pours run to the gate's opening at t = 3.0 s, when the "
+            "column is at rest (before: 2.4 s, with the case's own seed still "
+            "settling). For seeds 1-3 it changed little: with the opening at "
+            "2.4 s they stood at H0 17.8-18.2 cm with 6.35-6.66 neighbours, the Table "
+            "3.1 point lost 1.7-3.8 % (region 3) and kt 1e2, γt 3e2 27-55 % (region 2); "
+            "opened at 3.0 s, with one contact point per element pair (2026-11-25), "
+            "17.8-18.1 cm, 6.35-6.65, 1.2-3.1 % and 35-59 %. On the case's own seed, "
+            "settled, the Table 3.1 point collapsed then (23 %, crosses_tangential_map): "
+            "the point sat on the border of regions 2 and 3.",
+            # The collapses of 2026-12-05 23:16-23:26 UTC; the pours are older.
+            "On 2026-12-05 evening (two points on three pours, AMD EPYC VM) with the "
+            "torsional spring of the patches spread over them (docs/theory/dem.md, \"The "
+            "torsional spring until 2026-12-05 evening\"): the Table 3.1 point lost "
+            "1.1-3.4 % on every pour (region 3) and kt 1e2, γt 3e2 26-55 % (region 2); "
+            "with the corners' spring before, 1.0-4.4 % and 26-61 %, the same regions.",
+            "Since 2026-12-06 (an Intel Xeon VM: a build for another processor rounds "
+            "otherwise with -march=native, so the same seeds pack otherwise) the pours "
+            f"stand at H0 {span([100 * packing[s]['H0_m'] for s in SEEDS], '.1f')} cm "
+            f"with {span([packing[s]['pair_coordination'] for s in SEEDS], '.2f')} "
+            "touching neighbours per cross. The Table 3.1 point loses "
+            f"{span([100 * results[(s, *TABLE_31)]['height_loss'] for s in SEEDS], '.1f')}"
+            f" % of H0 and collapses top-driven on {table31.count(2)} pour(s) of "
+            f"{len(SEEDS)}; kt 1e2, γt 3e2 loses "
+            f"{span([100 * results[(s, 1e2, 3e2)]['height_loss'] for s in SEEDS], '.0f')}"
+            " %. Regions by the rule of crosses_tangential_map that measures the base "
+            "against a column of spheres: the collapses here move their base at most "
+            f"{max_collapse_base:.1f} mm in one τc, against the spheres' "
+            f"{base_reference:.1f} mm."]
+
+
+def mean_notes(results, packing, table31):
+    """The report's notes for the element contacts averaged as in Grains3D."""
+    loss = [100 * results[(s, *TABLE_31)]["height_loss"] for s in SEEDS]
+    soft = [100 * results[(s, 1e2, 3e2)]["height_loss"] for s in SEEDS]
+    return [
+        "The same six pours and 3 x 3 as crosses_tangential_packings, with simulation."
+        "element_contacts = \"mean\" in the pours and the continuations: the force and torque "
+        "of each element contact between two crosses (up to four pairs of arms), or between "
+        "a cross and one wall, divided by the number of element contacts the two have at that "
+        "step, as Grains3D's composite particles do (CompositeParticle::InterAction passes "
+        "that number to the contact model, which multiplies each contact's force by its "
+        "inverse). The thesis ran its crosses on Grains3D; with the sum (the model's default) "
+        "this check fails (crosses_tangential_packings).",
+        f"The pours stand at H0 {span([100 * packing[s]['H0_m'] for s in SEEDS], '.1f')} cm "
+        f"with {span([packing[s]['pair_coordination'] for s in SEEDS], '.2f')} touching "
+        f"neighbours per cross. The Table 3.1 point loses {span(loss, '.1f')} % of H0 and "
+        f"collapses top-driven on {table31.count(2)} pour(s) of {len(SEEDS)}; kt 1e2, "
+        f"γt 3e2 loses {span(soft, '.0f')} %.",
+    ]
+
+
+def main(argv=None):
     ap = argparse.ArgumentParser()
     ap.add_argument("--build", default="build")
     ap.add_argument("--rerun-pours", action="store_true", help="pour again (and run again)")
@@ -121,7 +179,7 @@ def main():
                          "report (crosses_tangential_packings_mean)")
     ap.add_argument("--table31-only", action="store_true",
                     help="pour and run the Table 3.1 point only, print its regions, no report")
-    args = ap.parse_args()
+    args = ap.parse_args(argv)
     exe = os.path.join(ROOT, args.build, "app", "sanguis")
     mean = args.element_contacts == "mean"
     name = "crosses_tangential_packings" + ("_mean" if mean else "")
@@ -177,7 +235,7 @@ def main():
         return 0
 
     counts = collapse_counts(results, SEEDS, POINTS)
-    os.makedirs(os.path.dirname(FIGURE), exist_ok=True)
+    os.makedirs(os.path.dirname(figure), exist_ok=True)
     draw(results, counts, SEEDS, figure, args.element_contacts)
 
     max_collapse_base = max((r["bottom_move_mm"] for r in results.values() if r["region"] != 3),
@@ -210,9 +268,12 @@ def main():
                          f"{r['bottom_move_mm']:.2f}", f"{r['height_loss']:.3f}",
                          f"{r['runout_ratio']:.2f}"])
     ok = all(c["pass"] for c in checks if c["pass"] is not None)
+    notes = mean_notes(results, packing, table31) if mean else sum_notes(
+        results, packing, table31, max_collapse_base, base_reference)
     summary = {
-        "name": "crosses_tangential_packings",
-        "title": "Cross column: the 3 x 3 around Table 3.1 on six packings",
+        "name": name,
+        "title": "Cross column: the 3 x 3 around Table 3.1 on six packings"
+                 + (", element contacts averaged as in Grains3D" if mean else ""),
         "thesis": "§3.4.3, Fig. 3.17",
         "description": (
             f"The 300-cross column of the memory case poured with seeds {seeds_text} and "
@@ -220,8 +281,9 @@ def main():
             "crosses_tangential_map around Table 3.1 (kt 1e2, 3e2, 1e3 N/m; γt 3e2, 1e3, "
             "3e3 1/s; both interactions); regions as in crosses_tangential_map (3 stable: "
             "the highest particle lost less than 5 % of H0)."),
-        "command": "/usr/bin/python3 validation/dem/crosses_tangential_packings.py --build BUILD",
-        "figures": ["docs/validation/figures/crosses_tangential_packings.png"],
+        "command": "/usr/bin/python3 validation/dem/crosses_tangential_packings.py --build BUILD"
+                   + (" --element-contacts mean" if mean else ""),
+        "figures": [f"docs/validation/figures/{name}.png"],
         "checks": checks,
         "tables": [{"caption": "Per run (packing at the opening: H0 and touching neighbours "
                                "per cross).",
@@ -239,39 +301,7 @@ def main():
                               results[(s, *TABLE_31)]["region"],
                               "yes" if edge else "no"]
                              for s, edge in zip(SEEDS, ordered)]}],
-        "notes": ["Why this case: crosses_tangential_map uses one pour, and where the edge of "
-                  "its band of top-driven collapses passes changes with that pour. Here six "
-                  "pours of the same case place the edge around the Table 3.1 point; seed 5 is "
-                  "the case's own, so its pour and its 3 x 3 are the map's (the same bits).",
-                  # The runs of 2026-11-24 (pours to 2.4 s), quoted from this file's JSON then.
-                  "Since 2026-11-25 the pours run to the gate's opening at t = 3.0 s, when the "
-                  "column is at rest (before: 2.4 s, with the case's own seed still "
-                  "settling). For seeds 1-3 it changed little: with the opening at "
-                  "2.4 s they stood at H0 17.8-18.2 cm with 6.35-6.66 neighbours, the Table "
-                  "3.1 point lost 1.7-3.8 % (region 3) and kt 1e2, γt 3e2 27-55 % (region 2); "
-                  "opened at 3.0 s, with one contact point per element pair (2026-11-25), "
-                  "17.8-18.1 cm, 6.35-6.65, 1.2-3.1 % and 35-59 %. On the case's own seed, "
-                  "settled, the Table 3.1 point collapsed then (23 %, crosses_tangential_map): "
-                  "the point sat on the border of regions 2 and 3.",
-                  # The collapses of 2026-12-05 23:16-23:26 UTC; the pours are older.
-                  "On 2026-12-05 evening (two points on three pours, AMD EPYC VM) with the "
-                  "torsional spring of the patches spread over them (docs/theory/dem.md, \"The "
-                  "torsional spring until 2026-12-05 evening\"): the Table 3.1 point lost "
-                  "1.1-3.4 % on every pour (region 3) and kt 1e2, γt 3e2 26-55 % (region 2); "
-                  "with the corners' spring before, 1.0-4.4 % and 26-61 %, the same regions.",
-                  "Since 2026-12-06 (an Intel Xeon VM: a build for another processor rounds "
-                  "otherwise with -march=native, so the same seeds pack otherwise) the pours "
-                  f"stand at H0 {span([100 * packing[s]['H0_m'] for s in SEEDS], '.1f')} cm "
-                  f"with {span([packing[s]['pair_coordination'] for s in SEEDS], '.2f')} "
-                  "touching neighbours per cross. The Table 3.1 point loses "
-                  f"{span([100 * results[(s, *TABLE_31)]['height_loss'] for s in SEEDS], '.1f')}"
-                  f" % of H0 and collapses top-driven on {table31.count(2)} pour(s) of "
-                  f"{len(SEEDS)}; kt 1e2, γt 3e2 loses "
-                  f"{span([100 * results[(s, 1e2, 3e2)]['height_loss'] for s in SEEDS], '.0f')}"
-                  " %. Regions by the rule of crosses_tangential_map that measures the base "
-                  "against a column of spheres: the collapses here move their base at most "
-                  f"{max_collapse_base:.1f} mm in one τc, against the spheres' "
-                  f"{base_reference:.1f} mm."],
+        "notes": notes,
     }
     write_summary(summary, RESULTS, elapsed, args.quick, ok)
     print(f"{'PASS' if ok else 'FAIL'}: Table 3.1 regions {table31}, collapses per point "
