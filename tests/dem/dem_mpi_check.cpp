@@ -249,6 +249,9 @@ int main(int argc, char** argv) {
     ok &= compare("spheres drifting across the periodic seam", periodic_drift(), 20000, 0);
     ok &= compare("crosses", crosses(), 10000, 0);
     ok &= compare("spheres meeting crosses", crosses(true), 10000, 0);
+    DemSetup averaged = crosses();
+    averaged.mean_element_contacts = true;  // element_contacts = "mean"
+    ok &= compare("crosses, element contacts averaged", averaged, 10000, 0);
     ok &= restart_across_process_counts();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "dem_mpi_check: %s\n", e.what());

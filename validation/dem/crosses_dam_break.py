@@ -57,8 +57,6 @@ import matplotlib.pyplot as plt  # noqa: E402
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 CASE = os.path.join(ROOT, "cases", "dem", "dam-break-crosses.toml")
 RESULTS = os.path.join(ROOT, "validation", "dem", "results")
-RUNS = os.path.join(RESULTS, "runs", "crosses_dam_break")
-FIGURE = os.path.join(ROOT, "docs", "validation", "figures", "crosses_dam_break.png")
 
 # gate position [cm] -> crosses (§3.2.3: 1300 to 7000); the column is about 16-21 cm tall
 CROSSES = {4: 1300, 8: 2000, 12: 3000, 20: 5000, 30: 7000}
@@ -243,11 +241,12 @@ def stopped(run, opening):
     return f"came to rest {after:.2f} s after the opening"
 
 
-def run_gate(exe, gate, out, threads, hold_file=None):
+def run_gate(exe, gate, out, threads, hold_file=None, extra=()):
     """pour_gate, then remove the gate and follow the collapse until at rest (at most
     COLLAPSE_S). A folder with a checkpoint (a run stopped on the way) is continued from
-    it. Returns the opening time."""
-    advance = gate_runner(exe, column(gate), out, threads, hold_file)
+    it; `extra` are more overrides, in the pour and the collapse. Returns the opening
+    time."""
+    advance = gate_runner(exe, column(gate), out, threads, hold_file, extra)
     checkpoint = os.path.join(out, "checkpoint.bin")
 
     def collapse(t):
@@ -265,7 +264,7 @@ def run_gate(exe, gate, out, threads, hold_file=None):
     if os.path.exists(checkpoint) and opening_time(out) < 1e5:  # stopped in the collapse
         t = opening_time(out)
     else:
-        t = pour_gate(exe, column(gate), out, threads, hold_file)
+        t = pour_gate(exe, column(gate), out, threads, hold_file, extra)
     collapse(t)
     return t
 
@@ -309,7 +308,7 @@ def velocity_curve(run):
             [float(r["mean_speed_over_sqrt_gH0"]) for r in rows])
 
 
-def main():
+def main(argv=None):
     ap = argparse.ArgumentParser()
     ap.add_argument("--build", default="build")
     ap.add_argument("--gates", type=int, nargs="+", default=[4], choices=sorted(CROSSES))
@@ -317,15 +316,24 @@ def main():
     ap.add_argument("--reuse", action="store_true", help="analyse the runs already on disk")
     ap.add_argument("--quick", action="store_true", help="same as the default (the 4 cm gate)")
     ap.add_argument("--hold-file", help="before each run segment, wait while this file exists")
-    args = ap.parse_args()
+    ap.add_argument("--element-contacts", choices=["sum", "mean"], default="sum",
+                    help="how the element contacts of two crosses add up (simulation."
+                         "element_contacts): mean, as Grains3D, runs in its own folders and "
+                         "report (crosses_dam_break_mean)")
+    args = ap.parse_args(argv)
     exe = os.path.join(ROOT, args.build, "app", "sanguis")
+    mean = args.element_contacts == "mean"
+    name = "crosses_dam_break" + ("_mean" if mean else "")
+    run_root = os.path.join(RESULTS, "runs", name)
+    figure = os.path.join(ROOT, "docs", "validation", "figures", name + ".png")
+    rule = ["--set", 'simulation.element_contacts="mean"'] if mean else []
     runs = {}
     for gate in args.gates:
-        out = os.path.join(RUNS, f"L{gate}cm_seed{SEED}")
+        out = os.path.join(run_root, f"L{gate}cm_seed{SEED}")
         runs[gate] = out
         if args.reuse and os.path.exists(os.path.join(out, "diagnostics.csv")):
             continue  # analyse what is there (a stopped run: continue it without --reuse)
-        run_gate(exe, gate, out, args.threads, args.hold_file)
+        run_gate(exe, gate, out, args.threads, args.hold_file, rule)
     for out in runs.values():
         subprocess.run([exe, "analyze", out], check=True, stdout=subprocess.DEVNULL)
 
@@ -389,20 +397,26 @@ def main():
     notes.append("The thesis' gate is lifted at 43 m/s², the gate here vanishes at once (as in "
                  "the thesis' own simulations of Fig. 3.7-3.9). crosses_gate_effect measures "
                  "what the lift changes, on the 300-cross column of the same parameters.")
-    if 30 not in args.gates:
+    if mean:
+        notes.insert(0, "The element contacts of two crosses (up to four pairs of arms), and "
+                        "of a cross and one wall, averaged as Grains3D, the thesis' code, does "
+                        "for composite particles: simulation.element_contacts = \"mean\" in "
+                        "the pour and the collapse (crosses_dam_break sums them, the model's "
+                        "default).")
+    elif 30 not in args.gates:
         notes.append(POINT_MODEL_30CM)
-    paused = paused_minutes(RUNS)
+    paused = paused_minutes(run_root)
     if paused:
         notes.append(f"The wall times of the table include {paused:.1f} min during which the "
                      "runs were stopped (SIGSTOP) while other work used the cores, as listed in "
-                     "validation/dem/results/runs/crosses_dam_break/PAUSES.txt; the run time "
+                     f"validation/dem/results/runs/{name}/PAUSES.txt; the run time "
                      "of the report leaves them out.")
     notes.append("Coordination: Table B.1 gives 8.2 for crosses and §3.3.3 gives "
                  "2 x 98939 / 12000 = 16.5; 98939 / 12000 = 8.24 matches Table B.1, so the two "
                  "differ by the factor 2 of the formula. Touching neighbours are checked "
                  "against Table B.1; contact points are reported.")
 
-    os.makedirs(os.path.dirname(FIGURE), exist_ok=True)
+    os.makedirs(os.path.dirname(figure), exist_ok=True)
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.2))
     a_line = [0.3 * 1.05 ** k for k in range(70)]
     a1.loglog(a_line, [lajeunesse(a) for a in a_line], "k--", label="Lajeunesse et al. (spheres)")
@@ -425,7 +439,7 @@ def main():
         a2.plot(t, v, label=f"sanguis, gate {gate} cm")
     draw_velocity_bands(a2)
     fig.tight_layout()
-    fig.savefig(FIGURE, dpi=130)
+    fig.savefig(figure, dpi=130)
 
     # The runs' own wall time (their segments may span several calls and sessions, and a
     # folder may come from another case), less the pauses listed beside them.
@@ -433,8 +447,9 @@ def main():
     ok = all(c["pass"] for c in checks if c["pass"] is not None)
     others = [g for g in sorted(CROSSES) if g not in args.gates]
     summary = {
-        "name": "crosses_dam_break",
-        "title": "Dam break of crosses in the experiments' box",
+        "name": name,
+        "title": "Dam break of crosses in the experiments' box"
+                 + (", element contacts averaged as in Grains3D" if mean else ""),
         "thesis": "§3.2-3.3, Table 3.1, Fig. 3.7-3.9, Table B.1",
         "description": (
             "cases/dem/dam-break-crosses.toml: box 64 x 30 x 20 cm, Table 3.1 crosses poured "
@@ -445,9 +460,9 @@ def main():
             + " of the five of §3.2.1"
             + (f" (the others: `--gates {' '.join(map(str, others))}`, hours each)" if others else "")
             + "."),
-        "command": "/usr/bin/python3 validation/dem/crosses_dam_break.py --build BUILD"
+        "command": f"/usr/bin/python3 validation/dem/{name}.py --build BUILD"
                    + ("" if args.gates == [4] else " --gates " + " ".join(map(str, args.gates))),
-        "figures": ["docs/validation/figures/crosses_dam_break.png"],
+        "figures": [f"docs/validation/figures/{name}.png"],
         "checks": checks,
         "tables": [{"caption": "Per run (`sanguis analyze`; coordination at the opening).",
                     "header": ["gate [cm]", "crosses", "L0 [cm]", "H0 [cm]", "a", "(L∞−L0)/L0",
@@ -460,7 +475,7 @@ def main():
         "quick": bool(args.quick),
         "pass": bool(ok),
     }
-    with open(os.path.join(RESULTS, "crosses_dam_break.json"), "w") as f:
+    with open(os.path.join(RESULTS, name + ".json"), "w") as f:
         json.dump(summary, f, indent=1)
     print(f"{'PASS' if ok else 'FAIL'}: {len(points)} run(s), {elapsed / 3600:.2f} h")
     return 0 if ok else 1
