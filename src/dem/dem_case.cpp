@@ -558,8 +558,7 @@ DemCase load_dem_case(const ConfigTable& cfg, const std::filesystem::path& sourc
   if (sort_steps < 0) sim.fail("storage_sort_steps", "must be >= 0 (0: never sort)");
   s.storage_sort_interval = sort_steps;
   s.contact_patches = sim.get_choice("flat_contacts", {"patch", "point"}, "patch") == "patch";
-  s.mean_element_contacts =
-      sim.get_choice("element_contacts", {"sum", "mean"}, "sum") == "mean";
+  s.mean_element_contacts = sim.get_choice("element_contacts", {"sum", "mean"}, "sum") == "mean";
   if (sim.has("forget_contact_memory_at_s")) {
     s.forget_contact_memory_at = sim.get_non_negative("forget_contact_memory_at_s", 0.0);
   }
