@@ -179,6 +179,10 @@ def main(argv=None):
                          "report (crosses_tangential_packings_mean)")
     ap.add_argument("--table31-only", action="store_true",
                     help="pour and run the Table 3.1 point only, print its regions, no report")
+    ap.add_argument("--open-with-sum", action="store_true",
+                    help="with --element-contacts mean --table31-only: open the mean's pours "
+                         "with the sum (folders *_opened_sum), the rule's effect on the same "
+                         "packings")
     args = ap.parse_args(argv)
     exe = os.path.join(ROOT, args.build, "app", "sanguis")
     mean = args.element_contacts == "mean"
@@ -205,14 +209,16 @@ def main(argv=None):
 
     jobs = []
     points = [TABLE_31] if args.table31_only else POINTS
+    opened_with_sum = mean and args.table31_only and args.open_with_sum
+    suffix, opening_rule = ("_opened_sum", []) if opened_with_sum else ("", rule)
     for seed, pour in pours.items():
         for kt, g in points:
-            d = run_folder(seed, kt, g, runs)
+            d = run_folder(seed, kt, g, runs) + suffix
             if args.rerun or args.rerun_pours:  # a new pour makes the old runs stale
                 shutil.rmtree(d, ignore_errors=True)
             cmd = continuation_command([exe, "run", CASE, "--output", d, "--restart", "--quiet",
-                                        "--threads", "1"] + rule + settings(kt, g), d, pour,
-                                       GATE_TIME)
+                                        "--threads", "1"] + opening_rule + settings(kt, g), d,
+                                       pour, GATE_TIME)
             if cmd:
                 jobs.append((cmd, d))
             else:
@@ -222,7 +228,7 @@ def main(argv=None):
     results = {}
     for seed in SEEDS:
         for kt, g in points:
-            d = run_folder(seed, kt, g, runs)
+            d = run_folder(seed, kt, g, runs) + suffix
             subprocess.run([exe, "analyze", d], check=True, stdout=subprocess.DEVNULL)
             results[(seed, kt, g)] = classify(d, base_reference)
     elapsed = time.time() - t0 + two_at_a_time_span(reused)
