@@ -21,8 +21,17 @@ pours. Runs are resumable: a pour or continuation that reached its end is kept.
 
 Writes validation/dem/results/crosses_tangential_packings.json and
 docs/validation/figures/crosses_tangential_packings.png.
+
+`--element-contacts mean` pours and runs everything with the element contacts of two
+crosses averaged, as Grains3D does for composite particles (simulation.element_contacts),
+in runs/crosses_tangential_packings_mean, and writes crosses_tangential_packings_mean.json
+and .png (not yet in the report: the full grid has not been run with it).
+`--table31-only` runs the pours and the Table 3.1 point only and prints the regions;
+with `--element-contacts mean`, `--open-with-sum` opens the same pours with the sum (the
+rule's effect on the same packings; docs/theory/dem.md).
 Usage: /usr/bin/python3 validation/dem/crosses_tangential_packings.py [--build build]
-       [--rerun-pours] [--rerun]
+       [--rerun-pours] [--rerun] [--element-contacts sum|mean] [--table31-only
+       [--open-with-sum]]
 """
 import argparse
 import os
@@ -176,7 +185,7 @@ def main(argv=None):
     ap.add_argument("--element-contacts", choices=["sum", "mean"], default="sum",
                     help="how the element contacts of two crosses add up (simulation."
                          "element_contacts): mean, as Grains3D, runs in its own folders and "
-                         "report (crosses_tangential_packings_mean)")
+                         "summary (crosses_tangential_packings_mean)")
     ap.add_argument("--table31-only", action="store_true",
                     help="pour and run the Table 3.1 point only, print its regions, no report")
     ap.add_argument("--open-with-sum", action="store_true",
