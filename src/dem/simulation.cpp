@@ -378,6 +378,9 @@ void DemSimulation::compute_forces() {
       };
   std::int64_t deep = 0;
   const bool mean = setup_.mean_element_contacts;
+  if (mean && element_groups_.size() < static_cast<std::size_t>(std::max(threads_, 1))) {
+    element_groups_.resize(static_cast<std::size_t>(std::max(threads_, 1)));
+  }
   const auto body_pair_outcome = [&](std::size_t k) {
     ContactOutcome out;
     const std::uint32_t i = body_pairs_.first[k], j = body_pairs_.second[k];
@@ -514,7 +517,8 @@ void DemSimulation::compute_forces() {
         [&](std::size_t k, const ContactOutcome& o) {
           add_sphere_pair(o, k, touching_pairs, worst);
         });
-    std::vector<ContactOutcome> group;
+    std::vector<ContactOutcome> unused;
+    std::vector<ContactOutcome>& group = mean ? element_groups_[0] : unused;
     const auto in_order = [](std::size_t e) { return e; };
     element_contact_outcomes(body_pairs_, in_order, n_body_pairs, mean, group, body_pair_outcome,
                              [&](std::size_t k, const ContactOutcome& o) {
@@ -610,7 +614,9 @@ void DemSimulation::compute_forces() {
                 });
           }
         }
-        std::vector<ContactOutcome> group;
+        std::vector<ContactOutcome> unused;
+        std::vector<ContactOutcome>& group =
+            mean ? element_groups_[static_cast<std::size_t>(omp_get_thread_num())] : unused;
         const std::span<const std::uint32_t> slab_body_pairs = block_body_pairs_.of(bu);
         element_contact_outcomes(
             body_pairs_, [&](std::size_t e) { return std::size_t{slab_body_pairs[e]}; },
@@ -942,6 +948,20 @@ void particle_ranges(const std::vector<std::uint32_t>& first, std::size_t n,
 }  // namespace
 
 void DemSimulation::build_incidence() {
+  if (setup_.mean_element_contacts) {
+    // Room for the longest group of one pair of bodies' element contacts (compute_forces).
+    std::size_t longest = 0;
+    for (const BodyContactList* list : {&body_pairs_, &body_walls_}) {
+      for (std::size_t k = 0, run = 0; k < list->size(); ++k) {
+        const bool same =
+            k > 0 && list->first[k] == list->first[k - 1] && list->second[k] == list->second[k - 1];
+        run = same ? run + 1 : 1;
+        longest = std::max(longest, run);
+      }
+    }
+    element_groups_.resize(static_cast<std::size_t>(std::max(threads_, 1)));
+    for (std::vector<ContactOutcome>& group : element_groups_) group.reserve(longest);
+  }
   if (threads_ <= 1) {
     pair_runs_.clear();  // the serial loop needs no slabs
     return;

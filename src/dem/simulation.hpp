@@ -267,6 +267,9 @@ class DemSimulation {
   std::int64_t forget_memory_step_ = -1;
   BodyContactList body_pairs_, body_walls_;
   std::vector<ContactOutcome> body_pair_buffer_, body_wall_buffer_;
+  // With mean_element_contacts: the outcomes of one pair of bodies' element contacts, one
+  // buffer per thread, kept between steps so that the time loop allocates nothing.
+  std::vector<std::vector<ContactOutcome>> element_groups_;
   // Per slot: whether the contact touched this step (written for the contacts of shared
   // particles, the only ones the gather reads; the outcome only when it touched).
   std::vector<std::uint8_t> pair_touching_, wall_touching_, body_pair_touching_,

@@ -136,6 +136,16 @@ int main() {
       failures += allocating_steps(
                       sim, 2000, "falling crosses, " + std::to_string(threads) + " thread(s)") > 0;
     }
+    {
+      sanguis::dem::DemSetup s = sanguis::dem::testing::falling_crosses(
+          threads, [](int n) { return static_cast<std::int64_t>(n); });
+      s.mean_element_contacts = true;  // element_contacts = "mean": grouped outcomes
+      DemSimulation sim(std::move(s));
+      for (int n = 0; n < 20; ++n) sim.step();
+      failures += allocating_steps(sim, 2000,
+                                   "falling crosses, element contacts averaged, " +
+                                       std::to_string(threads) + " thread(s)") > 0;
+    }
   }
   std::printf(failures == 0 ? "no allocation between list rebuilds\n"
                             : "FAILED: steps without a list rebuild allocated\n");
