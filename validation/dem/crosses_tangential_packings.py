@@ -28,10 +28,11 @@ in runs/crosses_tangential_packings_mean, and writes crosses_tangential_packings
 and .png (not yet in the report: the full grid has not been run with it).
 `--table31-only` runs the pours and the Table 3.1 point only and prints the regions;
 with `--element-contacts mean`, `--open-with-sum` opens the same pours with the sum (the
-rule's effect on the same packings; docs/theory/dem.md).
+rule's effect on the same packings; docs/theory/dem.md), `--open-with-point` with one
+contact point per element pair and the mean (Grains3D's model).
 Usage: /usr/bin/python3 validation/dem/crosses_tangential_packings.py [--build build]
        [--rerun-pours] [--rerun] [--element-contacts sum|mean] [--table31-only
-       [--open-with-sum]]
+       [--open-with-sum | --open-with-point]]
 """
 import argparse
 import os
@@ -192,6 +193,10 @@ def main(argv=None):
                     help="with --element-contacts mean --table31-only: open the mean's pours "
                          "with the sum (folders *_opened_sum), the rule's effect on the same "
                          "packings")
+    ap.add_argument("--open-with-point", action="store_true",
+                    help="with --element-contacts mean --table31-only: open the mean's pours "
+                         "with one contact point per element pair and the mean, the model of "
+                         "the thesis' Grains3D (folders *_opened_point)")
     args = ap.parse_args(argv)
     exe = os.path.join(ROOT, args.build, "app", "sanguis")
     mean = args.element_contacts == "mean"
@@ -218,8 +223,11 @@ def main(argv=None):
 
     jobs = []
     points = [TABLE_31] if args.table31_only else POINTS
-    opened_with_sum = mean and args.table31_only and args.open_with_sum
-    suffix, opening_rule = ("_opened_sum", []) if opened_with_sum else ("", rule)
+    suffix, opening_rule = "", rule
+    if mean and args.table31_only and args.open_with_sum:
+        suffix, opening_rule = "_opened_sum", []
+    elif mean and args.table31_only and args.open_with_point:
+        suffix, opening_rule = "_opened_point", rule + ["--set", 'simulation.flat_contacts="point"']
     for seed, pour in pours.items():
         for kt, g in points:
             d = run_folder(seed, kt, g, runs) + suffix
