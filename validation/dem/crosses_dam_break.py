@@ -394,6 +394,9 @@ def main(argv=None):
                      f"{s['peak_time_over_tau_c']:.1f} τc, against the thesis' 18-39 % (Fig. "
                      "3.9a, other boxes); the centre of mass moved "
                      f"{s['com_displacement_x_over_L0']:.3f} L0.")
+    if args.threads != 1:
+        notes.append(f"Runs on {args.threads} threads (`--threads {args.threads}`; the results "
+                     "do not depend on the thread count).")
     notes.append("The thesis' gate is lifted at 43 m/s², the gate here vanishes at once (as in "
                  "the thesis' own simulations of Fig. 3.7-3.9). crosses_gate_effect measures "
                  "what the lift changes, on the 300-cross column of the same parameters.")
