@@ -292,6 +292,10 @@ int main(int argc, char** argv) {
       ->add_option("--flat-contacts", bo.flat_contacts,
                    "dem-crosses: \"patch\" (default) or \"point\", as flat_contacts in a case")
       ->check(CLI::IsMember({"patch", "point"}));
+  bench_cmd
+      ->add_option("--element-contacts", bo.element_contacts,
+                   "dem-crosses: \"sum\" (default) or \"mean\", as element_contacts in a case")
+      ->check(CLI::IsMember({"sum", "mean"}));
   std::string bench_case;
   bench_cmd->add_option("--case", bench_case,
                         "flow-adaptive: flow case file (default cases/flow/obstacle-wake.toml)");

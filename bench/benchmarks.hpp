@@ -47,6 +47,8 @@ struct BenchOptions {
   std::int64_t storage_sort_interval = -1;
   // dem-crosses: DemSetup::contact_patches ("patch", the default, or "point").
   std::string flat_contacts = "patch";
+  // dem-crosses: DemSetup::mean_element_contacts ("sum", the default, or "mean").
+  std::string element_contacts = "sum";
   // dem-spheres under mpirun: the processes share the system (domain decomposition).
   MPI_Comm comm = MPI_COMM_NULL;
 };
