@@ -331,7 +331,7 @@ std::vector<ContactRecord> touching_contacts(const DemSimulation& sim) {
         ++b;
       }
       const double share = 1.0 / static_cast<double>(b - a);
-      for (std::size_t k = a; b - a > 1 && k < b; ++k) {
+      for (std::size_t k = a; k < b; ++k) {  // share 1 for a single contact: unchanged
         out[k].force *= share;
         out[k].normal_force *= share;
       }

@@ -378,9 +378,6 @@ void DemSimulation::compute_forces() {
       };
   std::int64_t deep = 0;
   const bool mean = setup_.mean_element_contacts;
-  if (mean && element_groups_.size() < static_cast<std::size_t>(std::max(threads_, 1))) {
-    element_groups_.resize(static_cast<std::size_t>(std::max(threads_, 1)));
-  }
   const auto body_pair_outcome = [&](std::size_t k) {
     ContactOutcome out;
     const std::uint32_t i = body_pairs_.first[k], j = body_pairs_.second[k];
@@ -517,8 +514,7 @@ void DemSimulation::compute_forces() {
         [&](std::size_t k, const ContactOutcome& o) {
           add_sphere_pair(o, k, touching_pairs, worst);
         });
-    std::vector<ContactOutcome> unused;
-    std::vector<ContactOutcome>& group = mean ? element_groups_[0] : unused;
+    std::vector<ContactOutcome>& group = element_groups_[0];
     const auto in_order = [](std::size_t e) { return e; };
     element_contact_outcomes(body_pairs_, in_order, n_body_pairs, mean, group, body_pair_outcome,
                              [&](std::size_t k, const ContactOutcome& o) {
@@ -614,9 +610,8 @@ void DemSimulation::compute_forces() {
                 });
           }
         }
-        std::vector<ContactOutcome> unused;
         std::vector<ContactOutcome>& group =
-            mean ? element_groups_[static_cast<std::size_t>(omp_get_thread_num())] : unused;
+            element_groups_[static_cast<std::size_t>(omp_get_thread_num())];
         const std::span<const std::uint32_t> slab_body_pairs = block_body_pairs_.of(bu);
         element_contact_outcomes(
             body_pairs_, [&](std::size_t e) { return std::size_t{slab_body_pairs[e]}; },
@@ -948,6 +943,8 @@ void particle_ranges(const std::vector<std::uint32_t>& first, std::size_t n,
 }  // namespace
 
 void DemSimulation::build_incidence() {
+  // One group buffer per thread (compute_forces); empty unless the mean is asked for.
+  element_groups_.resize(static_cast<std::size_t>(std::max(threads_, 1)));
   if (setup_.mean_element_contacts) {
     // Room for the longest group of one pair of bodies' element contacts (compute_forces).
     std::size_t longest = 0;
@@ -959,7 +956,6 @@ void DemSimulation::build_incidence() {
         longest = std::max(longest, run);
       }
     }
-    element_groups_.resize(static_cast<std::size_t>(std::max(threads_, 1)));
     for (std::vector<ContactOutcome>& group : element_groups_) group.reserve(longest);
   }
   if (threads_ <= 1) {
