@@ -241,11 +241,11 @@ def stopped(run, opening):
     return f"came to rest {after:.2f} s after the opening"
 
 
-def run_gate(exe, gate, out, threads, hold_file=None, extra=()):
+def run_gate(exe, gate, out, threads, hold_file=None, extra=(), collapse_extra=()):
     """pour_gate, then remove the gate and follow the collapse until at rest (at most
     COLLAPSE_S). A folder with a checkpoint (a run stopped on the way) is continued from
-    it; `extra` are more overrides, in the pour and the collapse. Returns the opening
-    time."""
+    it; `extra` are more overrides, in the pour and the collapse, and `collapse_extra` more
+    still, in the collapse only (they come last, so they win). Returns the opening time."""
     advance = gate_runner(exe, column(gate), out, threads, hold_file, extra)
     checkpoint = os.path.join(out, "checkpoint.bin")
 
@@ -258,7 +258,7 @@ def run_gate(exe, gate, out, threads, hold_file=None, extra=()):
         while reached < end - 1e-9 and not (reached > t + 1e-9 and ended_at_rest(out)):
             nxt = min(end, CHECKPOINT_S * (math.floor(reached / CHECKPOINT_S + 1e-6) + 1))
             advance(round(nxt, 6), ["--set", f"obstacle[{GATE_INDEX}].remove_at_s={t}"]
-                    + at_rest_settings(t))
+                    + at_rest_settings(t) + list(collapse_extra))
             reached = diagnostics(out)[-1]["time_s"]
 
     if os.path.exists(checkpoint) and opening_time(out) < 1e5:  # stopped in the collapse
@@ -308,6 +308,59 @@ def velocity_curve(run):
             [float(r["mean_speed_over_sqrt_gH0"]) for r in rows])
 
 
+def table_row(label, gate, s, seconds):
+    """One row of the report's table: `sanguis analyze`'s summary `s` of a run of the
+    gate, and the wall time of its finished segments."""
+    a, ratio = s["aspect_ratio_H0_over_L0"], s["runout_ratio"]
+    return [label, f"{CROSSES[gate]}", f"{100 * s['L0_m']:.1f}", f"{100 * s['H0_m']:.1f}",
+            f"{a:.2f}", f"{ratio:.2f}", f"{ratio / a:.2f}", f"{lajeunesse(a):.2f}",
+            f"{s['height_ratio_H0_over_Hinf']:.2f}", f"{s['peak_mean_speed_over_sqrt_gH0']:.3f}",
+            f"{s['peak_time_over_tau_c']:.1f}", f"{s['pair_coordination']:.2f}",
+            f"{s['contact_point_coordination']:.2f}", regime_name(s), f"{seconds / 3600:.2f}"]
+
+
+def same_pour(control, run):
+    """Whether the control's rows of diagnostics.csv up to its opening are the run's,
+    digit for digit (the same pour: the runs are deterministic), and how many there are."""
+    opening = opening_time(control)
+    with open(os.path.join(control, "diagnostics.csv")) as f:
+        mine = f.read().splitlines()
+    with open(os.path.join(run, "diagnostics.csv")) as f:
+        theirs = f.read().splitlines()
+    count = 1 + sum(1 for r in diagnostics(control) if r["time_s"] <= opening + 1e-9)
+    return opening == opening_time(run) and mine[:count] == theirs[:count], count - 1
+
+
+def control_rows(gate, control, run, rows, checks, notes, points):
+    """The control of a gate (poured with the mean, opened with the sum): its row, the
+    check that its pour is the mean run's, and a note; the run-out is reported, not
+    graded (the control tells what the rule does after the opening, it validates nothing)."""
+    s = read_summary(control)
+    a, ratio = s["aspect_ratio_H0_over_L0"], s["runout_ratio"]
+    label = f"{gate}, the same pour opened with the sum"
+    points.append((f"gate {gate} cm, opened with the sum", s, control))
+    rows.append(table_row(label, gate, s, wall_time(control)))
+    identical, count = same_pour(control, run)
+    checks += [
+        {"quantity": f"(L∞−L0)/L0, gate {gate} cm, a = {a:.2f}, the mean's pour opened with the sum",
+         "measured": round(ratio, 3), "thesis": f"{lajeunesse(a):.2f} (Lajeunesse)",
+         "tolerance": "reported (a control)", "pass": None},
+        {"quantity": f"sanity, gate {gate} cm: the control's pour is the mean run's "
+                     "(diagnostics rows up to the opening, digit for digit)",
+         "measured": f"{count} rows, {'identical' if identical else 'different'}",
+         "thesis": "—", "tolerance": "identical", "pass": identical}]
+    opening = opening_time(control)
+    notes.append(f"Control, gate {gate} cm: the column poured again with the mean (the same "
+                 f"steps: {count} diagnostics rows up to the opening at {opening:g} s, "
+                 f"{'identical to' if identical else 'NOT identical to'} the mean run's) and "
+                 f"opened with the sum; the collapse {stopped(control, opening)}, "
+                 f"{wall_time(control, opening) / 3600:.2f} h. Run-out {ratio:.2f}, H0/H∞ "
+                 f"{s['height_ratio_H0_over_Hinf']:.2f}, peak mean speed "
+                 f"{100 * s['peak_mean_speed_over_sqrt_gH0']:.1f} % of √(g H0) at "
+                 f"{s['peak_time_over_tau_c']:.1f} τc, {regime_name(s)}: what the rule "
+                 "changes after the opening alone, on one packing.")
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser()
     ap.add_argument("--build", default="build")
@@ -320,25 +373,40 @@ def main(argv=None):
                     help="how the element contacts of two crosses add up (simulation."
                          "element_contacts): mean, as Grains3D, runs in its own folders and "
                          "report (crosses_dam_break_mean)")
+    ap.add_argument("--sum-control", action="store_true",
+                    help="with --element-contacts mean: pour each column again with the mean "
+                         "(the same bits) and open it with the sum (folders *_opened_sum): "
+                         "what the rule changes after the opening alone")
     args = ap.parse_args(argv)
+    if args.sum_control and args.element_contacts != "mean":
+        ap.error("--sum-control opens pours made with the mean: give --element-contacts mean")
     exe = os.path.join(ROOT, args.build, "app", "sanguis")
     mean = args.element_contacts == "mean"
     name = "crosses_dam_break" + ("_mean" if mean else "")
     run_root = os.path.join(RESULTS, "runs", name)
     figure = os.path.join(ROOT, "docs", "validation", "figures", name + ".png")
     rule = ["--set", 'simulation.element_contacts="mean"'] if mean else []
-    runs = {}
+    runs = {}  # (gate, opened with the sum after a pour with the mean) -> folder
     for gate in args.gates:
         out = os.path.join(run_root, f"L{gate}cm_seed{SEED}")
-        runs[gate] = out
-        if args.reuse and os.path.exists(os.path.join(out, "diagnostics.csv")):
-            continue  # analyse what is there (a stopped run: continue it without --reuse)
-        run_gate(exe, gate, out, args.threads, args.hold_file, rule)
+        runs[(gate, False)] = out
+        control = out + "_opened_sum"
+        if mean and (args.sum_control or os.path.exists(os.path.join(control, "diagnostics.csv"))):
+            runs[(gate, True)] = control  # a control on disk stays in the report
+        if not (args.reuse and os.path.exists(os.path.join(out, "diagnostics.csv"))):
+            run_gate(exe, gate, out, args.threads, args.hold_file, rule)
+        if args.sum_control and not (args.reuse and os.path.exists(
+                os.path.join(control, "diagnostics.csv"))):
+            run_gate(exe, gate, control, args.threads, args.hold_file, rule,
+                     ["--set", 'simulation.element_contacts="sum"'])
     for out in runs.values():
         subprocess.run([exe, "analyze", out], check=True, stdout=subprocess.DEVNULL)
 
     checks, rows, points, notes = [], [], [], []
-    for gate, out in runs.items():
+    for (gate, opened_sum), out in runs.items():
+        if opened_sum:
+            control_rows(gate, out, runs[(gate, False)], rows, checks, notes, points)
+            continue
         s = read_summary(out)
         a = s["aspect_ratio_H0_over_L0"]
         ratio = s["runout_ratio"]
@@ -347,14 +415,8 @@ def main(argv=None):
         before = [r for r in diag if r["time_s"] <= opening + 1e-9][-1]
         overlap = max(r["max_overlap_over_radius"] for r in diag)
         seconds = wall_time(out)
-        points.append((gate, s, out))
-        rows.append([f"{gate}", f"{CROSSES[gate]}", f"{100 * s['L0_m']:.1f}",
-                     f"{100 * s['H0_m']:.1f}", f"{a:.2f}", f"{ratio:.2f}", f"{ratio / a:.2f}",
-                     f"{lajeunesse(a):.2f}", f"{s['height_ratio_H0_over_Hinf']:.2f}",
-                     f"{s['peak_mean_speed_over_sqrt_gH0']:.3f}", f"{s['peak_time_over_tau_c']:.1f}",
-                     f"{s['pair_coordination']:.2f}", f"{s['contact_point_coordination']:.2f}",
-                     regime_name(s),
-                     f"{seconds / 3600:.2f}"])
+        points.append((f"gate {gate} cm", s, out))
+        rows.append(table_row(f"{gate}", gate, s, seconds))
         if a >= 4.0:
             ref = 1.9 * a ** (2.0 / 3.0)
             checks.append({"quantity": f"(L∞−L0)/L0, gate {gate} cm, a = {a:.2f}",
@@ -423,23 +485,23 @@ def main(argv=None):
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.2))
     a_line = [0.3 * 1.05 ** k for k in range(70)]
     a1.loglog(a_line, [lajeunesse(a) for a in a_line], "k--", label="Lajeunesse et al. (spheres)")
-    for gate, s, _ in points:
+    for label, s, _ in points:
         l0 = s["L0_m"]
         lo = (s["Linf_20pc_m"] - l0) / l0
         hi = (s["Linf_1pc_m"] - l0) / l0
         r = s["runout_ratio"]
         a1.errorbar([s["aspect_ratio_H0_over_L0"]], [r],
                     yerr=[[max(0.0, r - lo)], [max(0.0, hi - r)]], fmt="o", capsize=3,
-                    label=f"sanguis, gate {gate} cm")
+                    label=f"sanguis, {label}")
         a1.plot([s["aspect_ratio_H0_over_L0"]], [s["com_displacement_x_over_L0"]], "d",
                 color="tab:orange")
     a1.plot([], [], "d", color="tab:orange", label="centre-of-mass shift / L0")
     a1.set_xlabel(r"$a = H_0/L_0$")
     a1.set_ylabel(r"$(L_\infty - L_0)/L_0$")
     a1.legend(fontsize=8)
-    for gate, _, out in points:
+    for label, _, out in points:
         t, v = velocity_curve(out)
-        a2.plot(t, v, label=f"sanguis, gate {gate} cm")
+        a2.plot(t, v, label=f"sanguis, {label}")
     draw_velocity_bands(a2)
     fig.tight_layout()
     fig.savefig(figure, dpi=130)
@@ -464,7 +526,8 @@ def main(argv=None):
             + (f" (the others: `--gates {' '.join(map(str, others))}`, hours each)" if others else "")
             + "."),
         "command": f"/usr/bin/python3 validation/dem/{name}.py --build BUILD"
-                   + ("" if args.gates == [4] else " --gates " + " ".join(map(str, args.gates))),
+                   + ("" if args.gates == [4] else " --gates " + " ".join(map(str, args.gates)))
+                   + (" --sum-control" if any(k[1] for k in runs) else ""),
         "figures": [f"docs/validation/figures/{name}.png"],
         "checks": checks,
         "tables": [{"caption": "Per run (`sanguis analyze`; coordination at the opening).",
