@@ -51,9 +51,13 @@ six runs may span several sessions. `--sizes small` (or `--quick`) runs and repo
 small columns only; `--reuse` analyses the finished runs on disk, and with
 `--finished-only` reports those that have finished while the others go on (it names them;
 the contrast between the sizes is then taken over the packings there are).
+`--element-contacts mean` pours and collapses with the element contacts of two crosses
+averaged, as Grains3D does (simulation.element_contacts), and Table 3.1 throughout (no
+calibration, no second collapse), with the same checks, in its own folders and report
+(crosses_column_width_mean.py runs it).
 Usage: /usr/bin/python3 validation/dem/crosses_column_width.py [--build build]
            [--sizes small large] [--seeds 1 2 3] [--reuse [--finished-only]]
-           [--without-table31] [--quick]
+           [--without-table31] [--quick] [--element-contacts sum|mean]
 """
 import argparse
 import math
@@ -61,6 +65,7 @@ import os
 import subprocess
 import sys
 from concurrent.futures import ThreadPoolExecutor
+from typing import NamedTuple, Optional
 
 import matplotlib
 import numpy as np
@@ -77,8 +82,29 @@ from crosses_dam_break import (RESULTS, ROOT, Column, diagnostics, draw_velocity
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-RUNS = os.path.join(RESULTS, "runs", "crosses_column_width")
-FIGURE = os.path.join(ROOT, "docs", "validation", "figures", "crosses_column_width.png")
+
+
+class Variant(NamedTuple):
+    """What the checked collapses are made with: the report's name (also of the runs'
+    folder and the figure), the element-contact rule's overrides (in the pours and the
+    collapses) and the collapse's tangential (kt, gamma_t); None: Table 3.1's."""
+    name: str
+    rule: list
+    tangential: Optional[tuple]
+
+    def runs(self):
+        return os.path.join(RESULTS, "runs", self.name)
+
+    def figure(self):
+        return os.path.join(ROOT, "docs", "validation", "figures", self.name + ".png")
+
+
+# The model's sum with the calibration of crosses_recalibrated, and Grains3D's mean of the
+# element contacts with the thesis' own Table 3.1 (crosses_dam_break_mean: its 4 cm gate
+# runs out as the thesis' crosses with no calibration). main() chooses one.
+SUM = Variant("crosses_column_width", [], (KT, GAMMA_T))
+MEAN = Variant("crosses_column_width_mean", ["--set", 'simulation.element_contacts="mean"'], None)
+variant = SUM
 SPHERES = os.path.join(RESULTS, "runs", "dam_break_scaling", "L0_4.1cm")  # Fig. 3.9 spheres
 
 ASPECT = 3.2             # Fig. 3.9
@@ -146,11 +172,12 @@ SIZES = {"small": Size("small", 1000, (0.34, 0.39), (3.0, 5.0), (6.0, 8.0)),
 
 
 def folders(size, seed):
-    """The pour, the calibrated collapse and the Table 3.1 collapse of one size and seed."""
-    tag = f"{size}_seed{seed}"
-    return (os.path.join(RUNS, f"{tag}_pour"),
-            os.path.join(RUNS, f"{tag}_kt{KT:g}_gamma{GAMMA_T:g}"),
-            os.path.join(RUNS, f"{tag}_table31"))
+    """The pour, the checked collapse (the calibrated one, or Table 3.1's with the mean)
+    and the Table 3.1 collapse of one size and seed (with the mean, the same folder)."""
+    tag, runs = f"{size}_seed{seed}", variant.runs()
+    checked = (f"{tag}_kt{KT:g}_gamma{GAMMA_T:g}" if variant.tangential else f"{tag}_table31")
+    return (os.path.join(runs, f"{tag}_pour"), os.path.join(runs, checked),
+            os.path.join(runs, f"{tag}_table31"))
 
 
 def run_one(exe, size, seed, table31):
@@ -159,9 +186,10 @@ def run_one(exe, size, seed, table31):
     stopped on the way."""
     col = SIZES[size].column()
     pour, out, out31 = folders(size, seed)
-    opening = pour_gate(exe, col, pour, 1, extra=seed_settings(seed))
-    frames = ["--set", f"output.interval_s={FRAME_S}"]
-    collapse(exe, col, pour, out, opening, 1, seed=seed, extra=frames)
+    opening = pour_gate(exe, col, pour, 1, extra=seed_settings(seed) + variant.rule)
+    frames = ["--set", f"output.interval_s={FRAME_S}"] + variant.rule
+    collapse(exe, col, pour, out, opening, 1, tangential=variant.tangential, seed=seed,
+             extra=frames)
     if table31:
         collapse(exe, col, pour, out31, opening, 1, tangential=None, seed=seed, extra=frames)
 
@@ -194,21 +222,22 @@ def highest_point(points, l0, count=5):
     return float(points[top, 0].mean() / l0)
 
 
-def collapse_finished(size, seed, tangential=(KT, GAMMA_T)):
-    """Whether the pour and the collapse (tangential None: Table 3.1) of this size and seed
-    have both finished."""
+def collapse_finished(size, seed, table31=False):
+    """Whether the pour and the checked collapse (`table31`: the Table 3.1 one) of this
+    size and seed have both finished."""
+    tangential = None if table31 else variant.tangential
     pour, out, out31 = folders(size, seed)
     if not os.path.exists(os.path.join(pour, "diagnostics.csv")):
         return False
     opening = diagnostics(pour)[-1]["time_s"]
-    return finished(out if tangential else out31, tangential, opening)
+    return finished(out31 if table31 else out, tangential, opening)
 
 
 def finished_only(keys, with_table31):
     """The keys (size, seed) whose calibrated collapse has finished, the Table 3.1 ones
     whose own has, and a sentence naming what is left out (None when nothing is)."""
     done = [key for key in keys if collapse_finished(*key)]
-    done31 = [key for key in with_table31 if collapse_finished(*key, tangential=None)]
+    done31 = [key for key in with_table31 if collapse_finished(*key, table31=True)]
     left = [f"{SIZES[size].count} crosses, seed {seed}" for size, seed in keys
             if (size, seed) not in done]
     left += [f"{SIZES[size].count} crosses, seed {seed}, Table 3.1" for size, seed in with_table31
@@ -221,10 +250,12 @@ def finished_only(keys, with_table31):
     return done, done31, note
 
 
-def measure(exe, size, seed, tangential=(KT, GAMMA_T)):
-    """The analysed figures of one finished collapse (tangential None: Table 3.1)."""
+def measure(exe, size, seed, table31=False):
+    """The analysed figures of one finished collapse: the checked one (`table31`: the
+    Table 3.1 one)."""
     pour, out, out31 = folders(size, seed)
-    out = out if tangential else out31
+    out = out31 if table31 else out
+    tangential = None if table31 else variant.tangential
     if not os.path.exists(os.path.join(pour, "diagnostics.csv")):
         sys.exit(f"{pour}: no pour; run without --reuse to make it")
     at_opening = diagnostics(pour)[-1]
@@ -333,15 +364,16 @@ def draw(results, table31, sizes, seeds):
                         label=f"{SIZES[size].count} crosses, seed {seed}, Table 3.1")
     draw_velocity_bands(ax)
     ax.set_xlim(0, 16)
-    ax.set_title(f"a = {ASPECT}, kt {KT:g} N/m, γt {GAMMA_T:g} 1/s", fontsize=9)
+    ax.set_title(f"a = {ASPECT}, " + (f"kt {KT:g} N/m, γt {GAMMA_T:g} 1/s" if variant.tangential
+                                      else "Table 3.1, element contacts averaged"), fontsize=9)
     for k, size in enumerate(sizes):
         shown = [seed for seed in seeds if (size, seed) in results]
         if shown:
             snapshot(fig.add_subplot(2, 2, 2 * (k + 1)), size, shown[0],
                      results[(size, shown[0])])
     fig.tight_layout()
-    os.makedirs(os.path.dirname(FIGURE), exist_ok=True)
-    fig.savefig(FIGURE, dpi=130)
+    os.makedirs(os.path.dirname(variant.figure()), exist_ok=True)
+    fig.savefig(variant.figure(), dpi=130)
 
 
 def twist_model_note(keys, with_table31):
@@ -363,7 +395,8 @@ def twist_model_note(keys, with_table31):
             "reported here ran " + "; ".join(parts) + ". " + TWIST_MOMENT_EFFECT)
 
 
-def main():
+def main(argv=None):
+    global variant
     ap = argparse.ArgumentParser()
     ap.add_argument("--build", default="build")
     ap.add_argument("--sizes", nargs="+", default=list(SIZES), choices=list(SIZES))
@@ -374,7 +407,12 @@ def main():
     ap.add_argument("--quick", action="store_true", help="the small columns only")
     ap.add_argument("--finished-only", action="store_true",
                     help="with --reuse: report the runs that have finished, naming the others")
-    args = ap.parse_args()
+    ap.add_argument("--element-contacts", choices=["sum", "mean"], default="sum",
+                    help="mean: pour and collapse with the element contacts of two crosses "
+                         "averaged, as Grains3D, and Table 3.1 (no calibration), in their own "
+                         "folders and report (crosses_column_width_mean)")
+    args = ap.parse_args(argv)
+    variant = MEAN if args.element_contacts == "mean" else SUM
     if args.finished_only and not args.reuse:
         ap.error("--finished-only reports runs on disk: give --reuse as well")
     if args.quick:
@@ -384,7 +422,8 @@ def main():
     exe = os.path.join(ROOT, args.build, "app", "sanguis")
     keys = [(size, seed) for size in args.sizes for seed in args.seeds]
     first = min(args.seeds)
-    with_table31 = [] if args.without_table31 else [(size, first) for size in args.sizes]
+    with_table31 = ([] if args.without_table31 or not variant.tangential
+                    else [(size, first) for size in args.sizes])
     if not args.reuse:
         run_all_jobs(exe, keys, with_table31)
     left_out = None
@@ -393,11 +432,18 @@ def main():
         if not keys:
             sys.exit("no collapse has finished yet: nothing to report")
     results = {key: measure(exe, *key) for key in keys}
-    table31 = {key: measure(exe, *key, tangential=None) for key in with_table31}
+    table31 = {key: measure(exe, *key, table31=True) for key in with_table31}
 
     checks, rows, notes = [], [], []
     if left_out:
         notes.append(left_out)
+    if not variant.tangential:
+        notes.append("The element contacts of two crosses (up to four pairs of arms), and of a "
+                     "cross and one wall, averaged as Grains3D, the thesis' code, does for "
+                     "composite particles (simulation.element_contacts = \"mean\"), in the "
+                     "pours and the collapses, with the thesis' Table 3.1 throughout (no "
+                     "calibration): crosses_column_width sums them and collapses with the "
+                     "calibration of crosses_recalibrated.")
     for (size, seed), r in results.items():
         label = f"{SIZES[size].count} crosses, seed {seed}"
         checks += SIZES[size].checks(label, r["peak"], r["peak_t"], r["below"])
@@ -407,6 +453,7 @@ def main():
         rows.append(table_row(label, r, f"{r['pour_s'] / 3600:.2f}"))
         notes.append(f"{sentence(label)}: poured with Table 3.1 and at rest at "
                      f"{r['opening']:g} s; the collapse {r['stopped']}.")
+    runs_text = f"results/runs/{variant.name}/PAUSES.txt"
     for (size, seed), r in table31.items():
         label = f"{SIZES[size].count} crosses, seed {seed}, Table 3.1 (kt 3e2, γt 1e3)"
         checks.append({"quantity": f"{label}: peak mean speed / √(g H0); below 5 % from t / τc",
@@ -422,44 +469,47 @@ def main():
     notes.append("The thesis' sphere curves of Fig. 3.9a are checked by dam_break_scaling "
                  "(its column of a = 3.2); they are drawn here in grey when its runs are on "
                  "disk.")
-    paused = paused_minutes(RUNS)
+    paused = paused_minutes(variant.runs())
     if paused and left_out:
         # The pause list covers every run of the case, without dates: it cannot be split
         # between the runs reported and those still going.
         notes.append(f"The wall times include stops (SIGSTOP, while other work used the "
-                     f"cores) of the runs reported here: results/runs/crosses_column_width/"
-                     f"PAUSES.txt lists {paused:.1f} min for all the case's runs, those not "
+                     f"cores) of the runs reported here: {runs_text} lists {paused:.1f} min for all the case's runs, those not "
                      "finished included, so the run time is given with the stops in it.")
         paused = None
     elif paused:
         notes.append(f"The wall times include {paused:.1f} min in which the runs were "
                      "stopped (SIGSTOP) while other work used the cores (listed in "
-                     "results/runs/crosses_column_width/PAUSES.txt); the run time leaves "
-                     "them out.")
+                     f"{runs_text}); the run time leaves them out.")
     draw(results, table31, args.sizes, args.seeds)
     elapsed = pool_span([r["pour_s"] + r["collapse_s"]
                                   + (table31[key]["collapse_s"] if key in table31 else 0.0)
                                   for key, r in results.items()])
     elapsed -= 60.0 * (paused or 0.0)
     ok = all(c["pass"] for c in checks if c["pass"] is not None)
+    collapsed_with = (f"collapsed with kt {KT:g} N/m, γt {GAMMA_T:g} 1/s (the calibration of "
+                      "crosses_recalibrated)" if variant.tangential else
+                      "collapsed with Table 3.1 too, the element contacts of two crosses "
+                      "averaged as in Grains3D throughout")
     summary = {
-        "name": "crosses_column_width",
-        "title": "Narrow and wide columns of crosses at a = 3.2",
+        "name": variant.name,
+        "title": "Narrow and wide columns of crosses at a = 3.2"
+                 + ("" if variant.tangential else ", element contacts averaged as in Grains3D"),
         "thesis": "§3.3.2, Fig. 3.9",
         "description": (
             "The box of crosses_dam_break 15 cm deep; columns of a = 3.2 of 1000 crosses "
             "(L0 under two cross lengths) and 3000 (over three), three packings each, poured "
-            f"with Table 3.1, collapsed with kt {KT:g} N/m, γt {GAMMA_T:g} 1/s (the "
-            "calibration of crosses_recalibrated) until at rest; the mean speed against "
+            f"with Table 3.1, {collapsed_with}, until at rest; the mean speed against "
             "the thesis' Fig. 3.9a curves."),
-        "command": "/usr/bin/python3 validation/dem/crosses_column_width.py --build BUILD"
+        "command": f"/usr/bin/python3 validation/dem/{variant.name}.py --build BUILD"
                    + (" --quick" if args.quick else "" if args.sizes == list(SIZES)
                       else " --sizes " + " ".join(args.sizes))
                    + ("" if args.seeds == list(SEEDS)
                       else " --seeds " + " ".join(map(str, args.seeds)))
-                   + (" --without-table31" if args.without_table31 else "")
+                   + (" --without-table31" if args.without_table31 and variant.tangential
+                      else "")
                    + (" --reuse --finished-only" if args.finished_only else ""),
-        "figures": ["docs/validation/figures/crosses_column_width.png"],
+        "figures": [f"docs/validation/figures/{variant.name}.png"],
         "checks": checks,
         "tables": [{"caption": "Per run (`sanguis analyze`; the top's x at 3 τc).",
                     "header": TABLE_HEADER,

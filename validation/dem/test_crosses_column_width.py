@@ -64,8 +64,8 @@ class Checks(unittest.TestCase):
     def test_finished_only_keeps_the_finished_runs_and_names_the_others(self):
         done = {("small", 1, True), ("small", 2, True), ("large", 1, True), ("small", 1, False)}
         saved = cw.collapse_finished
-        cw.collapse_finished = lambda size, seed, tangential=(1, 1): \
-            (size, seed, tangential is not None) in done
+        cw.collapse_finished = lambda size, seed, table31=False: \
+            (size, seed, not table31) in done
         try:
             keys = [(size, seed) for size in ("small", "large") for seed in (1, 2)]
             kept, kept31, note = cw.finished_only(keys, [("small", 1), ("large", 1)])
@@ -76,6 +76,21 @@ class Checks(unittest.TestCase):
         self.assertEqual(kept31, [("small", 1)])
         self.assertIn("3000 crosses, seed 2; 3000 crosses, seed 1, Table 3.1.", note)
         self.assertEqual(everything, ([("small", 1), ("large", 1)], [("small", 1)], None))
+
+    def test_the_mean_checks_its_table31_collapses_in_its_own_folders(self):
+        saved = cw.variant
+        try:
+            cw.variant = cw.MEAN
+            pour, checked, table31 = cw.folders("small", 2)
+        finally:
+            cw.variant = saved
+        self.assertEqual(os.path.basename(os.path.dirname(pour)), "crosses_column_width_mean")
+        self.assertEqual(os.path.basename(checked), "small_seed2_table31")
+        self.assertEqual(checked, table31)
+        self.assertIsNone(cw.MEAN.tangential)
+        self.assertIn('simulation.element_contacts="mean"', cw.MEAN.rule)
+        self.assertEqual(os.path.basename(cw.folders("small", 2)[1]),
+                         f"small_seed2_kt{cw.KT:g}_gamma{cw.GAMMA_T:g}")
 
     def test_a_failed_job_cancels_the_jobs_not_yet_started(self):
         started = []
