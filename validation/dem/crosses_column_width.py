@@ -45,9 +45,9 @@ the back wall (x of the five highest crosses over L0) than the small columns'.
 
 Writes validation/dem/results/crosses_column_width.json and
 docs/validation/figures/crosses_column_width.png. The runs go two at a time, one thread
-each (hours: a pour and a collapse of 1000 crosses about 2 h, of 3000 crosses several);
-a run stopped on the way is continued from its checkpoint by the same command, so the
-six runs may span several sessions. `--sizes small` (or `--quick`) runs and reports the
+each unless `--threads` says more (hours: a pour and a collapse of 1000 crosses about 2 h,
+of 3000 crosses several); a run stopped on the way is continued from its checkpoint by the
+same command, so the six runs may span several sessions. `--sizes small` (or `--quick`) runs and reports the
 small columns only; `--reuse` analyses the finished runs on disk, and with
 `--finished-only` reports those that have finished while the others go on (it names them;
 the contrast between the sizes is then taken over the packings there are).
@@ -57,7 +57,7 @@ calibration, no second collapse), with the same checks, in its own folders and r
 (crosses_column_width_mean.py runs it).
 Usage: /usr/bin/python3 validation/dem/crosses_column_width.py [--build build]
            [--sizes small large] [--seeds 1 2 3] [--reuse [--finished-only]]
-           [--without-table31] [--quick] [--element-contacts sum|mean]
+           [--without-table31] [--quick] [--threads T] [--element-contacts sum|mean]
 """
 import argparse
 import math
@@ -180,25 +180,26 @@ def folders(size, seed):
             os.path.join(runs, f"{tag}_table31"))
 
 
-def run_one(exe, size, seed, table31):
+def run_one(exe, size, seed, table31, threads=1):
     """Pour (Table 3.1, gate in place, at rest), then the calibrated collapse and, if
     `table31`, the Table 3.1 one; one thread. Each goes on from its checkpoint when
     stopped on the way."""
     col = SIZES[size].column()
     pour, out, out31 = folders(size, seed)
-    opening = pour_gate(exe, col, pour, 1, extra=seed_settings(seed) + variant.rule)
+    opening = pour_gate(exe, col, pour, threads, extra=seed_settings(seed) + variant.rule)
     frames = ["--set", f"output.interval_s={FRAME_S}"] + variant.rule
-    collapse(exe, col, pour, out, opening, 1, tangential=variant.tangential, seed=seed,
+    collapse(exe, col, pour, out, opening, threads, tangential=variant.tangential, seed=seed,
              extra=frames)
     if table31:
-        collapse(exe, col, pour, out31, opening, 1, tangential=None, seed=seed, extra=frames)
+        collapse(exe, col, pour, out31, opening, threads, tangential=None, seed=seed,
+                 extra=frames)
 
 
-def run_all_jobs(exe, keys, with_table31):
+def run_all_jobs(exe, keys, with_table31, threads=1):
     """run_one for every (size, seed), two at a time; the first failure (or Ctrl-C)
     cancels the jobs not yet started and is raised once the running ones end."""
     with ThreadPoolExecutor(max_workers=2) as pool:
-        jobs = [pool.submit(run_one, exe, size, seed, (size, seed) in with_table31)
+        jobs = [pool.submit(run_one, exe, size, seed, (size, seed) in with_table31, threads)
                 for size, seed in keys]
         try:
             for job in jobs:
@@ -407,6 +408,9 @@ def main(argv=None):
     ap.add_argument("--quick", action="store_true", help="the small columns only")
     ap.add_argument("--finished-only", action="store_true",
                     help="with --reuse: report the runs that have finished, naming the others")
+    ap.add_argument("--threads", type=int, default=1,
+                    help="threads of each run (two run at a time; one run alone on two "
+                         "threads gives its result in half the time, and the same bits)")
     ap.add_argument("--element-contacts", choices=["sum", "mean"], default="sum",
                     help="mean: pour and collapse with the element contacts of two crosses "
                          "averaged, as Grains3D, and Table 3.1 (no calibration), in their own "
@@ -425,7 +429,7 @@ def main(argv=None):
     with_table31 = ([] if args.without_table31 or not variant.tangential
                     else [(size, first) for size in args.sizes])
     if not args.reuse:
-        run_all_jobs(exe, keys, with_table31)
+        run_all_jobs(exe, keys, with_table31, args.threads)
     left_out = None
     if args.finished_only:
         keys, with_table31, left_out = finished_only(keys, with_table31)

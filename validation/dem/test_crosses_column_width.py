@@ -95,7 +95,7 @@ class Checks(unittest.TestCase):
     def test_a_failed_job_cancels_the_jobs_not_yet_started(self):
         started = []
 
-        def fake_run_one(exe, size, seed, table31):
+        def fake_run_one(exe, size, seed, table31, threads=1):
             started.append((size, seed, table31))
             if seed == 1:
                 raise RuntimeError("run failed")
