@@ -490,12 +490,12 @@ def main(argv=None):
         lo = (s["Linf_20pc_m"] - l0) / l0
         hi = (s["Linf_1pc_m"] - l0) / l0
         r = s["runout_ratio"]
-        a1.errorbar([s["aspect_ratio_H0_over_L0"]], [r],
-                    yerr=[[max(0.0, r - lo)], [max(0.0, hi - r)]], fmt="o", capsize=3,
-                    label=f"sanguis, {label}")
+        bar = a1.errorbar([s["aspect_ratio_H0_over_L0"]], [r],
+                          yerr=[[max(0.0, r - lo)], [max(0.0, hi - r)]], fmt="o", capsize=3,
+                          label=f"sanguis, {label}")
         a1.plot([s["aspect_ratio_H0_over_L0"]], [s["com_displacement_x_over_L0"]], "d",
-                color="tab:orange")
-    a1.plot([], [], "d", color="tab:orange", label="centre-of-mass shift / L0")
+                mfc="none", color=bar.lines[0].get_color())
+    a1.plot([], [], "d", mfc="none", color="0.3", label="centre-of-mass shift / L0 (same colour)")
     a1.set_xlabel(r"$a = H_0/L_0$")
     a1.set_ylabel(r"$(L_\infty - L_0)/L_0$")
     a1.legend(fontsize=8)
