@@ -32,8 +32,12 @@ Writes validation/dem/results/crosses_dam_break.json and
 docs/validation/figures/crosses_dam_break.png. `--reuse`: analyse the runs on disk. A run
 folder left with a checkpoint by a stopped run is continued from it (hours-long gates
 can span several sessions).
+`--element-contacts mean` pours and collapses with the element contacts of two crosses
+averaged, as Grains3D does (crosses_dam_break_mean.py runs it), and with it `--sum-control`
+pours each column again (the same steps, checked row by row) and opens it with the sum.
 Usage: /usr/bin/python3 validation/dem/crosses_dam_break.py [--build build] [--hold-file F]
            [--gates 4 8 ...] [--threads T] [--reuse] [--quick]
+           [--element-contacts sum|mean [--sum-control]]
 """
 import argparse
 import csv

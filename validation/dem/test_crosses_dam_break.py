@@ -146,5 +146,30 @@ class Columns(unittest.TestCase):
         self.assertIn(f"obstacle[{db.SIDE_WALL_INDEX}].point_m=[0.0, 0.135, 0.0]", settings)
 
 
+class SumControl(unittest.TestCase):
+    def folder(self, root, name, rows, opening=0.2):
+        d = os.path.join(root, name)
+        os.makedirs(d)
+        fake_run(d, [], rows)
+        with open(os.path.join(d, "obstacles.csv"), "w") as f:
+            f.write(f"name,remove_at_s\nfloor,1e30\ngate,{opening}\n")
+        return d
+
+    def test_the_pours_must_agree_digit_for_digit_up_to_the_opening(self):
+        pour = [(0.1, 0.5), (0.2, 1e-4)]
+        with tempfile.TemporaryDirectory() as root:
+            run = self.folder(root, "mean", pour + [(0.3, 0.02)])
+            same = self.folder(root, "same", pour + [(0.3, 0.01)])  # differs after it only
+            other = self.folder(root, "other", [(0.1, 0.5), (0.2, 1.0001e-4), (0.3, 0.01)])
+            late = self.folder(root, "late", pour + [(0.3, 0.01)], opening=0.3)
+            self.assertEqual(db.same_pour(same, run), (True, 2))
+            self.assertEqual(db.same_pour(other, run), (False, 2))
+            self.assertFalse(db.same_pour(late, run)[0])  # opened elsewhere
+
+    def test_the_control_needs_the_mean(self):
+        with self.assertRaises(SystemExit):
+            db.main(["--sum-control"])
+
+
 if __name__ == "__main__":
     unittest.main()
