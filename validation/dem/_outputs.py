@@ -80,6 +80,12 @@ def speed_landmarks(t, v, line=0.05):
     return v[peak], t[peak], below
 
 
+def element_contacts_setting(rule):
+    """The `sanguis run` override of simulation.element_contacts ("sum" or "mean": how the
+    element contacts of two composite bodies add up)."""
+    return ["--set", f'simulation.element_contacts="{rule}"']
+
+
 def read_summary(run_dir):
     """The one row of RUN/analysis/summary.csv (written by `sanguis analyze`) as floats."""
     with open(os.path.join(run_dir, "analysis", "summary.csv"), newline="") as f:

@@ -47,8 +47,8 @@ Writes validation/dem/results/crosses_column_width.json and
 docs/validation/figures/crosses_column_width.png. The runs go two at a time, one thread
 each unless `--threads` says more (hours: a pour and a collapse of 1000 crosses about 2 h,
 of 3000 crosses several); a run stopped on the way is continued from its checkpoint by the
-same command, so the six runs may span several sessions. `--sizes small` (or `--quick`) runs and reports the
-small columns only; `--reuse` analyses the finished runs on disk, and with
+same command, so the six runs may span several sessions. `--sizes small` (or `--quick`)
+runs and reports the small columns only; `--reuse` analyses the finished runs on disk, and with
 `--finished-only` reports those that have finished while the others go on (it names them;
 the contrast between the sizes is then taken over the packings there are).
 `--element-contacts mean` pours and collapses with the element contacts of two crosses
@@ -71,9 +71,10 @@ import matplotlib
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import (TWIST_MOMENT_EFFECT, TWIST_MOMENT_FROM, paused_minutes,  # noqa: E402
-                      pool_span, read_arrays, read_pvd, segment_starts,
-                      read_summary, regime_name, speed_landmarks, wall_time, write_summary)
+from _outputs import (TWIST_MOMENT_EFFECT, TWIST_MOMENT_FROM,  # noqa: E402
+                      element_contacts_setting, paused_minutes, pool_span, read_arrays,
+                      read_pvd, segment_starts, read_summary, regime_name, speed_landmarks,
+                      wall_time, write_summary)
 from crosses_calibrated_gates import (GAMMA_T, KT, collapse, finished,  # noqa: E402
                                       seed_settings)
 from crosses_dam_break import (RESULTS, ROOT, Column, diagnostics, draw_velocity_bands,  # noqa: E402
@@ -81,7 +82,6 @@ from crosses_dam_break import (RESULTS, ROOT, Column, diagnostics, draw_velocity
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-
 
 
 class Variant(NamedTuple):
@@ -103,7 +103,7 @@ class Variant(NamedTuple):
 # element contacts with the thesis' own Table 3.1 (crosses_dam_break_mean: its 4 cm gate
 # runs out as the thesis' crosses with no calibration). main() chooses one.
 SUM = Variant("crosses_column_width", [], (KT, GAMMA_T))
-MEAN = Variant("crosses_column_width_mean", ["--set", 'simulation.element_contacts="mean"'], None)
+MEAN = Variant("crosses_column_width_mean", element_contacts_setting("mean"), None)
 variant = SUM
 SPHERES = os.path.join(RESULTS, "runs", "dam_break_scaling", "L0_4.1cm")  # Fig. 3.9 spheres
 
@@ -457,7 +457,6 @@ def main(argv=None):
         rows.append(table_row(label, r, f"{r['pour_s'] / 3600:.2f}"))
         notes.append(f"{sentence(label)}: poured with Table 3.1 and at rest at "
                      f"{r['opening']:g} s; the collapse {r['stopped']}.")
-    runs_text = f"results/runs/{variant.name}/PAUSES.txt"
     for (size, seed), r in table31.items():
         label = f"{SIZES[size].count} crosses, seed {seed}, Table 3.1 (kt 3e2, γt 1e3)"
         checks.append({"quantity": f"{label}: peak mean speed / √(g H0); below 5 % from t / τc",
@@ -477,12 +476,14 @@ def main(argv=None):
                  "(its column of a = 3.2); they are drawn here in grey when its runs are on "
                  "disk.")
     paused = paused_minutes(variant.runs())
+    runs_text = f"results/runs/{variant.name}/PAUSES.txt"
     if paused and left_out:
         # The pause list covers every run of the case, without dates: it cannot be split
         # between the runs reported and those still going.
         notes.append(f"The wall times include stops (SIGSTOP, while other work used the "
-                     f"cores) of the runs reported here: {runs_text} lists {paused:.1f} min for all the case's runs, those not "
-                     "finished included, so the run time is given with the stops in it.")
+                     f"cores) of the runs reported here: {runs_text} lists {paused:.1f} min "
+                     "for all the case's runs, those not finished included, so the run time "
+                     "is given with the stops in it.")
         paused = None
     elif paused:
         notes.append(f"The wall times include {paused:.1f} min in which the runs were "

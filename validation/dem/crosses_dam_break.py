@@ -53,7 +53,8 @@ from typing import NamedTuple
 import matplotlib
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import paused_minutes, read_summary, regime_name, wall_time  # noqa: E402
+from _outputs import (element_contacts_setting, paused_minutes, read_summary,  # noqa: E402
+                      regime_name, wall_time)
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -331,8 +332,8 @@ def same_pour(control, run):
         mine = f.read().splitlines()
     with open(os.path.join(run, "diagnostics.csv")) as f:
         theirs = f.read().splitlines()
-    count = 1 + sum(1 for r in diagnostics(control) if r["time_s"] <= opening + 1e-9)
-    return opening == opening_time(run) and mine[:count] == theirs[:count], count - 1
+    count = sum(1 for line in mine[1:] if float(line.split(",", 1)[0]) <= opening + 1e-9)
+    return opening == opening_time(run) and mine[:count + 1] == theirs[:count + 1], count
 
 
 def control_rows(gate, control, run, rows, checks, notes, points):
@@ -341,19 +342,20 @@ def control_rows(gate, control, run, rows, checks, notes, points):
     graded (the control tells what the rule does after the opening, it validates nothing)."""
     s = read_summary(control)
     a, ratio = s["aspect_ratio_H0_over_L0"], s["runout_ratio"]
+    opening = opening_time(control)
     label = f"{gate}, the same pour opened with the sum"
     points.append((f"gate {gate} cm, opened with the sum", s, control))
     rows.append(table_row(label, gate, s, wall_time(control)))
     identical, count = same_pour(control, run)
     checks += [
-        {"quantity": f"(L∞−L0)/L0, gate {gate} cm, a = {a:.2f}, the mean's pour opened with the sum",
+        {"quantity": f"(L∞−L0)/L0, gate {gate} cm, a = {a:.2f}, the mean's pour opened "
+                     "with the sum",
          "measured": round(ratio, 3), "thesis": f"{lajeunesse(a):.2f} (Lajeunesse)",
          "tolerance": "reported (a control)", "pass": None},
         {"quantity": f"sanity, gate {gate} cm: the control's pour is the mean run's "
                      "(diagnostics rows up to the opening, digit for digit)",
          "measured": f"{count} rows, {'identical' if identical else 'different'}",
          "thesis": "—", "tolerance": "identical", "pass": identical}]
-    opening = opening_time(control)
     notes.append(f"Control, gate {gate} cm: the column poured again with the mean (the same "
                  f"steps: {count} diagnostics rows up to the opening at {opening:g} s, "
                  f"{'identical to' if identical else 'NOT identical to'} the mean run's) and "
@@ -389,20 +391,20 @@ def main(argv=None):
     name = "crosses_dam_break" + ("_mean" if mean else "")
     run_root = os.path.join(RESULTS, "runs", name)
     figure = os.path.join(ROOT, "docs", "validation", "figures", name + ".png")
-    rule = ["--set", 'simulation.element_contacts="mean"'] if mean else []
+    rule = element_contacts_setting("mean") if mean else []
     runs = {}  # (gate, opened with the sum after a pour with the mean) -> folder
     for gate in args.gates:
         out = os.path.join(run_root, f"L{gate}cm_seed{SEED}")
         runs[(gate, False)] = out
         control = out + "_opened_sum"
-        if mean and (args.sum_control or os.path.exists(os.path.join(control, "diagnostics.csv"))):
+        control_on_disk = os.path.exists(os.path.join(control, "diagnostics.csv"))
+        if mean and (args.sum_control or control_on_disk):
             runs[(gate, True)] = control  # a control on disk stays in the report
         if not (args.reuse and os.path.exists(os.path.join(out, "diagnostics.csv"))):
             run_gate(exe, gate, out, args.threads, args.hold_file, rule)
-        if args.sum_control and not (args.reuse and os.path.exists(
-                os.path.join(control, "diagnostics.csv"))):
+        if args.sum_control and not (args.reuse and control_on_disk):
             run_gate(exe, gate, control, args.threads, args.hold_file, rule,
-                     ["--set", 'simulation.element_contacts="sum"'])
+                     element_contacts_setting("sum"))
     for out in runs.values():
         subprocess.run([exe, "analyze", out], check=True, stdout=subprocess.DEVNULL)
 

@@ -47,8 +47,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import (continuation_command, pour_command, read_summary,  # noqa: E402
-                      run_two_at_a_time, span, two_at_a_time_span, wall_time, write_summary)
+from _outputs import (continuation_command, element_contacts_setting,  # noqa: E402
+                      pour_command, read_summary, run_two_at_a_time, span,
+                      two_at_a_time_span, wall_time, write_summary)
 from crosses_tangential_map import (CASE, GATE_TIME, LOCAL_GAMMA, LOCAL_KT, RESULTS,  # noqa: E402
                                     ROOT, TABLE_31, classify, settings, sphere_reference)
 
@@ -203,7 +204,7 @@ def main(argv=None):
     name = "crosses_tangential_packings" + ("_mean" if mean else "")
     runs = os.path.join(RESULTS, "runs", name)
     figure = os.path.join(ROOT, "docs", "validation", "figures", name + ".png")
-    rule = ["--set", 'simulation.element_contacts="mean"'] if mean else []
+    rule = element_contacts_setting("mean") if mean else []
     t0 = time.time()
     pours = {seed: os.path.join(runs, f"pour_seed_{seed}") for seed in SEEDS}
     reused = []  # wall times of runs kept from an earlier call: they count in the run time
