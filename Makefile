@@ -4,7 +4,7 @@ JOBS ?= $(shell nproc)
 CASE ?= cases/dem/dam-break-spheres.toml
 OUT ?= output/demo
 
-.PHONY: deps build demo test bench bench-deps validate-dem format clean
+.PHONY: deps build demo test bench bench-deps validate-dem format format-check clean
 
 deps:
 	bash scripts/install-deps.sh
@@ -31,7 +31,11 @@ validate-dem: build
 	/usr/bin/python3 validation/dem/run_all.py --build $(BUILD)
 
 format:
-	find src app tests bench -name '*.hpp' -o -name '*.cpp' | xargs clang-format -i
+	find src app tests bench validation -name '*.hpp' -o -name '*.cpp' | xargs clang-format -i
+
+# Lists every file clang-format would change and fails if there is one.
+format-check:
+	find src app tests bench validation -name '*.hpp' -o -name '*.cpp' | xargs clang-format --dry-run -Werror
 
 clean:
 	rm -rf $(BUILD)

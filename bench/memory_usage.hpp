@@ -17,7 +17,11 @@ inline std::int64_t proc_status_bytes(const std::string& name) {
   return 0;
 }
 
-inline std::int64_t resident_bytes() { return proc_status_bytes("VmRSS"); }
-inline std::int64_t peak_resident_bytes() { return proc_status_bytes("VmHWM"); }
+inline std::int64_t resident_bytes() {
+  return proc_status_bytes("VmRSS");
+}
+inline std::int64_t peak_resident_bytes() {
+  return proc_status_bytes("VmHWM");
+}
 
 }  // namespace sanguis::bench

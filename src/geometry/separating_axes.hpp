@@ -17,8 +17,8 @@
 
 namespace sanguis::geometry {
 
-inline bool boxes_apart_beyond(const Box& a, const Pose& pose_a, const Box& b,
-                               const Pose& pose_b, double margin) {
+inline bool boxes_apart_beyond(const Box& a, const Pose& pose_a, const Box& b, const Pose& pose_b,
+                               double margin) {
   margin *= 1.0 + 1e-9;  // round-off never turns a touching pair into a rejected one
   // The boxes' axes in space: the columns of their rotation matrices.
   const Mat3 rot_a = rotation_matrix(pose_a.orientation);

@@ -32,7 +32,8 @@ TEST(SeparatingAxes, OnlyAnEdgeAxisSeparatesTwoCubesEdgeToEdge) {
   // separates them, the axis x cross y does.
   const Box cube{{0.5, 0.5, 0.5}};
   const double g = 0.05;
-  const Pose a{{0.0, 0.0, 0.0}, Quaternion::from_axis_angle({1.0, 0.0, 0.0}, 0.25 * std::numbers::pi)};
+  const Pose a{{0.0, 0.0, 0.0},
+               Quaternion::from_axis_angle({1.0, 0.0, 0.0}, 0.25 * std::numbers::pi)};
   const Pose b{{0.0, 0.0, std::sqrt(2.0) + g},
                Quaternion::from_axis_angle({0.0, 1.0, 0.0}, 0.25 * std::numbers::pi)};
   const DistanceResult d = gjk_distance(ConvexShape{cube}, a, ConvexShape{cube}, b);

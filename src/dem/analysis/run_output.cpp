@@ -110,7 +110,8 @@ void keep_entries(const std::vector<bool>& keep, Arrays&... arrays) {
 // Glued particles (a rough floor) are part of the walls, not of the granular mass: the
 // run-out, heights, velocities and coordination are measured on the mobile particles.
 void drop_fixed(ParticleFrame& f, const std::vector<std::int64_t>& fixed) {
-  if (fixed.size() != f.size()) throw std::runtime_error("particle frame: 'fixed' has a wrong length");
+  if (fixed.size() != f.size())
+    throw std::runtime_error("particle frame: 'fixed' has a wrong length");
   std::vector<bool> keep(fixed.size());
   for (std::size_t k = 0; k < fixed.size(); ++k) keep[k] = fixed[k] == 0;
   keep_entries(keep, f.id, f.position, f.velocity, f.radius, f.mass, f.spherical);
