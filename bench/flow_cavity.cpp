@@ -224,7 +224,8 @@ std::string run_flow_cavity(const BenchOptions& options_in) {
        << ",\"multigrid_kernels\":\"" << (constant ? "constant" : "general") << "\""
        << ",\"relaxation\":" << mg_options.relaxation
        << ",\"viscous_relaxation\":" << options.viscous.relaxation
-       << ",\"sweeps\":" << mg_options.pre_sweeps << ",\"prefetch\":\"" << o.prefetch << "\"";
+       << ",\"sweeps\":" << mg_options.pre_sweeps << ",\"prefetch\":\"" << o.prefetch << "\""
+       << ",\"prefetch_finest\":\"" << mg.finest_prefetch() << "\"";
   const std::int64_t triad_n = triad_elements();
   const double triad = stream_triad_bytes_per_s(o.threads, triad_n);
   const double effective = vcycle_bytes_per_cell(!constant, mg_options.pre_sweeps) *

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -598,24 +599,40 @@ inline NextBlock next_block(const BlockField& x, const BlockField& rhs, int blk)
   }
 }
 
-/// Whether a half-sweep over x and rhs should prefetch the next block: when
-/// the two fields hold more than half the last-level cache (sysconf; 32 MiB
-/// where it does not tell), so the blocks come from memory. In cache the
-/// prefetches only add instructions (forced on, 11-15 % of the smoother's
-/// time on the 64³ cavity; docs/performance.md, "Prefetching the next block
-/// in the smoother").
-bool prefetch_worthwhile(NextBlockPrefetch mode, const BlockField& x, const BlockField& rhs) {
-  if (mode != NextBlockPrefetch::OutOfCache) return mode == NextBlockPrefetch::Always;
-  static const double cache_bytes = [] {
+/// Bytes of x and the right-hand side, what a half-sweep streams.
+double field_bytes(const BlockField& x, const BlockField& rhs) {
+  return sizeof(double) *
+         (static_cast<double>(x.raw().size()) + static_cast<double>(rhs.raw().size()));
+}
+
+/// The last-level cache sysconf reports (32 MiB where it does not tell).
+double reported_cache_bytes() {
+  static const double bytes = [] {
     long reported = 0;
 #ifdef _SC_LEVEL3_CACHE_SIZE  // glibc's; elsewhere the default below
     reported = sysconf(_SC_LEVEL3_CACHE_SIZE);
 #endif
-    return reported > 0 ? static_cast<double>(reported) : 32.0 * 1024 * 1024;
+    return reported > 0 ? static_cast<double>(reported) : kUsualCoreCache;
   }();
-  const double bytes = sizeof(double) * (static_cast<double>(x.raw().size()) +
-                                         static_cast<double>(rhs.raw().size()));
-  return bytes > 0.5 * cache_bytes;
+  return bytes;
+}
+
+/// What OutOfCache makes of fields of `bytes`: prefetch when they hold more
+/// than half the reported last-level cache, so the blocks come from memory;
+/// not when they hold at most half of what a core usually reaches
+/// (kUsualCoreCache), where the prefetches only add instructions (forced on,
+/// 11-15 % of the smoother's time on the 64³ cavity; docs/performance.md,
+/// "Prefetching the next block in the smoother"); between the two, where a
+/// VM may report more cache than a core has, time both (PrefetchTrial).
+enum class PrefetchRule { No, Yes, Timed };
+PrefetchRule prefetch_rule(NextBlockPrefetch mode, double bytes) {
+  if (mode != NextBlockPrefetch::OutOfCache) {
+    return mode == NextBlockPrefetch::Always ? PrefetchRule::Yes : PrefetchRule::No;
+  }
+  const double reported = reported_cache_bytes();
+  if (bytes > 0.5 * reported) return PrefetchRule::Yes;
+  if (bytes <= 0.5 * std::min(reported, kUsualCoreCache)) return PrefetchRule::No;
+  return PrefetchRule::Timed;
 }
 
 /// relax_constant with kB cells per edge, every row through relax_row
@@ -1462,7 +1479,10 @@ void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const Sc
   // runs forwards, the second backwards), or on the thread beside at the end
   // of a share: its rows are prefetched meanwhile, when the fields do not fit
   // in the cache (blocks 0: no prefetching).
-  const int blocks = prefetch_worthwhile(prefetch_, x, rhs) ? x.blocks() : 0;
+  const bool timed = prefetch_rule(prefetch_, field_bytes(x, rhs)) == PrefetchRule::Timed;
+  const bool prefetch = prefetching(level, x, rhs, true);
+  const int blocks = prefetch ? x.blocks() : 0;
+  const auto start = std::chrono::steady_clock::now();
   for (int sweep = 0; sweep < sweeps; ++sweep) {
     for (int colour = 0; colour < 2; ++colour) {
       if (fused) {
@@ -1490,6 +1510,46 @@ void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const Sc
       }
     }
   }
+  if (timed) {  // prefetching() made the level's trial
+    prefetch_trials_[D(level)].record(
+        prefetch, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  }
+  if (level == 0) {
+    const auto decided = timed ? prefetch_trials_[0].decision() : std::nullopt;
+    finest_prefetch_ = !timed ? (prefetch ? "on" : "off")
+                              : (decided ? (*decided ? "timed on" : "timed off") : "timing");
+  }
+}
+
+bool PrefetchTrial::next_choice(double field_bytes) {
+  if (field_bytes > 2.0 * bytes_ || field_bytes < 0.5 * bytes_) *this = PrefetchTrial{};
+  bytes_ = field_bytes;
+  if (decided_) return *decided_;
+  // Thue-Morse: 0 1 1 0 1 0 0 1 1 0 0 1 0 1 1 0; 1 prefetches.
+  return (__builtin_popcount(static_cast<unsigned>(calls_)) & 1) != 0;
+}
+
+void PrefetchTrial::record(bool prefetching, double seconds) {
+  if (decided_) return;
+  double& best = best_[prefetching ? 1 : 0];
+  best = std::min(best, seconds);
+  if (++calls_ == kTrialCalls) decided_ = best_[1] < best_[0];
+}
+
+bool Multigrid::prefetching(int level, const BlockField& x, const BlockField& rhs, bool trial) {
+  const double bytes = field_bytes(x, rhs);
+  switch (prefetch_rule(prefetch_, bytes)) {
+    case PrefetchRule::No:
+      return false;
+    case PrefetchRule::Yes:
+      return true;
+    case PrefetchRule::Timed:
+      break;
+  }
+  if (prefetch_trials_.size() <= D(level)) prefetch_trials_.resize(D(level) + 1);
+  PrefetchTrial& timed = prefetch_trials_[D(level)];
+  // The residual does not take turns: it prefetches once the trial says so.
+  return trial ? timed.next_choice(bytes) : timed.decision().value_or(false);
 }
 
 void Multigrid::compute_residual(int level, BlockField& x, const BlockField& rhs,
@@ -1501,7 +1561,7 @@ void Multigrid::compute_residual(int level, BlockField& x, const BlockField& rhs
   const std::array<std::ptrdiff_t, 3> s{L.stride(0), L.stride(1), L.stride(2)};
   fill_ghosts_between_blocks_apart(level, x);  // the rest block by block, as in smooth()
   block_squares_.resize(static_cast<std::size_t>(forest_.local_blocks()));
-  const int blocks = prefetch_worthwhile(prefetch_, x, rhs) ? x.blocks() : 0;  // as in smooth()
+  const int blocks = prefetching(level, x, rhs, false) ? x.blocks() : 0;  // as in smooth()
   forest_.for_each_block([&](int blk) {
     const auto at = static_cast<std::size_t>(blk);
     // Same-level neighbours of this process are read in place, unless the

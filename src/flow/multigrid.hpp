@@ -54,7 +54,10 @@
 // rebuild() (or a new Multigrid).
 
 #include <array>
+#include <limits>
 #include <memory>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "flow/block_field.hpp"
@@ -70,7 +73,41 @@ namespace sanguis::flow {
 /// smoother"): only when x and the right-hand side outgrow half the
 /// last-level cache (in cache the prefetches only cost), always, or never.
 /// A hint to the memory, so every choice gives the same bits.
+///
+/// The cache size comes from sysconf, which a virtual machine may report as
+/// its host's whole cache (508 MiB on a 2-core AMD EPYC VM whose smoother
+/// leaves the cache between 20 and 48 MB of fields). Where the reported
+/// cache exceeds kUsualCoreCache and the fields lie between half of each,
+/// OutOfCache times the level's first smoother calls both ways and keeps the
+/// faster (PrefetchTrial; docs/performance.md, "The cache a VM reports").
 enum class NextBlockPrefetch { OutOfCache, Always, Never };
+
+/// The last-level cache one core of a common server processor reaches (a
+/// CCD's L3 on AMD EPYC); below half of it the fields stay in cache.
+inline constexpr double kUsualCoreCache = 32.0 * 1024 * 1024;
+
+/// One level's choice between prefetching and not, where it is timed: the
+/// first kTrialCalls smoother calls alternate (in Thue-Morse order, so that
+/// each way gets as many pre- as post-smoothing calls of a V-cycle), then the
+/// way with the shorter best call is kept. A fields' size that moves by more
+/// than 2x (a regrid) starts a new trial.
+class PrefetchTrial {
+ public:
+  static constexpr int kTrialCalls = 16;
+  /// Whether the next call prefetches (the trial's turn, or the decision).
+  [[nodiscard]] bool next_choice(double field_bytes);
+  /// Records a call's time (ignored once decided).
+  void record(bool prefetching, double seconds);
+  /// The decision; nullopt while the trial runs.
+  [[nodiscard]] std::optional<bool> decision() const { return decided_; }
+
+ private:
+  double bytes_ = 0.0;
+  int calls_ = 0;
+  std::array<double, 2> best_{std::numeric_limits<double>::infinity(),
+                              std::numeric_limits<double>::infinity()};
+  std::optional<bool> decided_;
+};
 
 struct MultigridOptions {
   double tolerance = 1e-8;  ///< stop when |r|_2 <= tolerance |rhs|_2 (RMS norms)
@@ -206,6 +243,13 @@ class Multigrid {
   /// Cells per edge of the blocks the solves run on (the merged ones when merged).
   [[nodiscard]] int solver_block_cells() const {
     return merged_ ? merged_->forest->block_cells() : forest_.block_cells();
+  }
+  /// Whether the last smoother call on the finest level prefetched the next
+  /// block: "on" or "off" by the rule of NextBlockPrefetch, "timed on" or
+  /// "timed off" where PrefetchTrial decided, "timing" while it runs, "" before
+  /// any call (the merged blocks' solver when merged).
+  [[nodiscard]] std::string finest_prefetch() const {
+    return merged_ ? merged_->solver->finest_prefetch() : finest_prefetch_;
   }
 
  private:
@@ -361,6 +405,11 @@ class Multigrid {
   bool constant_kernels_ = true;  ///< MultigridOptions::constant_coefficient_kernels of the solve
   bool in_place_ = true;          ///< MultigridOptions::read_neighbours_in_place of the solve
   NextBlockPrefetch prefetch_ = NextBlockPrefetch::OutOfCache;  ///< MultigridOptions::prefetch
+  std::vector<PrefetchTrial> prefetch_trials_;  ///< per level, where OutOfCache times it
+  std::string finest_prefetch_;                 ///< what finest_prefetch() returns
+  /// Whether a smoother call (`trial`: one that may time the choice) or a
+  /// residual on `level` prefetches the next block.
+  bool prefetching(int level, const BlockField& x, const BlockField& rhs, bool trial);
 };
 
 }  // namespace sanguis::flow

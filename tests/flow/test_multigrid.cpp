@@ -216,6 +216,37 @@ void expect_kernels_agree(const Forest& forest, Multigrid& mg, const BlockField&
   }
 }
 
+TEST(FlowMultigrid, PrefetchTrialTakesTurnsThenKeepsTheFasterWay) {
+  // Where the reported cache and a core's usual one disagree, the smoother's
+  // first calls on a level alternate between prefetching (true) and not, in
+  // Thue-Morse order (as many pre- as post-smoothing calls each way), and the
+  // way with the shorter best call is kept until the fields change size.
+  const double bytes = 40e6;
+  const std::vector<bool> turns{false, true, true, false, true, false, false, true,
+                                true, false, false, true, false, true, true, false};
+  ASSERT_EQ(static_cast<int>(turns.size()), PrefetchTrial::kTrialCalls);
+  for (const bool prefetch_faster : {true, false}) {
+    SCOPED_TRACE(prefetch_faster ? "prefetching faster" : "prefetching slower");
+    PrefetchTrial trial;
+    for (std::size_t call = 0; call < turns.size(); ++call) {
+      EXPECT_FALSE(trial.decision().has_value());
+      const bool turn = trial.next_choice(bytes);
+      EXPECT_EQ(turn, turns[call]) << "call " << call;
+      // One slow first call each way (cold caches) must not decide it.
+      const double seconds = (turn == prefetch_faster ? 1.0 : 1.2) * (call < 2 ? 3.0 : 1.0);
+      trial.record(turn, seconds);
+    }
+    ASSERT_TRUE(trial.decision().has_value());
+    EXPECT_EQ(*trial.decision(), prefetch_faster);
+    trial.record(!prefetch_faster, 0.1);  // after the decision calls change nothing
+    EXPECT_EQ(trial.next_choice(1.5 * bytes), prefetch_faster);
+    EXPECT_EQ(*trial.decision(), prefetch_faster);
+    // A regrid that moves the fields by more than 2x starts again.
+    EXPECT_FALSE(trial.next_choice(3.1 * bytes));
+    EXPECT_FALSE(trial.decision().has_value());
+  }
+}
+
 TEST(FlowMultigrid, ConstantCoefficientKernelsGiveTheSameBitsAsTheGeneralOnes) {
   // Constant alpha and beta (no solid, constant viscosity) relax and form
   // residuals without reading the coefficient arrays. Same operations in the
