@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -1526,7 +1527,7 @@ bool PrefetchTrial::next_choice(double field_bytes) {
   bytes_ = field_bytes;
   if (decided_) return *decided_;
   // Thue-Morse: 0 1 1 0 1 0 0 1 1 0 0 1 0 1 1 0; 1 prefetches.
-  return (__builtin_popcount(static_cast<unsigned>(calls_)) & 1) != 0;
+  return (std::popcount(static_cast<unsigned>(calls_)) & 1) != 0;
 }
 
 void PrefetchTrial::record(bool prefetching, double seconds) {

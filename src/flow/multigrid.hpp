@@ -89,8 +89,8 @@ inline constexpr double kUsualCoreCache = 32.0 * 1024 * 1024;
 /// One level's choice between prefetching and not, where it is timed: the
 /// first kTrialCalls smoother calls alternate (in Thue-Morse order, so that
 /// each way gets as many pre- as post-smoothing calls of a V-cycle), then the
-/// way with the shorter best call is kept. A fields' size that moves by more
-/// than 2x (a regrid) starts a new trial.
+/// way with the shorter best call is kept. Fields whose size moves by more
+/// than 2x (a regrid) start a new trial.
 class PrefetchTrial {
  public:
   static constexpr int kTrialCalls = 16;

@@ -222,8 +222,8 @@ TEST(FlowMultigrid, PrefetchTrialTakesTurnsThenKeepsTheFasterWay) {
   // Thue-Morse order (as many pre- as post-smoothing calls each way), and the
   // way with the shorter best call is kept until the fields change size.
   const double bytes = 40e6;
-  const std::vector<bool> turns{false, true, true, false, true, false, false, true,
-                                true, false, false, true, false, true, true, false};
+  const std::vector<bool> turns{false, true,  true,  false, true,  false, false, true,
+                                true,  false, false, true,  false, true,  true,  false};
   ASSERT_EQ(static_cast<int>(turns.size()), PrefetchTrial::kTrialCalls);
   for (const bool prefetch_faster : {true, false}) {
     SCOPED_TRACE(prefetch_faster ? "prefetching faster" : "prefetching slower");
