@@ -25,7 +25,7 @@ docs/validation/figures/crosses_tangential_packings.png.
 `--element-contacts mean` pours and runs everything with the element contacts of two
 crosses averaged, as Grains3D does for composite particles (simulation.element_contacts),
 in runs/crosses_tangential_packings_mean, and writes crosses_tangential_packings_mean.json
-and .png (not yet in the report: the full grid has not been run with it).
+and .png (the wrapper crosses_tangential_packings_mean.py runs it so for the report).
 `--table31-only` runs the pours and the Table 3.1 point only and prints the regions;
 with `--element-contacts mean`, `--open-with-sum` opens the same pours with the sum (the
 rule's effect on the same packings; docs/theory/dem.md), `--open-with-point` with one
@@ -305,8 +305,7 @@ def main(argv=None):
             "crosses_tangential_map around Table 3.1 (kt 1e2, 3e2, 1e3 N/m; γt 3e2, 1e3, "
             "3e3 1/s; both interactions); regions as in crosses_tangential_map (3 stable: "
             "the highest particle lost less than 5 % of H0)."),
-        "command": "/usr/bin/python3 validation/dem/crosses_tangential_packings.py --build BUILD"
-                   + (" --element-contacts mean" if mean else ""),
+        "command": f"/usr/bin/python3 validation/dem/{name}.py --build BUILD",
         "figures": [f"docs/validation/figures/{name}.png"],
         "checks": checks,
         "tables": [{"caption": "Per run (packing at the opening: H0 and touching neighbours "
