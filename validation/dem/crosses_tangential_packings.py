@@ -48,7 +48,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from _outputs import (continuation_command, element_contacts_setting,  # noqa: E402
-                      pour_command, read_summary, run_two_at_a_time, span,
+                      paused_minutes, pour_command, read_summary, run_two_at_a_time, span,
                       two_at_a_time_span, wall_time, write_summary)
 from crosses_tangential_map import (CASE, GATE_TIME, LOCAL_GAMMA, LOCAL_KT, RESULTS,  # noqa: E402
                                     ROOT, TABLE_31, classify, settings, sphere_reference)
@@ -294,6 +294,12 @@ def main(argv=None):
     ok = all(c["pass"] for c in checks if c["pass"] is not None)
     notes = mean_notes(results, packing, table31) if mean else sum_notes(
         results, packing, table31, max_collapse_base, base_reference)
+    paused = paused_minutes(runs)
+    if paused:
+        notes.append(f"The wall times include {paused:.1f} min in which the runs were stopped "
+                     "(SIGSTOP) while other work used the cores (listed in "
+                     f"results/runs/{name}/PAUSES.txt); the run time leaves them out.")
+        elapsed -= 60.0 * paused
     summary = {
         "name": name,
         "title": "Cross column: the 3 x 3 around Table 3.1 on six packings"
