@@ -1480,8 +1480,7 @@ void Multigrid::smooth(int level, BlockField& x, const BlockField& rhs, const Sc
   // runs forwards, the second backwards), or on the thread beside at the end
   // of a share: its rows are prefetched meanwhile, when the fields do not fit
   // in the cache (blocks 0: no prefetching).
-  const bool timed = prefetch_rule(prefetch_, field_bytes(x, rhs)) == PrefetchRule::Timed;
-  const bool prefetch = prefetching(level, x, rhs, true);
+  const auto [prefetch, timed] = prefetching(level, x, rhs, true);
   const int blocks = prefetch ? x.blocks() : 0;
   const auto start = std::chrono::steady_clock::now();
   for (int sweep = 0; sweep < sweeps; ++sweep) {
@@ -1537,20 +1536,21 @@ void PrefetchTrial::record(bool prefetching, double seconds) {
   if (++calls_ == kTrialCalls) decided_ = best_[1] < best_[0];
 }
 
-bool Multigrid::prefetching(int level, const BlockField& x, const BlockField& rhs, bool trial) {
+Multigrid::PrefetchChoice Multigrid::prefetching(int level, const BlockField& x,
+                                                 const BlockField& rhs, bool trial) {
   const double bytes = field_bytes(x, rhs);
   switch (prefetch_rule(prefetch_, bytes)) {
     case PrefetchRule::No:
-      return false;
+      return {false, false};
     case PrefetchRule::Yes:
-      return true;
+      return {true, false};
     case PrefetchRule::Timed:
       break;
   }
   if (prefetch_trials_.size() <= D(level)) prefetch_trials_.resize(D(level) + 1);
   PrefetchTrial& timed = prefetch_trials_[D(level)];
   // The residual does not take turns: it prefetches once the trial says so.
-  return trial ? timed.next_choice(bytes) : timed.decision().value_or(false);
+  return {trial ? timed.next_choice(bytes) : timed.decision().value_or(false), true};
 }
 
 void Multigrid::compute_residual(int level, BlockField& x, const BlockField& rhs,
@@ -1562,7 +1562,7 @@ void Multigrid::compute_residual(int level, BlockField& x, const BlockField& rhs
   const std::array<std::ptrdiff_t, 3> s{L.stride(0), L.stride(1), L.stride(2)};
   fill_ghosts_between_blocks_apart(level, x);  // the rest block by block, as in smooth()
   block_squares_.resize(static_cast<std::size_t>(forest_.local_blocks()));
-  const int blocks = prefetching(level, x, rhs, false) ? x.blocks() : 0;  // as in smooth()
+  const int blocks = prefetching(level, x, rhs, false).on ? x.blocks() : 0;  // as in smooth()
   forest_.for_each_block([&](int blk) {
     const auto at = static_cast<std::size_t>(blk);
     // Same-level neighbours of this process are read in place, unless the

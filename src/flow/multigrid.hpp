@@ -408,8 +408,13 @@ class Multigrid {
   std::vector<PrefetchTrial> prefetch_trials_;  ///< per level, where OutOfCache times it
   std::string finest_prefetch_;                 ///< what finest_prefetch() returns
   /// Whether a smoother call (`trial`: one that may time the choice) or a
-  /// residual on `level` prefetches the next block.
-  bool prefetching(int level, const BlockField& x, const BlockField& rhs, bool trial);
+  /// residual on `level` prefetches the next block (`on`), and whether the
+  /// level's PrefetchTrial decides it (`timed`).
+  struct PrefetchChoice {
+    bool on = false;
+    bool timed = false;
+  };
+  PrefetchChoice prefetching(int level, const BlockField& x, const BlockField& rhs, bool trial);
 };
 
 }  // namespace sanguis::flow

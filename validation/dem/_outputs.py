@@ -330,6 +330,14 @@ def paused_minutes(runs_dir):
     return sum(float(m) for m in re.findall(r"(?:\(|about )([0-9]+(?:\.[0-9]+)?) min", text))
 
 
+def paused_note(minutes, name):
+    """The report's note on the stops of the case `name` (its runs' PAUSES.txt) that its
+    run time leaves out."""
+    return (f"The wall times include {minutes:.1f} min in which the runs were stopped "
+            "(SIGSTOP) while other work used the cores (listed in "
+            f"results/runs/{name}/PAUSES.txt); the run time leaves them out.")
+
+
 def write_summary(summary, results_dir, elapsed, quick, ok):
     """Completes a case's summary (run time, date, quick, pass) and writes it as
     RESULTS/<name>.json, the file run_all.py reads for the report."""

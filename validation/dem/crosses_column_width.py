@@ -72,9 +72,9 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from _outputs import (TWIST_MOMENT_EFFECT, TWIST_MOMENT_FROM,  # noqa: E402
-                      element_contacts_setting, paused_minutes, pool_span, read_arrays,
-                      read_pvd, segment_starts, read_summary, regime_name, speed_landmarks,
-                      wall_time, write_summary)
+                      element_contacts_setting, paused_minutes, paused_note, pool_span,
+                      read_arrays, read_pvd, segment_starts, read_summary, regime_name,
+                      speed_landmarks, wall_time, write_summary)
 from crosses_calibrated_gates import (GAMMA_T, KT, collapse, finished,  # noqa: E402
                                       seed_settings)
 from crosses_dam_break import (RESULTS, ROOT, Column, diagnostics, draw_velocity_bands,  # noqa: E402
@@ -486,9 +486,7 @@ def main(argv=None):
                      "is given with the stops in it.")
         paused = None
     elif paused:
-        notes.append(f"The wall times include {paused:.1f} min in which the runs were "
-                     "stopped (SIGSTOP) while other work used the cores (listed in "
-                     f"{runs_text}); the run time leaves them out.")
+        notes.append(paused_note(paused, variant.name))
     draw(results, table31, args.sizes, args.seeds)
     # Two runs at a time on one thread each share the two cores; runs on two threads each
     # take them both, so their times add up.

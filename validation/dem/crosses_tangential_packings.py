@@ -48,8 +48,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from _outputs import (continuation_command, element_contacts_setting,  # noqa: E402
-                      paused_minutes, pour_command, read_summary, run_two_at_a_time, span,
-                      two_at_a_time_span, wall_time, write_summary)
+                      paused_minutes, paused_note, pour_command, read_summary,
+                      run_two_at_a_time, span, two_at_a_time_span, wall_time, write_summary)
 from crosses_tangential_map import (CASE, GATE_TIME, LOCAL_GAMMA, LOCAL_KT, RESULTS,  # noqa: E402
                                     ROOT, TABLE_31, classify, settings, sphere_reference)
 
@@ -296,9 +296,7 @@ def main(argv=None):
         results, packing, table31, max_collapse_base, base_reference)
     paused = paused_minutes(runs)
     if paused:
-        notes.append(f"The wall times include {paused:.1f} min in which the runs were stopped "
-                     "(SIGSTOP) while other work used the cores (listed in "
-                     f"results/runs/{name}/PAUSES.txt); the run time leaves them out.")
+        notes.append(paused_note(paused, name))
         elapsed -= 60.0 * paused
     summary = {
         "name": name,
