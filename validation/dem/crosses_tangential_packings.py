@@ -29,9 +29,13 @@ and .png (the wrapper crosses_tangential_packings_mean.py runs it so for the rep
 `--table31-only` runs the pours and the Table 3.1 point only and prints the regions;
 with `--element-contacts mean`, `--open-with-sum` opens the same pours with the sum (the
 rule's effect on the same packings; docs/theory/dem.md), `--open-with-point` with one
-contact point per element pair and the mean (Grains3D's model).
+contact point per element pair and the mean (Grains3D's model). `--element-contacts mean
+--flat-contacts point` pours and runs everything with that model, in
+runs/crosses_tangential_packings_mean_point (the wrapper crosses_tangential_packings_mean_point.py
+for the report).
 Usage: /usr/bin/python3 validation/dem/crosses_tangential_packings.py [--build build]
-       [--rerun-pours] [--rerun] [--element-contacts sum|mean] [--table31-only
+       [--rerun-pours] [--rerun] [--element-contacts sum|mean [--flat-contacts point]]
+       [--table31-only
        [--open-with-sum | --open-with-point]]
 """
 import argparse
@@ -82,7 +86,7 @@ def collapse_counts(results, seeds, points):
     return {p: sum(collapses(results[(s, *p)]) for s in seeds) for p in points}
 
 
-def draw(results, counts, seeds, figure=FIGURE, rule="sum"):
+def draw(results, counts, seeds, figure=FIGURE, model=""):
     """Left: on how many pours each point collapses; right: each pour's height loss."""
     fig, (ax, bx) = plt.subplots(1, 2, figsize=(10.0, 4.0),
                                  gridspec_kw={"width_ratios": [1, 1.6]})
@@ -114,8 +118,7 @@ def draw(results, counts, seeds, figure=FIGURE, rule="sum"):
     bx.set_ylabel("height lost / $H_0$ within 0.5 s [%]")
     bx.legend(fontsize=7, ncol=3, loc="upper right")
     fig.suptitle("300 crosses, six pours (thesis: Table 3.1 is top-driven, region 2)"
-                 + ("; element contacts: the mean (Grains3D)" if rule == "mean" else ""),
-                 fontsize=10)
+                 + (f"; {model}" if model else ""), fontsize=10)
     fig.tight_layout()
     fig.savefig(figure, dpi=130)
 
@@ -157,19 +160,33 @@ def sum_notes(results, packing, table31, max_collapse_base, base_reference):
             f"{base_reference:.1f} mm."]
 
 
-def mean_notes(results, packing, table31):
-    """The report's notes for the element contacts averaged as in Grains3D."""
+def model_label(mean, point):
+    """How the variant's element contacts differ from the default (sum, contact patches),
+    for the figure's title; empty for the default."""
+    parts = (["element contacts: the mean"] if mean else []) + (
+        ["one contact point per element pair"] if point else [])
+    return " and ".join(parts) + (" (Grains3D)" if mean and point else "")
+
+
+def mean_notes(results, packing, table31, point=False):
+    """The report's notes for the element contacts averaged as in Grains3D (with `point`,
+    and one contact point per element pair, as Grains3D too)."""
     loss = [100 * results[(s, *TABLE_31)]["height_loss"] for s in SEEDS]
     soft = [100 * results[(s, 1e2, 3e2)]["height_loss"] for s in SEEDS]
+    flat = ("; and simulation.flat_contacts = \"point\": one contact point per pair of "
+            "touching elements (GJK's closest points), where the model's default "
+            "spreads a contact between flat faces over a patch (docs/theory/dem.md, \"Flat "
+            "contacts\"). Grains3D uses one point, so this variant is the thesis' code's "
+            "contact model, poured and opened with it" if point else "")
     return [
-        "The same six pours and 3 x 3 as crosses_tangential_packings, with simulation."
+        "The same six seeds and 3 x 3 as crosses_tangential_packings, with simulation."
         "element_contacts = \"mean\" in the pours and the continuations: the force and torque "
         "of each element contact between two crosses (up to four pairs of arms), or between "
         "a cross and one wall, divided by the number of element contacts the two have at that "
         "step, as Grains3D's composite particles do (CompositeParticle::InterAction passes "
         "that number to the contact model, which multiplies each contact's force by its "
-        "inverse). The thesis ran its crosses on Grains3D; with the sum (the model's default) "
-        "this check fails (crosses_tangential_packings).",
+        f"inverse){flat}. The thesis ran its crosses on Grains3D; with the sum and the "
+        "patches (the model's defaults) this check fails (crosses_tangential_packings).",
         f"The pours stand at H0 {span([100 * packing[s]['H0_m'] for s in SEEDS], '.1f')} cm "
         f"with {span([packing[s]['pair_coordination'] for s in SEEDS], '.2f')} touching "
         f"neighbours per cross. The Table 3.1 point loses {span(loss, '.1f')} % of H0 and "
@@ -188,6 +205,11 @@ def main(argv=None):
                     help="how the element contacts of two crosses add up (simulation."
                          "element_contacts): mean, as Grains3D, runs in its own folders and "
                          "summary (crosses_tangential_packings_mean)")
+    ap.add_argument("--flat-contacts", choices=["patch", "point"], default="patch",
+                    help="with --element-contacts mean, point: one contact point per element "
+                         "pair (simulation.flat_contacts) in the pours and the continuations "
+                         "too, Grains3D's model, in its own folders and summary "
+                         "(crosses_tangential_packings_mean_point)")
     ap.add_argument("--table31-only", action="store_true",
                     help="pour and run the Table 3.1 point only, print its regions, no report")
     ap.add_argument("--open-with-sum", action="store_true",
@@ -199,12 +221,18 @@ def main(argv=None):
                          "with one contact point per element pair and the mean, the model of "
                          "the thesis' Grains3D (folders *_opened_point)")
     args = ap.parse_args(argv)
+    mean, point = args.element_contacts == "mean", args.flat_contacts == "point"
+    if point and not mean:
+        ap.error("--flat-contacts point runs with --element-contacts mean (Grains3D's model)")
+    if point and (args.open_with_sum or args.open_with_point):
+        ap.error("--open-with-sum and --open-with-point open pours made with the patches: "
+                 "leave out --flat-contacts point")
     exe = os.path.join(ROOT, args.build, "app", "sanguis")
-    mean = args.element_contacts == "mean"
-    name = "crosses_tangential_packings" + ("_mean" if mean else "")
+    name = "crosses_tangential_packings" + ("_mean" if mean else "") + ("_point" if point else "")
     runs = os.path.join(RESULTS, "runs", name)
     figure = os.path.join(ROOT, "docs", "validation", "figures", name + ".png")
-    rule = element_contacts_setting("mean") if mean else []
+    rule = (element_contacts_setting("mean") if mean else []) + (
+        ["--set", 'simulation.flat_contacts="point"'] if point else [])
     t0 = time.time()
     pours = {seed: os.path.join(runs, f"pour_seed_{seed}") for seed in SEEDS}
     reused = []  # wall times of runs kept from an earlier call: they count in the run time
@@ -260,7 +288,7 @@ def main(argv=None):
 
     counts = collapse_counts(results, SEEDS, POINTS)
     os.makedirs(os.path.dirname(figure), exist_ok=True)
-    draw(results, counts, SEEDS, figure, args.element_contacts)
+    draw(results, counts, SEEDS, figure, model_label(mean, point))
 
     max_collapse_base = max((r["bottom_move_mm"] for r in results.values() if r["region"] != 3),
                             default=0.0)
@@ -292,7 +320,7 @@ def main(argv=None):
                          f"{r['bottom_move_mm']:.2f}", f"{r['height_loss']:.3f}",
                          f"{r['runout_ratio']:.2f}"])
     ok = all(c["pass"] for c in checks if c["pass"] is not None)
-    notes = mean_notes(results, packing, table31) if mean else sum_notes(
+    notes = mean_notes(results, packing, table31, point) if mean else sum_notes(
         results, packing, table31, max_collapse_base, base_reference)
     paused = paused_minutes(runs)
     if paused:
@@ -301,7 +329,8 @@ def main(argv=None):
     summary = {
         "name": name,
         "title": "Cross column: the 3 x 3 around Table 3.1 on six packings"
-                 + (", element contacts averaged as in Grains3D" if mean else ""),
+                 + (", element contacts averaged as in Grains3D" if mean else "")
+                 + (", one contact point per element pair" if point else ""),
         "thesis": "§3.4.3, Fig. 3.17",
         "description": (
             f"The 300-cross column of the memory case poured with seeds {seeds_text} and "

@@ -1,11 +1,14 @@
 """Unit tests of crosses_tangential_packings' summaries of the 3 x 3 on several pours (run
 by ctest ValidationScripts.DemHelpers)."""
+import contextlib
+import io
 import os
 import sys
 import unittest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from crosses_tangential_packings import collapse_counts, stands_above_edge  # noqa: E402
+from crosses_tangential_packings import (collapse_counts, main, model_label,  # noqa: E402
+                                         stands_above_edge)
 
 KT = [1e2, 3e2, 1e3]
 GAMMA = [3e2, 1e3, 3e3]
@@ -45,6 +48,26 @@ class CollapseCounts(unittest.TestCase):
                    (2, 1e3, 3e3): {"region": 3}, (3, 1e3, 3e3): {"region": 3}}
         self.assertEqual(collapse_counts(results, [1, 2, 3], [(3e2, 1e3), (1e3, 3e3)]),
                          {(3e2, 1e3): 2, (1e3, 3e3): 0})
+
+
+class Variants(unittest.TestCase):
+    def test_the_figure_names_what_differs_from_the_default_model(self):
+        self.assertEqual(model_label(False, False), "")
+        self.assertEqual(model_label(True, False), "element contacts: the mean")
+        self.assertEqual(model_label(True, True), "element contacts: the mean and one contact "
+                                                  "point per element pair (Grains3D)")
+
+    def test_one_point_per_element_pair_runs_with_the_mean_only(self):
+        # Refused before anything runs: Grains3D's model is the point and the mean together,
+        # and the --open-with options reopen pours made with the patches.
+        for argv in (["--flat-contacts", "point"],
+                     ["--element-contacts", "mean", "--flat-contacts", "point",
+                      "--table31-only", "--open-with-sum"]):
+            with contextlib.redirect_stderr(io.StringIO()) as err:
+                with self.assertRaises(SystemExit) as stop:
+                    main(argv + ["--build", "no-such-build"])
+            self.assertEqual(stop.exception.code, 2)
+            self.assertIn("--flat-contacts point", err.getvalue())
 
 
 if __name__ == "__main__":
