@@ -118,7 +118,7 @@ def draw(results, counts, seeds, figure=FIGURE, model=""):
     bx.set_ylabel("height lost / $H_0$ within 0.5 s [%]")
     bx.legend(fontsize=7, ncol=3, loc="upper right")
     fig.suptitle("300 crosses, six pours (thesis: Table 3.1 is top-driven, region 2)"
-                 + (f"; {model}" if model else ""), fontsize=10)
+                 + (f"\n{model}" if model else ""), fontsize=10)
     fig.tight_layout()
     fig.savefig(figure, dpi=130)
 
