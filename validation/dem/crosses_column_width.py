@@ -54,10 +54,13 @@ the contrast between the sizes is then taken over the packings there are).
 `--element-contacts mean` pours and collapses with the element contacts of two crosses
 averaged, as Grains3D does (simulation.element_contacts), and Table 3.1 throughout (no
 calibration, no second collapse), with the same checks, in its own folders and report
-(crosses_column_width_mean.py runs it).
+(crosses_column_width_mean.py runs it); `--element-contacts mean --flat-contacts point`
+with one contact point per element pair as well, Grains3D's whole model
+(crosses_column_width_mean_point.py).
 Usage: /usr/bin/python3 validation/dem/crosses_column_width.py [--build build]
            [--sizes small large] [--seeds 1 2 3] [--reuse [--finished-only]]
-           [--without-table31] [--quick] [--threads T] [--element-contacts sum|mean]
+           [--without-table31] [--quick] [--threads T]
+           [--element-contacts sum|mean [--flat-contacts point]]
 """
 import argparse
 import math
@@ -104,6 +107,9 @@ class Variant(NamedTuple):
 # runs out as the thesis' crosses with no calibration). main() chooses one.
 SUM = Variant("crosses_column_width", [], (KT, GAMMA_T))
 MEAN = Variant("crosses_column_width_mean", element_contacts_setting("mean"), None)
+# Grains3D's whole model: the mean and one contact point per pair of touching elements.
+MEAN_POINT = Variant("crosses_column_width_mean_point", element_contacts_setting("mean")
+                     + ["--set", 'simulation.flat_contacts="point"'], None)
 variant = SUM
 SPHERES = os.path.join(RESULTS, "runs", "dam_break_scaling", "L0_4.1cm")  # Fig. 3.9 spheres
 
@@ -415,8 +421,15 @@ def main(argv=None):
                     help="mean: pour and collapse with the element contacts of two crosses "
                          "averaged, as Grains3D, and Table 3.1 (no calibration), in their own "
                          "folders and report (crosses_column_width_mean)")
+    ap.add_argument("--flat-contacts", choices=["patch", "point"], default="patch",
+                    help="with --element-contacts mean, point: one contact point per element "
+                         "pair (simulation.flat_contacts) too, Grains3D's model, in its own "
+                         "folders and report (crosses_column_width_mean_point)")
     args = ap.parse_args(argv)
-    variant = MEAN if args.element_contacts == "mean" else SUM
+    point = args.flat_contacts == "point"
+    if point and args.element_contacts != "mean":
+        ap.error("--flat-contacts point runs with --element-contacts mean (Grains3D's model)")
+    variant = (MEAN_POINT if point else MEAN) if args.element_contacts == "mean" else SUM
     if args.finished_only and not args.reuse:
         ap.error("--finished-only reports runs on disk: give --reuse as well")
     if args.quick:
@@ -447,7 +460,11 @@ def main(argv=None):
                      "composite particles (simulation.element_contacts = \"mean\"), in the "
                      "pours and the collapses, with the thesis' Table 3.1 throughout (no "
                      "calibration): crosses_column_width sums them and collapses with the "
-                     "calibration of crosses_recalibrated.")
+                     "calibration of crosses_recalibrated."
+                     + (" And one contact point per pair of touching elements (simulation."
+                        "flat_contacts = \"point\", GJK's closest points) where the model's "
+                        "default spreads a contact between flat faces over a patch: Grains3D's "
+                        "whole contact model, poured and collapsed with it." if point else ""))
     for (size, seed), r in results.items():
         label = f"{SIZES[size].count} crosses, seed {seed}"
         checks += SIZES[size].checks(label, r["peak"], r["peak_t"], r["below"])
@@ -471,7 +488,8 @@ def main(argv=None):
     if args.threads != 1:
         notes.append(f"Runs on {args.threads} threads (`--threads {args.threads}`; the results "
                      "do not depend on the thread count), so the run time adds their times.")
-    notes.append(twist_model_note(keys, with_table31))
+    if not point:  # the torsional spring belongs to the contact patches
+        notes.append(twist_model_note(keys, with_table31))
     notes.append("The thesis' sphere curves of Fig. 3.9a are checked by dam_break_scaling "
                  "(its column of a = 3.2); they are drawn here in grey when its runs are on "
                  "disk.")
@@ -502,7 +520,8 @@ def main(argv=None):
     summary = {
         "name": variant.name,
         "title": "Narrow and wide columns of crosses at a = 3.2"
-                 + ("" if variant.tangential else ", element contacts averaged as in Grains3D"),
+                 + ("" if variant.tangential else ", element contacts averaged as in Grains3D")
+                 + (", one contact point per element pair" if point else ""),
         "thesis": "§3.3.2, Fig. 3.9",
         "description": (
             "The box of crosses_dam_break 15 cm deep; columns of a = 3.2 of 1000 crosses "

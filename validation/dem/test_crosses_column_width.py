@@ -1,5 +1,7 @@
 """Unit tests of crosses_column_width's columns and checks (run by ctest
 ValidationScripts.DemHelpers)."""
+import contextlib
+import io
 import math
 import os
 import sys
@@ -91,6 +93,26 @@ class Checks(unittest.TestCase):
         self.assertIn('simulation.element_contacts="mean"', cw.MEAN.rule)
         self.assertEqual(os.path.basename(cw.folders("small", 2)[1]),
                          f"small_seed2_kt{cw.KT:g}_gamma{cw.GAMMA_T:g}")
+
+    def test_grains3d_model_runs_in_its_own_folders_and_needs_the_mean(self):
+        saved = cw.variant
+        try:
+            cw.variant = cw.MEAN_POINT
+            pour, checked, _ = cw.folders("small", 1)
+        finally:
+            cw.variant = saved
+        self.assertEqual(os.path.basename(os.path.dirname(pour)),
+                         "crosses_column_width_mean_point")
+        self.assertEqual(os.path.basename(checked), "small_seed1_table31")
+        self.assertIsNone(cw.MEAN_POINT.tangential)
+        self.assertIn('simulation.element_contacts="mean"', cw.MEAN_POINT.rule)
+        self.assertIn('simulation.flat_contacts="point"', cw.MEAN_POINT.rule)
+        with contextlib.redirect_stderr(io.StringIO()) as err:
+            with self.assertRaises(SystemExit) as stop:
+                cw.main(["--flat-contacts", "point", "--build", "no-such-build"])
+        self.assertEqual(stop.exception.code, 2)
+        self.assertIn("--element-contacts mean", err.getvalue())
+        self.assertIs(cw.variant, saved)  # refused before it chose a variant
 
     def test_a_failed_job_cancels_the_jobs_not_yet_started(self):
         started = []
