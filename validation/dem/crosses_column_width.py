@@ -372,7 +372,9 @@ def draw(results, table31, sizes, seeds):
     draw_velocity_bands(ax)
     ax.set_xlim(0, 16)
     ax.set_title(f"a = {ASPECT}, " + (f"kt {KT:g} N/m, γt {GAMMA_T:g} 1/s" if variant.tangential
-                                      else "Table 3.1, element contacts averaged"), fontsize=9)
+                                      else "Table 3.1, element contacts averaged"
+                                      + (", one point per element pair (Grains3D)"
+                                         if variant is MEAN_POINT else "")), fontsize=9)
     for k, size in enumerate(sizes):
         shown = [seed for seed in seeds if (size, seed) in results]
         if shown:
