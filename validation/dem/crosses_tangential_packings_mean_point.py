@@ -10,8 +10,8 @@ and the same reported counts, in its own folders
 (validation/dem/results/runs/crosses_tangential_packings_mean_point). Runs are resumable.
 
 Writes validation/dem/results/crosses_tangential_packings_mean_point.json and
-docs/validation/figures/crosses_tangential_packings_mean_point.png. About 100 min on 2
-cores (the pours about 12 min each on one thread).
+docs/validation/figures/crosses_tangential_packings_mean_point.png. About 90 min on 2
+cores (the pours about 14 min each on one thread, two at a time).
 Usage: /usr/bin/python3 validation/dem/crosses_tangential_packings_mean_point.py
            [--build build] [--rerun-pours] [--rerun] [--table31-only]
 """

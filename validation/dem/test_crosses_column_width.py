@@ -11,6 +11,17 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import crosses_column_width as cw  # noqa: E402
 
 
+def folders_of(variant, size, seed):
+    """cw.folders() with `variant` chosen, as main() chooses it; the module's variant is
+    restored after."""
+    saved = cw.variant
+    try:
+        cw.variant = variant
+        return cw.folders(size, seed)
+    finally:
+        cw.variant = saved
+
+
 class Columns(unittest.TestCase):
     def test_the_small_column_is_under_two_cross_lengths_the_large_over_three(self):
         small, large = cw.SIZES["small"].column(), cw.SIZES["large"].column()
@@ -80,12 +91,7 @@ class Checks(unittest.TestCase):
         self.assertEqual(everything, ([("small", 1), ("large", 1)], [("small", 1)], None))
 
     def test_the_mean_checks_its_table31_collapses_in_its_own_folders(self):
-        saved = cw.variant
-        try:
-            cw.variant = cw.MEAN
-            pour, checked, table31 = cw.folders("small", 2)
-        finally:
-            cw.variant = saved
+        pour, checked, table31 = folders_of(cw.MEAN, "small", 2)
         self.assertEqual(os.path.basename(os.path.dirname(pour)), "crosses_column_width_mean")
         self.assertEqual(os.path.basename(checked), "small_seed2_table31")
         self.assertEqual(checked, table31)
@@ -96,11 +102,7 @@ class Checks(unittest.TestCase):
 
     def test_grains3d_model_runs_in_its_own_folders_and_needs_the_mean(self):
         saved = cw.variant
-        try:
-            cw.variant = cw.MEAN_POINT
-            pour, checked, _ = cw.folders("small", 1)
-        finally:
-            cw.variant = saved
+        pour, checked, _ = folders_of(cw.MEAN_POINT, "small", 1)
         self.assertEqual(os.path.basename(os.path.dirname(pour)),
                          "crosses_column_width_mean_point")
         self.assertEqual(os.path.basename(checked), "small_seed1_table31")
