@@ -86,6 +86,20 @@ def element_contacts_setting(rule):
     return ["--set", f'simulation.element_contacts="{rule}"']
 
 
+def flat_contacts_setting(kind):
+    """The `sanguis run` override of simulation.flat_contacts ("patch" or "point": how flat
+    faces of two bodies touch)."""
+    return ["--set", f'simulation.flat_contacts="{kind}"']
+
+
+# What one contact point per element pair is, for the notes of the cases that run
+# Grains3D's whole model (the mean and one point).
+ONE_POINT_PER_PAIR = ("one contact point per pair of touching elements (simulation.flat_contacts "
+                      "= \"point\", GJK's closest points), where the model's default spreads "
+                      "a contact between flat faces over a patch (docs/theory/dem.md, \"Flat "
+                      "contacts\")")
+
+
 def read_summary(run_dir):
     """The one row of RUN/analysis/summary.csv (written by `sanguis analyze`) as floats."""
     with open(os.path.join(run_dir, "analysis", "summary.csv"), newline="") as f:

@@ -74,10 +74,11 @@ import matplotlib
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import (TWIST_MOMENT_EFFECT, TWIST_MOMENT_FROM,  # noqa: E402
-                      element_contacts_setting, paused_minutes, paused_note, pool_span,
-                      read_arrays, read_pvd, segment_starts, read_summary, regime_name,
-                      speed_landmarks, wall_time, write_summary)
+from _outputs import (ONE_POINT_PER_PAIR, TWIST_MOMENT_EFFECT,  # noqa: E402
+                      TWIST_MOMENT_FROM, element_contacts_setting, flat_contacts_setting,
+                      paused_minutes, paused_note, pool_span, read_arrays, read_pvd,
+                      segment_starts, read_summary, regime_name, speed_landmarks, wall_time,
+                      write_summary)
 from crosses_calibrated_gates import (GAMMA_T, KT, collapse, finished,  # noqa: E402
                                       seed_settings)
 from crosses_dam_break import (RESULTS, ROOT, Column, diagnostics, draw_velocity_bands,  # noqa: E402
@@ -109,7 +110,7 @@ SUM = Variant("crosses_column_width", [], (KT, GAMMA_T))
 MEAN = Variant("crosses_column_width_mean", element_contacts_setting("mean"), None)
 # Grains3D's whole model: the mean and one contact point per pair of touching elements.
 MEAN_POINT = Variant("crosses_column_width_mean_point", element_contacts_setting("mean")
-                     + ["--set", 'simulation.flat_contacts="point"'], None)
+                     + flat_contacts_setting("point"), None)
 variant = SUM
 SPHERES = os.path.join(RESULTS, "runs", "dam_break_scaling", "L0_4.1cm")  # Fig. 3.9 spheres
 
@@ -463,10 +464,8 @@ def main(argv=None):
                      "pours and the collapses, with the thesis' Table 3.1 throughout (no "
                      "calibration): crosses_column_width sums them and collapses with the "
                      "calibration of crosses_recalibrated."
-                     + (" And one contact point per pair of touching elements (simulation."
-                        "flat_contacts = \"point\", GJK's closest points) where the model's "
-                        "default spreads a contact between flat faces over a patch: Grains3D's "
-                        "whole contact model, poured and collapsed with it." if point else ""))
+                     + (f" And {ONE_POINT_PER_PAIR}: Grains3D's whole contact model, poured "
+                        "and collapsed with it." if point else ""))
     for (size, seed), r in results.items():
         label = f"{SIZES[size].count} crosses, seed {seed}"
         checks += SIZES[size].checks(label, r["peak"], r["peak_t"], r["below"])

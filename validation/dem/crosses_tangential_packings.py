@@ -51,9 +51,10 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import (continuation_command, element_contacts_setting,  # noqa: E402
-                      paused_minutes, paused_note, pour_command, read_summary,
-                      run_two_at_a_time, span, two_at_a_time_span, wall_time, write_summary)
+from _outputs import (ONE_POINT_PER_PAIR, continuation_command,  # noqa: E402
+                      element_contacts_setting, flat_contacts_setting, paused_minutes,
+                      paused_note, pour_command, read_summary, run_two_at_a_time, span,
+                      two_at_a_time_span, wall_time, write_summary)
 from crosses_tangential_map import (CASE, GATE_TIME, LOCAL_GAMMA, LOCAL_KT, RESULTS,  # noqa: E402
                                     ROOT, TABLE_31, classify, settings, sphere_reference)
 
@@ -173,11 +174,8 @@ def mean_notes(results, packing, table31, point=False):
     and one contact point per element pair, as Grains3D too)."""
     loss = [100 * results[(s, *TABLE_31)]["height_loss"] for s in SEEDS]
     soft = [100 * results[(s, 1e2, 3e2)]["height_loss"] for s in SEEDS]
-    flat = ("; and simulation.flat_contacts = \"point\": one contact point per pair of "
-            "touching elements (GJK's closest points), where the model's default "
-            "spreads a contact between flat faces over a patch (docs/theory/dem.md, \"Flat "
-            "contacts\"). Grains3D uses one point, so this variant is the thesis' code's "
-            "contact model, poured and opened with it" if point else "")
+    flat = (f"; and {ONE_POINT_PER_PAIR}. Grains3D uses one point, so this variant is the "
+            "thesis' code's contact model, poured and opened with it" if point else "")
     return [
         "The same six seeds and 3 x 3 as crosses_tangential_packings, with simulation."
         "element_contacts = \"mean\" in the pours and the continuations: the force and torque "
@@ -232,7 +230,7 @@ def main(argv=None):
     runs = os.path.join(RESULTS, "runs", name)
     figure = os.path.join(ROOT, "docs", "validation", "figures", name + ".png")
     rule = (element_contacts_setting("mean") if mean else []) + (
-        ["--set", 'simulation.flat_contacts="point"'] if point else [])
+        flat_contacts_setting("point") if point else [])
     t0 = time.time()
     pours = {seed: os.path.join(runs, f"pour_seed_{seed}") for seed in SEEDS}
     reused = []  # wall times of runs kept from an earlier call: they count in the run time
@@ -256,7 +254,7 @@ def main(argv=None):
     if mean and args.table31_only and args.open_with_sum:
         suffix, opening_rule = "_opened_sum", []
     elif mean and args.table31_only and args.open_with_point:
-        suffix, opening_rule = "_opened_point", rule + ["--set", 'simulation.flat_contacts="point"']
+        suffix, opening_rule = "_opened_point", rule + flat_contacts_setting("point")
     for seed, pour in pours.items():
         for kt, g in points:
             d = run_folder(seed, kt, g, runs) + suffix
