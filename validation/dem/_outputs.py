@@ -2,6 +2,7 @@
 binary base64, UInt64 headers, Float64 / Int64 arrays) as numpy arrays, and the
 summary row of `sanguis analyze`. Not a general VTK reader."""
 import base64
+import calendar
 import csv
 import heapq
 import json
@@ -134,6 +135,17 @@ def _log_lines(run):
 
 def _segments(lines):
     """finished_segments of these lines of a run.log."""
+    return [(end, seconds) for end, seconds, _ in _stamped_segments(lines)]
+
+
+def _utc_seconds(text, fmt="%Y-%m-%d %H:%M:%S"):
+    return calendar.timegm(time.strptime(text, fmt))
+
+
+def _stamped_segments(lines):
+    """(simulated end [s], wall-clock seconds, UTC end [s since the epoch] or None) of each
+    counted segment of these run.log lines: the end's date is the `done:` line's "ended"
+    or the kept checkpoint's (lines written since 2026-12-05 carry one)."""
     units = {"h": 3600, "m": 60, "s": 1}
     kept = None  # the last checkpoint of the segment being read
     out = []
@@ -145,8 +157,10 @@ def _segments(lines):
         end = re.search(r"t = (\S+) s", line)
         if not (m and end) or not line.startswith(("done:", "checkpoint:")):
             continue
+        stamp = re.search(r"(\d{4}-\d{2}-\d{2} \d{2}:\d{2}:\d{2}) UTC", line)
         segment = (float(end.group(1)),
-                   sum(int(n) * units[u] for n, u in re.findall(r"(\d+)([hms])", m.group(1))))
+                   sum(int(n) * units[u] for n, u in re.findall(r"(\d+)([hms])", m.group(1))),
+                   _utc_seconds(stamp.group(1)) if stamp else None)
         if line.startswith("done:"):
             out.append(segment)
             kept = None
@@ -331,17 +345,56 @@ def two_at_a_time_span(durations):
     return max([now] + running)
 
 
-def paused_minutes(runs_dir):
-    """Minutes that a case's runs spent stopped (SIGSTOP, while benchmarks or
-    CI used the cores) and that their run.log wall times therefore include,
-    as listed by hand in RUNS_DIR/PAUSES.txt ("(12.5 min" or "about 17 min"
-    per pause); None without that file."""
+def stops(runs_dir):
+    """(start, end) [UTC s since the epoch] of each stop of a case's runs (SIGSTOP, while
+    benchmarks or CI used the cores) listed in RUNS_DIR/PAUSES.txt, one per line: its date
+    to the minute or the second, then its length, "2026-12-06T13:18 stopped for the CI of
+    c8ee68c (5.1 min)"; [] without that file. Lines without a length (a note that a session
+    ended) are no stops. A stop dated to the minute is taken to start on that minute, which
+    the one who stopped the runs wrote when they did: up to a minute early."""
     path = os.path.join(runs_dir, "PAUSES.txt")
     if not os.path.exists(path):
-        return None
+        return []
+    out = []
     with open(path) as f:
-        text = f.read()
-    return sum(float(m) for m in re.findall(r"(?:\(|about )([0-9]+(?:\.[0-9]+)?) min", text))
+        for number, line in enumerate(f, 1):
+            length = re.search(r"(?:\(|about )([0-9]+(?:\.[0-9]+)?) min", line)
+            if not length:
+                continue
+            date = re.match(r"(\d{4}-\d{2}-\d{2})T(\d{2}:\d{2}(?::\d{2})?)", line)
+            if not date:
+                sys.exit(f"{path}:{number}: a stop of {length.group(1)} min without a date: "
+                         "begin the line with YYYY-MM-DDTHH:MM, when the runs were stopped "
+                         "(the run time leaves out the stops that fall in its runs)")
+            clock = date.group(2) + ("" if date.group(2).count(":") == 2 else ":00")
+            start = _utc_seconds(f"{date.group(1)} {clock}")
+            out.append((start, start + 60.0 * float(length.group(1))))
+    return out
+
+
+def _merged(intervals):
+    """The union of (start, end) intervals, as disjoint intervals in order."""
+    out = []
+    for start, end in sorted(intervals):
+        if out and start <= out[-1][1]:
+            out[-1] = (out[-1][0], max(out[-1][1], end))
+        else:
+            out.append((start, end))
+    return out
+
+
+def counted_intervals(run, after=-1.0):
+    """(start, end) [UTC s since the epoch] of the segments wall_time(run, after) adds
+    (a segment without a date, written before 2026-12-05, is left out)."""
+    return [(stamp - seconds, stamp) for end, seconds, stamp in
+            _stamped_segments(_log_lines(run)) if end > after + 1e-9 and stamp is not None]
+
+
+def stopped_seconds(intervals, stop_list):
+    """Seconds of the stops inside the union of these intervals (counted_intervals of one
+    run, or of several runs together): what their wall times hold of the stops."""
+    return sum(max(0.0, min(end, stop_end) - max(start, stop_start))
+               for start, end in _merged(intervals) for stop_start, stop_end in _merged(stop_list))
 
 
 def paused_note(minutes, name):

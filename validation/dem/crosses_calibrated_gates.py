@@ -44,8 +44,8 @@ import sys
 import matplotlib
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import (continue_or_copy, paused_minutes, read_summary, regime_name, wall_time,  # noqa: E402
-                      write_summary)
+from _outputs import (continue_or_copy, counted_intervals, read_summary, regime_name,  # noqa: E402
+                      stopped_seconds, stops, wall_time, write_summary)
 from crosses_dam_break import (COLLAPSE_S, CROSSES, GATE_INDEX, RESULTS, ROOT,  # noqa: E402
                                SEED, at_rest_settings, column, diagnostics,
                                draw_velocity_bands, gate_runner, lajeunesse, pour_gate,
@@ -231,6 +231,7 @@ def main():
 
     checks, rows, notes = [], [], []
     elapsed = 0.0  # the run segments' wall times (a pour reused by a later call counts)
+    stop_list, paused = stops(RUNS), 0.0
     several = len(args.seeds) > 1
     # Each run's summary, read once: (calibrated, Table 3.1 or None) per (gate, seed).
     summaries = {key: (read_summary(out), read_summary(table31) if table31 else None)
@@ -243,7 +244,12 @@ def main():
         opening = before["time_s"]
         pour_s, collapse_s = wall_time(pour), wall_time(out, opening)
         table31_s = wall_time(table31, opening) if table31 else 0.0
-        elapsed += pour_s + collapse_s + table31_s
+        # less the stops (PAUSES.txt) that fell in the segments counted
+        stopped_s = stopped_seconds(counted_intervals(pour), stop_list) + stopped_seconds(
+            counted_intervals(out, opening) + (counted_intervals(table31, opening) if table31
+                                               else []), stop_list)
+        paused += stopped_s / 60.0
+        elapsed += pour_s + collapse_s + table31_s - stopped_s
         which = describe(gate, seed, several)
         checks.append({"quantity": f"K = (L∞−L0)/(L0 a), {which}, a = {a:.2f}, "
                                    f"kt {KT:g}, γt {GAMMA_T:g}",
@@ -371,13 +377,11 @@ def main():
                     "rows": rows}],
         "notes": notes,
     }
-    paused = paused_minutes(RUNS)
     if paused:
         notes.append(f"The wall times include {paused:.0f} min in which the runs were stopped "
                      "(SIGSTOP) while benchmarks and CI used the VM's two cores "
                      "(listed in results/runs/crosses_calibrated_gates/PAUSES.txt); the run "
                      "time of the report leaves them out.")
-        elapsed -= 60.0 * paused
     write_summary(summary, RESULTS, elapsed, args.quick, ok)
     print(f"{'PASS' if ok else 'FAIL'}: {elapsed / 3600:.2f} h")
     return 0 if ok else 1

@@ -75,10 +75,10 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from _outputs import (ONE_POINT_PER_PAIR, TWIST_MOMENT_EFFECT,  # noqa: E402
-                      TWIST_MOMENT_FROM, element_contacts_setting, flat_contacts_setting,
-                      paused_minutes, paused_note, pool_span, read_arrays, read_pvd,
-                      segment_starts, read_summary, regime_name, speed_landmarks, wall_time,
-                      write_summary)
+                      TWIST_MOMENT_FROM, counted_intervals, element_contacts_setting,
+                      flat_contacts_setting, paused_note, pool_span, read_arrays, read_pvd,
+                      segment_starts, read_summary, regime_name, speed_landmarks,
+                      stopped_seconds, stops, wall_time, write_summary)
 from crosses_calibrated_gates import (GAMMA_T, KT, collapse, finished,  # noqa: E402
                                       seed_settings)
 from crosses_dam_break import (RESULTS, ROOT, Column, diagnostics, draw_velocity_bands,  # noqa: E402
@@ -146,9 +146,12 @@ class Size:
             {"quantity": f"{label}: peak mean speed / √(g H0)", "measured": round(peak, 3),
              "thesis": span(self.peak), "tolerance": f"[{lo:.3g}, {hi:.3g}] (±20 %)",
              "pass": lo <= peak <= hi},
-            {"quantity": f"{label}: time of the peak / τc", "measured": round(peak_t, 2),
+            {"quantity": f"{label}: time of the peak / τc",
+             "measured": round(peak_t, 2) if peak >= 0.05 else
+             f"{peak_t:.2f} (the peak under 5 %)",
              "thesis": span(self.peak_time), "tolerance": f"[{t_lo:g}, {t_hi:g}]",
-             "pass": t_lo <= peak_t <= t_hi},
+             # the time of a peak under the 5 % line is when a standing column crept most
+             "pass": peak >= 0.05 and t_lo <= peak_t <= t_hi},
             {"quantity": f"{label}: speed below 5 % from t / τc",
              "measured": rest_text(peak, below, 2),
              "thesis": span(self.rest_time), "tolerance": f"[{r_lo:g}, {r_hi:g}]",
@@ -166,6 +169,23 @@ def rest_text(peak, below, digits):
     if peak < 0.05:
         return "never above 5 %"
     return f"{below:.{digits}f}" if math.isfinite(below) else "still above 5 % at the end"
+
+
+def columns_text(keys):
+    """The columns of these (size, seed) keys, in words: "1000 crosses (L0 under two cross
+    lengths), packings 1 and 2; 3000 (over three), packing 1"."""
+    parts = []
+    for size in SIZES:
+        seeds = [seed for key_size, seed in keys if key_size == size]
+        if not seeds:
+            continue
+        count = SIZES[size].count
+        lengths = "under two cross lengths" if size == "small" else "over three"
+        what = (f"{count} ({lengths})" if parts else
+                f"{count} crosses (L0 {lengths}{'' if size == 'small' else ' cross lengths'})")
+        parts.append(what + (f", packing {seeds[0]}" if len(seeds) == 1 else ", packings "
+                             + ", ".join(map(str, seeds[:-1])) + f" and {seeds[-1]}"))
+    return "; ".join(parts)
 
 
 def span(pair):
@@ -280,6 +300,7 @@ def measure(exe, size, seed, table31=False):
             "x_top": highest_point(frame["Points"], s["L0_m"]), "frame": frame,
             "x_top_at": (frame_t - opening) / tau_c, "opening": opening,
             "pour_s": wall_time(pour), "collapse_s": wall_time(out, opening),
+            "pour_stops": counted_intervals(pour), "collapse_stops": counted_intervals(out, opening),
             "stopped": stopped(out, opening),
             "mean_speed_at_opening": at_opening["mean_velocity_m_s"]}
 
@@ -494,30 +515,28 @@ def main(argv=None):
     notes.append("The thesis' sphere curves of Fig. 3.9a are checked by dam_break_scaling "
                  "(its column of a = 3.2); they are drawn here in grey when its runs are on "
                  "disk.")
-    paused = paused_minutes(variant.runs())
-    runs_text = f"results/runs/{variant.name}/PAUSES.txt"
-    if paused and left_out:
-        # The pause list covers every run of the case, without dates: it cannot be split
-        # between the runs reported and those still going.
-        notes.append(f"The wall times include stops (SIGSTOP, while other work used the "
-                     f"cores) of the runs reported here: {runs_text} lists {paused:.1f} min "
-                     "for all the case's runs, those not finished included, so the run time "
-                     "is given with the stops in it.")
-        paused = None
-    elif paused:
+    # Each run's wall time less the stops (PAUSES.txt) that fell in its counted segments.
+    stop_list = stops(variant.runs())
+    durations, paused = [], 0.0
+    for key, r in results.items():
+        spans = [r["pour_stops"], r["collapse_stops"]] + (
+            [table31[key]["collapse_stops"]] if key in table31 else [])
+        stopped_s = sum(stopped_seconds(intervals, stop_list) for intervals in spans)
+        paused += stopped_s / 60.0
+        durations.append(r["pour_s"] + r["collapse_s"] - stopped_s
+                         + (table31[key]["collapse_s"] if key in table31 else 0.0))
+    if paused:
         notes.append(paused_note(paused, variant.name))
     draw(results, table31, args.sizes, args.seeds)
     # Two runs at a time on one thread each share the two cores; runs on two threads each
     # take them both, so their times add up.
-    elapsed = pool_span([r["pour_s"] + r["collapse_s"]
-                         + (table31[key]["collapse_s"] if key in table31 else 0.0)
-                         for key, r in results.items()], workers=2 if args.threads == 1 else 1)
-    elapsed -= 60.0 * (paused or 0.0)
+    elapsed = pool_span(durations, workers=2 if args.threads == 1 else 1)
     ok = all(c["pass"] for c in checks if c["pass"] is not None)
     collapsed_with = (f"collapsed with kt {KT:g} N/m, γt {GAMMA_T:g} 1/s (the calibration of "
                       "crosses_recalibrated)" if variant.tangential else
                       "collapsed with Table 3.1 too, the element contacts of two crosses "
-                      "averaged as in Grains3D throughout")
+                      "averaged as in Grains3D" + (" and one contact point per element pair"
+                                                   if point else "") + " throughout")
     summary = {
         "name": variant.name,
         "title": "Narrow and wide columns of crosses at a = 3.2"
@@ -525,10 +544,11 @@ def main(argv=None):
                  + (", one contact point per element pair" if point else ""),
         "thesis": "§3.3.2, Fig. 3.9",
         "description": (
-            "The box of crosses_dam_break 15 cm deep; columns of a = 3.2 of 1000 crosses "
-            "(L0 under two cross lengths) and 3000 (over three), three packings each, poured "
-            f"with Table 3.1, {collapsed_with}, until at rest; the mean speed against "
-            "the thesis' Fig. 3.9a curves."),
+            "The box of crosses_dam_break 15 cm deep; columns of a = 3.2 of "
+            + columns_text(sorted(results)) + ", poured with Table 3.1"
+            + (" and the same model" if not variant.tangential else "")
+            + f", {collapsed_with}, until at rest; the mean speed against the thesis' Fig. "
+            "3.9a curves."),
         "command": f"/usr/bin/python3 validation/dem/{variant.name}.py --build BUILD"
                    + (" --quick" if args.quick else "" if args.sizes == list(SIZES)
                       else " --sizes " + " ".join(args.sizes))
@@ -536,6 +556,7 @@ def main(argv=None):
                       else " --seeds " + " ".join(map(str, args.seeds)))
                    + (" --without-table31" if args.without_table31 and variant.tangential
                       else "")
+                   + (f" --threads {args.threads}" if args.threads != 1 else "")
                    + (" --reuse --finished-only" if args.finished_only else ""),
         "figures": [f"docs/validation/figures/{variant.name}.png"],
         "checks": checks,

@@ -53,8 +53,8 @@ from typing import NamedTuple
 import matplotlib
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import (element_contacts_setting, paused_minutes, read_summary,  # noqa: E402
-                      regime_name, wall_time)
+from _outputs import (counted_intervals, element_contacts_setting, read_summary,  # noqa: E402
+                      regime_name, stopped_seconds, stops, wall_time)
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -476,10 +476,14 @@ def main(argv=None):
                         "default).")
     elif 30 not in args.gates:
         notes.append(POINT_MODEL_30CM)
-    paused = paused_minutes(run_root)
+    # Each run's stops (PAUSES.txt) that fell in its counted segments: its wall time holds them.
+    stop_list = stops(run_root)
+    stopped_s = {out: stopped_seconds(counted_intervals(out), stop_list) for out in runs.values()}
+    paused = sum(stopped_s.values()) / 60.0
     if paused:
         notes.append(f"The wall times of the table include {paused:.1f} min during which the "
-                     "runs were stopped (SIGSTOP) while other work used the cores, as listed in "
+                     "runs were stopped (SIGSTOP) while other work used the cores (each run's "
+                     "stops, added up), as listed in "
                      f"validation/dem/results/runs/{name}/PAUSES.txt; the run time "
                      "of the report leaves them out.")
     notes.append("Coordination: Table B.1 gives 8.2 for crosses and §3.3.3 gives "
@@ -514,7 +518,7 @@ def main(argv=None):
 
     # The runs' own wall time (their segments may span several calls and sessions, and a
     # folder may come from another case), less the pauses listed beside them.
-    elapsed = sum(wall_time(out) for out in runs.values()) - 60.0 * (paused or 0.0)
+    elapsed = sum(wall_time(out) - stopped_s[out] for out in runs.values())
     ok = all(c["pass"] for c in checks if c["pass"] is not None)
     others = [g for g in sorted(CROSSES) if g not in args.gates]
     summary = {

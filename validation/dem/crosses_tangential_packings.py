@@ -52,9 +52,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from _outputs import (ONE_POINT_PER_PAIR, continuation_command,  # noqa: E402
-                      element_contacts_setting, flat_contacts_setting, paused_minutes,
+                      counted_intervals, element_contacts_setting, flat_contacts_setting,
                       paused_note, pour_command, read_summary, run_two_at_a_time, span,
-                      two_at_a_time_span, wall_time, write_summary)
+                      stopped_seconds, stops, two_at_a_time_span, wall_time, write_summary)
 from crosses_tangential_map import (CASE, GATE_TIME, LOCAL_GAMMA, LOCAL_KT, RESULTS,  # noqa: E402
                                     ROOT, TABLE_31, classify, settings, sphere_reference)
 
@@ -225,6 +225,13 @@ def main(argv=None):
     if point and (args.open_with_sum or args.open_with_point):
         ap.error("--open-with-sum and --open-with-point open pours made with the patches: "
                  "leave out --flat-contacts point")
+    if args.open_with_sum and args.open_with_point:
+        ap.error("--open-with-sum and --open-with-point each open the pours one way: give one")
+    if (args.open_with_sum or args.open_with_point) and not (mean and args.table31_only):
+        # Without both, the continuations would run with the pours' own rule and overwrite
+        # that rule's runs and summary.
+        ap.error("--open-with-sum and --open-with-point open the mean's pours at Table 3.1 "
+                 "only: give --element-contacts mean --table31-only")
     exe = os.path.join(ROOT, args.build, "app", "sanguis")
     name = "crosses_tangential_packings" + ("_mean" if mean else "") + ("_point" if point else "")
     runs = os.path.join(RESULTS, "runs", name)
@@ -251,9 +258,9 @@ def main(argv=None):
     jobs = []
     points = [TABLE_31] if args.table31_only else POINTS
     suffix, opening_rule = "", rule
-    if mean and args.table31_only and args.open_with_sum:
+    if args.open_with_sum:
         suffix, opening_rule = "_opened_sum", []
-    elif mean and args.table31_only and args.open_with_point:
+    elif args.open_with_point:
         suffix, opening_rule = "_opened_point", rule + flat_contacts_setting("point")
     for seed, pour in pours.items():
         for kt, g in points:
@@ -320,7 +327,12 @@ def main(argv=None):
     ok = all(c["pass"] for c in checks if c["pass"] is not None)
     notes = mean_notes(results, packing, table31, point) if mean else sum_notes(
         results, packing, table31, max_collapse_base, base_reference)
-    paused = paused_minutes(runs)
+    # The stops (PAUSES.txt) that fell while a run of the case was counted: the run time,
+    # the span of runs two at a time, holds each once.
+    counted = [interval for d in pours.values() for interval in counted_intervals(d)] + [
+        interval for seed in SEEDS for kt, g in points
+        for interval in counted_intervals(run_folder(seed, kt, g, runs) + suffix, GATE_TIME)]
+    paused = stopped_seconds(counted, stops(runs)) / 60.0
     if paused:
         notes.append(paused_note(paused, name))
         elapsed -= 60.0 * paused

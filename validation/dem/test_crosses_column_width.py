@@ -42,6 +42,17 @@ class Columns(unittest.TestCase):
         self.assertEqual(cw.SIZES["small"].column().pour_bottom_m, 0.28)
 
 
+class Description(unittest.TestCase):
+    def test_the_report_names_the_columns_it_reports(self):
+        self.assertEqual(cw.columns_text([("small", 1)]),
+                         "1000 crosses (L0 under two cross lengths), packing 1")
+        self.assertEqual(cw.columns_text([("large", 1), ("small", 1), ("small", 2), ("small", 3)]),
+                         "1000 crosses (L0 under two cross lengths), packings 1, 2 and 3; "
+                         "3000 (over three), packing 1")
+        self.assertEqual(cw.columns_text([("large", 2)]),
+                         "3000 crosses (L0 over three cross lengths), packing 2")
+
+
 class Checks(unittest.TestCase):
     def test_tolerances_widen_the_thesis_ranges_as_for_the_spheres(self):
         small = cw.SIZES["small"]
@@ -56,6 +67,13 @@ class Checks(unittest.TestCase):
         self.assertEqual(standing["measured"], "never above 5 %")
         self.assertFalse(standing["pass"])  # its peak's time is no end of a collapse
         self.assertEqual(checks[1]["tolerance"], "[2, 3]")
+
+    def test_a_column_that_never_moved_has_no_time_of_the_peak_to_pass(self):
+        # A standing column's speed creeps to its largest value in the thesis' window (the
+        # Grains3D model's narrow column of 2026-12-06: 0.029 at 3.9 tau_c): no collapse.
+        peak, time_of_peak, rest = cw.SIZES["small"].checks("x", 0.029, 3.9, math.inf)
+        self.assertEqual(time_of_peak["measured"], "3.90 (the peak under 5 %)")
+        self.assertEqual([c["pass"] for c in (peak, time_of_peak, rest)], [False] * 3)
 
     def test_contrast_checks_compare_the_means(self):
         results = {("small", 1): {"peak": 0.3, "below": 7.0, "x_top": 0.9},

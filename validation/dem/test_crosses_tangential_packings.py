@@ -69,6 +69,20 @@ class Variants(unittest.TestCase):
             self.assertEqual(stop.exception.code, 2)
             self.assertIn("--flat-contacts point", err.getvalue())
 
+    def test_the_pours_are_opened_another_way_at_table31_with_the_mean_only(self):
+        # Each of these ran the whole 3 x 3 with the pours' own rule before (the option
+        # ignored), overwriting that rule's runs and summary; two ways at once ran one.
+        for argv, reason in ((["--open-with-point"], "--element-contacts mean --table31-only"),
+                             (["--element-contacts", "mean", "--open-with-sum"],
+                              "--element-contacts mean --table31-only"),
+                             (["--element-contacts", "mean", "--table31-only",
+                               "--open-with-sum", "--open-with-point"], "give one")):
+            with contextlib.redirect_stderr(io.StringIO()) as err:
+                with self.assertRaises(SystemExit) as stop:
+                    main(argv + ["--build", "no-such-build"])
+            self.assertEqual(stop.exception.code, 2)
+            self.assertIn(reason, err.getvalue())
+
 
 if __name__ == "__main__":
     unittest.main()

@@ -198,15 +198,47 @@ class SegmentStarts(unittest.TestCase):
             self.assertEqual(_outputs.segment_starts(os.path.join(tmp, "none")), [])
 
 
-class Pauses(unittest.TestCase):
-    def test_minutes_are_summed_from_the_pause_list(self):
+class Stops(unittest.TestCase):
+    # The segments of the stamped log of RunSegments: 19:15:00-21:11:40 (to 5 s),
+    # 21:20:00-21:30:00 (to 5.25 s, then killed; the time after lost) and 22:00:00-22:22:00.
+    LOG = ["sanguis 0.1.0, started 2026-12-05 19:15:02 UTC",
+           "done: t = 5 s, 2000000 steps in 1h56m (2.92e+05 particle-steps/s), ended "
+           "2026-12-05 21:11:40 UTC",
+           "--- restart from checkpoint at t = 5.000000 s, 2026-12-05 21:20:00 UTC",
+           "checkpoint: t = 5.25 s, 100000 steps in 10m00s, 2026-12-05 21:30:00 UTC",
+           "--- restart from checkpoint at t = 5.250000 s, 2026-12-05 22:00:00 UTC",
+           "done: t = 6.1 s, 240000 steps in 22m00s (1e+05 particle-steps/s), ended "
+           "2026-12-05 22:22:00 UTC, settled"]
+
+    def test_the_stops_that_fall_in_counted_segments_are_what_their_wall_times_hold(self):
         with tempfile.TemporaryDirectory() as d:
-            self.assertIsNone(_outputs.paused_minutes(d))
+            self.assertEqual(_outputs.stops(d), [])
+            write_run_log(d, self.LOG)
             write_text(d, "PAUSES.txt",
-                       "- pour (stop 49): about 17 min (CI), before 2 s.\n"
-                       "  09:48:42-10:11:17 (22.6 min, benchmarks), 10:12:12-10:12:53\n"
-                       "  (0.7 min): between 2 s and 2.25 s; restarted at 09:24.\n")
-            self.assertAlmostEqual(_outputs.paused_minutes(d), 40.3)
+                       "2026-12-05T21:00 stopped for the CI of abc (5.0 min)\n"      # inside
+                       "2026-12-05T21:10:40-21:12:40 stopped for a build (2.0 min)\n"  # 1 of 2
+                       "2026-12-05T21:35 stopped for the CI of def (5.5 min)\n"       # lost time
+                       "2026-12-05T21:40 the session ended; restarted at 22:00\n"      # no length
+                       "2026-12-05T22:10 stopped for benchmarks (3 min)\n")           # inside
+            stop_list = _outputs.stops(d)
+            self.assertEqual(len(stop_list), 4)
+            intervals = _outputs.counted_intervals(d)
+            self.assertEqual([round(b - a) for a, b in intervals], [6960, 600, 1320])
+            self.assertAlmostEqual(_outputs.stopped_seconds(intervals, stop_list),
+                                   300 + 60 + 180)
+            # after 5 s: the segments of the collapse alone, which the 21:00 stop is not in
+            self.assertAlmostEqual(_outputs.stopped_seconds(
+                _outputs.counted_intervals(d, after=5.0), stop_list), 180)
+            # two runs stopped at once: their union holds each stop once
+            self.assertAlmostEqual(_outputs.stopped_seconds(intervals + intervals, stop_list),
+                                   540)
+
+    def test_a_stop_without_a_date_cannot_be_placed_and_is_refused(self):
+        with tempfile.TemporaryDirectory() as d:
+            path = write_text(d, "PAUSES.txt", "- pour (stop 49): about 17 min (CI)\n")
+            with self.assertRaises(SystemExit) as stop:
+                _outputs.stops(d)
+            self.assertIn(f"{path}:1: a stop of 17 min without a date", str(stop.exception))
 
 
 class TwoAtATime(unittest.TestCase):
