@@ -390,6 +390,15 @@ def counted_intervals(run, after=-1.0):
             _stamped_segments(_log_lines(run)) if end > after + 1e-9 and stamp is not None]
 
 
+def runs_utc(intervals):
+    """The first start and last end of these counted_intervals, as UTC dates to the minute
+    ("YYYY-MM-DD HH:MM"), for a summary's "runs_utc"; None when there are none."""
+    if not intervals:
+        return None
+    return [time.strftime("%Y-%m-%d %H:%M", time.gmtime(t))
+            for t in (min(a for a, _ in intervals), max(b for _, b in intervals))]
+
+
 def stopped_seconds(intervals, stop_list):
     """Seconds of the stops inside the union of these intervals (counted_intervals of one
     run, or of several runs together): what their wall times hold of the stops."""
@@ -405,10 +414,13 @@ def paused_note(minutes, name):
             f"results/runs/{name}/PAUSES.txt); the run time leaves them out.")
 
 
-def write_summary(summary, results_dir, elapsed, quick, ok):
-    """Completes a case's summary (run time, date, quick, pass) and writes it as
-    RESULTS/<name>.json, the file run_all.py reads for the report."""
+def write_summary(summary, results_dir, elapsed, quick, ok, intervals=()):
+    """Completes a case's summary (run time, date, quick, pass, and the span of its runs'
+    counted `intervals` when given) and writes it as RESULTS/<name>.json, the file
+    run_all.py reads for the report."""
     summary.update({"run_time_s": round(elapsed, 1), "date": time.strftime("%Y-%m-%d %H:%M"),
                     "quick": bool(quick), "pass": bool(ok)})
+    if runs_utc(intervals):
+        summary["runs_utc"] = runs_utc(intervals)
     with open(os.path.join(results_dir, summary["name"] + ".json"), "w") as f:
         json.dump(summary, f, indent=1)

@@ -231,7 +231,7 @@ def main():
 
     checks, rows, notes = [], [], []
     elapsed = 0.0  # the run segments' wall times (a pour reused by a later call counts)
-    stop_list, paused = stops(RUNS), 0.0
+    stop_list, paused, counted = stops(RUNS), 0.0, []
     several = len(args.seeds) > 1
     # Each run's summary, read once: (calibrated, Table 3.1 or None) per (gate, seed).
     summaries = {key: (read_summary(out), read_summary(table31) if table31 else None)
@@ -245,9 +245,11 @@ def main():
         pour_s, collapse_s = wall_time(pour), wall_time(out, opening)
         table31_s = wall_time(table31, opening) if table31 else 0.0
         # less the stops (PAUSES.txt) that fell in the segments counted
-        stopped_s = stopped_seconds(counted_intervals(pour), stop_list) + stopped_seconds(
-            counted_intervals(out, opening) + (counted_intervals(table31, opening) if table31
-                                               else []), stop_list)
+        collapses = counted_intervals(out, opening) + (
+            counted_intervals(table31, opening) if table31 else [])
+        stopped_s = (stopped_seconds(counted_intervals(pour), stop_list)
+                     + stopped_seconds(collapses, stop_list))
+        counted += counted_intervals(pour) + collapses
         paused += stopped_s / 60.0
         elapsed += pour_s + collapse_s + table31_s - stopped_s
         which = describe(gate, seed, several)
@@ -382,7 +384,7 @@ def main():
                      "(SIGSTOP) while benchmarks and CI used the VM's two cores "
                      "(listed in results/runs/crosses_calibrated_gates/PAUSES.txt); the run "
                      "time of the report leaves them out.")
-    write_summary(summary, RESULTS, elapsed, args.quick, ok)
+    write_summary(summary, RESULTS, elapsed, args.quick, ok, counted)
     print(f"{'PASS' if ok else 'FAIL'}: {elapsed / 3600:.2f} h")
     return 0 if ok else 1
 

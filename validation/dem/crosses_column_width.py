@@ -300,7 +300,7 @@ def measure(exe, size, seed, table31=False):
             "x_top": highest_point(frame["Points"], s["L0_m"]), "frame": frame,
             "x_top_at": (frame_t - opening) / tau_c, "opening": opening,
             "pour_s": wall_time(pour), "collapse_s": wall_time(out, opening),
-            "pour_stops": counted_intervals(pour), "collapse_stops": counted_intervals(out, opening),
+            "pour_counted": counted_intervals(pour), "collapse_counted": counted_intervals(out, opening),
             "stopped": stopped(out, opening),
             "mean_speed_at_opening": at_opening["mean_velocity_m_s"]}
 
@@ -517,10 +517,11 @@ def main(argv=None):
                  "disk.")
     # Each run's wall time less the stops (PAUSES.txt) that fell in its counted segments.
     stop_list = stops(variant.runs())
-    durations, paused = [], 0.0
+    durations, paused, counted = [], 0.0, []
     for key, r in results.items():
-        spans = [r["pour_stops"], r["collapse_stops"]] + (
-            [table31[key]["collapse_stops"]] if key in table31 else [])
+        spans = [r["pour_counted"], r["collapse_counted"]] + (
+            [table31[key]["collapse_counted"]] if key in table31 else [])
+        counted += [interval for intervals in spans for interval in intervals]
         stopped_s = sum(stopped_seconds(intervals, stop_list) for intervals in spans)
         paused += stopped_s / 60.0
         durations.append(r["pour_s"] + r["collapse_s"] - stopped_s
@@ -565,7 +566,7 @@ def main(argv=None):
                     "rows": rows}],
         "notes": notes,
     }
-    write_summary(summary, RESULTS, elapsed, args.quick, ok)
+    write_summary(summary, RESULTS, elapsed, args.quick, ok, counted)
     print(f"{'PASS' if ok else 'FAIL'}: {len(results)} run(s), {elapsed / 3600:.2f} h")
     return 0 if ok else 1
 

@@ -41,7 +41,6 @@ Usage: /usr/bin/python3 validation/dem/crosses_dam_break.py [--build build] [--h
 """
 import argparse
 import csv
-import json
 import math
 import os
 import re
@@ -54,7 +53,7 @@ import matplotlib
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from _outputs import (counted_intervals, element_contacts_setting, read_summary,  # noqa: E402
-                      regime_name, stopped_seconds, stops, wall_time)
+                      regime_name, stopped_seconds, stops, wall_time, write_summary)
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -537,7 +536,8 @@ def main(argv=None):
             + "."),
         "command": f"/usr/bin/python3 validation/dem/{name}.py --build BUILD"
                    + ("" if args.gates == [4] else " --gates " + " ".join(map(str, args.gates)))
-                   + (" --sum-control" if any(k[1] for k in runs) else ""),
+                   + (" --sum-control" if any(k[1] for k in runs) else "")
+                   + (f" --threads {args.threads}" if args.threads != 1 else ""),
         "figures": [f"docs/validation/figures/{name}.png"],
         "checks": checks,
         "tables": [{"caption": "Per run (`sanguis analyze`; coordination at the opening).",
@@ -546,13 +546,9 @@ def main(argv=None):
                                "neighbours", "contact points", "regime", "wall time of finished segments [h]"],
                     "rows": rows}],
         "notes": notes,
-        "run_time_s": round(elapsed, 1),
-        "date": time.strftime("%Y-%m-%d %H:%M"),
-        "quick": bool(args.quick),
-        "pass": bool(ok),
     }
-    with open(os.path.join(RESULTS, name + ".json"), "w") as f:
-        json.dump(summary, f, indent=1)
+    write_summary(summary, RESULTS, elapsed, args.quick, ok,
+                  [interval for out in runs.values() for interval in counted_intervals(out)])
     print(f"{'PASS' if ok else 'FAIL'}: {len(points)} run(s), {elapsed / 3600:.2f} h")
     return 0 if ok else 1
 

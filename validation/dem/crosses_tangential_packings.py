@@ -369,7 +369,7 @@ def main(argv=None):
                              for s, edge in zip(SEEDS, ordered)]}],
         "notes": notes,
     }
-    write_summary(summary, RESULTS, elapsed, args.quick, ok)
+    write_summary(summary, RESULTS, elapsed, args.quick, ok, counted)
     print(f"{'PASS' if ok else 'FAIL'}: Table 3.1 regions {table31}, collapses per point "
           f"{counts}, {elapsed:.0f} s")
     return 0 if ok else 1

@@ -92,7 +92,7 @@ def report(summaries, meta):
            "VMs of the report of 2026-11-25.", "",
            "| case | thesis | checks passed | result | run time |",
            "|---|---|---|---|---|"]
-    older = [name for name, s in summaries if s and s.get("date", "") < STORAGE_SORT_SINCE]
+    older = [name for name, s in summaries if s and first_run(s) < STORAGE_SORT_SINCE]
     if older:
         out[-2:-2] = [f"{len(older)} of these {len(summaries)} cases were run before the particle "
                       f"storage sort ({STORAGE_SORT_SINCE}) by earlier builds. The current build "
@@ -103,7 +103,7 @@ def report(summaries, meta):
                       "in its run of 2026-11-22. Pours of crosses are chaotic, so such a rerun is "
                       "another packing (see crosses_memory's notes).", ""]
     point_model = [name for name, s in summaries
-                   if s and name.startswith(BODY_CASES) and s.get("date", "") < CONTACT_PATCHES_SINCE]
+                   if s and name.startswith(BODY_CASES) and first_run(s) < CONTACT_PATCHES_SINCE]
     if point_model:
         out[-2:-2] = [f"{len(point_model)} cases of crosses ran before the contact patches of flat "
                       f"faces ({CONTACT_PATCHES_SINCE}, docs/theory/dem.md), with one contact point "
@@ -126,7 +126,7 @@ def report(summaries, meta):
                     "run to its end (not run yet, or it failed; see its output).", ""]
             continue
         out += [f"## {s['title']} (thesis {s['thesis']})", "", s["description"], "",
-                f"Command: `{s['command']}`. Run on {s.get('date', '?')}"
+                f"Command: `{s['command']}`. " + when_run(s)
                 + (f" on {s['cpu']} ({s['nproc']} cores), commit `{s['commit']}`" if "cpu" in s
                    else "")
                 + f", run time {fmt_time(s.get('run_time_s'))}. Result: {verdict(s['pass'])}.",
@@ -162,6 +162,24 @@ def stamp_hardware(path, since, build):
     with open(tmp, "w") as f:
         json.dump(s, f, indent=1)
     os.replace(tmp, path)
+
+
+def first_run(s):
+    """When a case's first run began, as far as its summary says: the start of its runs'
+    span, else the summary's date (a summary written later from runs on disk gives the
+    span, so the report's notes on older models go by when the runs ran)."""
+    return s["runs_utc"][0] if "runs_utc" in s else s.get("date", "")
+
+
+def when_run(s):
+    """When a case ran: its summary's date, and where the summary gives the span of its runs
+    (a summary written later from runs on disk), that span first."""
+    if "runs_utc" not in s:
+        return f"Run on {s.get('date', '?')}"
+    start, end = s["runs_utc"]
+    same_day = start[:10] == end[:10]
+    return (f"Runs {start} to {end[11:] if same_day else end} UTC, summary written "
+            f"{s.get('date', '?')}")
 
 
 def fmt_time(t):

@@ -229,6 +229,8 @@ class Stops(unittest.TestCase):
             # after 5 s: the segments of the collapse alone, which the 21:00 stop is not in
             self.assertAlmostEqual(_outputs.stopped_seconds(
                 _outputs.counted_intervals(d, after=5.0), stop_list), 180)
+            self.assertEqual(_outputs.runs_utc(intervals), ["2026-12-05 19:15", "2026-12-05 22:22"])
+            self.assertIsNone(_outputs.runs_utc([]))
             # two runs stopped at once: their union holds each stop once
             self.assertAlmostEqual(_outputs.stopped_seconds(intervals + intervals, stop_list),
                                    540)

@@ -77,6 +77,18 @@ class Report(unittest.TestCase):
         bad = text[text.index('<a id="bad">'):]
         self.assertIn("Run on 2026-12-02 05:00, run time 75 s. Result: **FAIL**.", bad)
 
+    def test_a_summary_written_from_older_runs_gives_when_they_ran(self):
+        later = summary("crosses_later", True, date="2026-12-06 16:47",
+                        runs_utc=["2026-11-30 09:11", "2026-12-01 10:41"])
+        same_day = summary("same_day", True, runs_utc=["2026-12-02 03:00", "2026-12-02 04:10"])
+        text = run_all.report([("crosses_later", later), ("same_day", same_day)], self.META)
+        self.assertIn("Runs 2026-11-30 09:11 to 2026-12-01 10:41 UTC, summary written "
+                      "2026-12-06 16:47, run time", text)
+        self.assertIn("Runs 2026-12-02 03:00 to 04:10 UTC, summary written 2026-12-02 05:00",
+                      text)
+        # the notes on older models go by the runs: these ran before the contact patches
+        self.assertIn("as in thesis §2.3: crosses_later.", text)
+
     def test_flags_cases_run_before_the_storage_sort(self):
         old = summary("old", True, date="2026-11-20 10:00")
         text = run_all.report([("old", old)], self.META)
