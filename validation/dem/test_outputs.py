@@ -110,6 +110,19 @@ class CaseAndSummaries(unittest.TestCase):
         self.assertRegex(s["date"], r"^\d{4}-\d\d-\d\d \d\d:\d\d$")
 
 
+# A run.log as written since 2026-12-05, every line stamped in UTC: a segment to 5 s, one
+# killed after its checkpoint at 5.25 s, and one to 6.1 s.
+STAMPED_LOG = [
+    "sanguis 0.1.0, started 2026-12-05 19:15:02 UTC",
+    "done: t = 5 s, 2000000 steps in 1h56m (2.92e+05 particle-steps/s), ended "
+    "2026-12-05 21:11:40 UTC",
+    "--- restart from checkpoint at t = 5.000000 s, 2026-12-05 21:20:00 UTC",
+    "checkpoint: t = 5.25 s, 100000 steps in 10m00s, 2026-12-05 21:30:00 UTC",
+    "--- restart from checkpoint at t = 5.250000 s, 2026-12-05 22:00:00 UTC",
+    "done: t = 6.1 s, 240000 steps in 22m00s (1e+05 particle-steps/s), ended "
+    "2026-12-05 22:22:00 UTC, settled"]
+
+
 class RunSegments(unittest.TestCase):
     LOG = ["sanguis 0.1, case.toml",
            "done: t = 3 s, 880000 steps in 11m25s (2.964e+05 particle-steps/s)",
@@ -147,15 +160,7 @@ class RunSegments(unittest.TestCase):
     def test_lines_stamped_with_the_date_read_the_same(self):
         # Since 2026-12-05 run.log stamps its start, restarts, checkpoints and end in UTC.
         with tempfile.TemporaryDirectory() as tmp:
-            write_run_log(tmp, [
-                "sanguis 0.1.0, started 2026-12-05 19:15:02 UTC",
-                "done: t = 5 s, 2000000 steps in 1h56m (2.92e+05 particle-steps/s), ended "
-                "2026-12-05 21:11:40 UTC",
-                "--- restart from checkpoint at t = 5.000000 s, 2026-12-05 21:20:00 UTC",
-                "checkpoint: t = 5.25 s, 100000 steps in 10m00s, 2026-12-05 21:30:00 UTC",
-                "--- restart from checkpoint at t = 5.250000 s, 2026-12-05 22:00:00 UTC",
-                "done: t = 6.1 s, 240000 steps in 22m00s (1e+05 particle-steps/s), ended "
-                "2026-12-05 22:22:00 UTC, settled"])
+            write_run_log(tmp, STAMPED_LOG)
             self.assertEqual(list(_outputs.finished_segments(tmp)),
                              [(5.0, 6960), (5.25, 600), (6.1, 1320)])
             self.assertEqual(_outputs.done_times(tmp), [5.0, 6.1])
@@ -199,21 +204,12 @@ class SegmentStarts(unittest.TestCase):
 
 
 class Stops(unittest.TestCase):
-    # The segments of the stamped log of RunSegments: 19:15:00-21:11:40 (to 5 s),
-    # 21:20:00-21:30:00 (to 5.25 s, then killed; the time after lost) and 22:00:00-22:22:00.
-    LOG = ["sanguis 0.1.0, started 2026-12-05 19:15:02 UTC",
-           "done: t = 5 s, 2000000 steps in 1h56m (2.92e+05 particle-steps/s), ended "
-           "2026-12-05 21:11:40 UTC",
-           "--- restart from checkpoint at t = 5.000000 s, 2026-12-05 21:20:00 UTC",
-           "checkpoint: t = 5.25 s, 100000 steps in 10m00s, 2026-12-05 21:30:00 UTC",
-           "--- restart from checkpoint at t = 5.250000 s, 2026-12-05 22:00:00 UTC",
-           "done: t = 6.1 s, 240000 steps in 22m00s (1e+05 particle-steps/s), ended "
-           "2026-12-05 22:22:00 UTC, settled"]
-
+    # STAMPED_LOG's counted segments: 19:15:00-21:11:40 (to 5 s), 21:20:00-21:30:00 (to
+    # 5.25 s, then killed; the time after lost) and 22:00:00-22:22:00.
     def test_the_stops_that_fall_in_counted_segments_are_what_their_wall_times_hold(self):
         with tempfile.TemporaryDirectory() as d:
             self.assertEqual(_outputs.stops(d), [])
-            write_run_log(d, self.LOG)
+            write_run_log(d, STAMPED_LOG)
             write_text(d, "PAUSES.txt",
                        "2026-12-05T21:00 stopped for the CI of abc (5.0 min)\n"      # inside
                        "2026-12-05T21:10:40-21:12:40 stopped for a build (2.0 min)\n"  # 1 of 2
