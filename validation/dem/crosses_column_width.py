@@ -300,7 +300,8 @@ def measure(exe, size, seed, table31=False):
             "x_top": highest_point(frame["Points"], s["L0_m"]), "frame": frame,
             "x_top_at": (frame_t - opening) / tau_c, "opening": opening,
             "pour_s": wall_time(pour), "collapse_s": wall_time(out, opening),
-            "pour_counted": counted_intervals(pour), "collapse_counted": counted_intervals(out, opening),
+            "pour_counted": counted_intervals(pour),
+            "collapse_counted": counted_intervals(out, opening),
             "stopped": stopped(out, opening),
             "mean_speed_at_opening": at_opening["mean_velocity_m_s"]}
 
