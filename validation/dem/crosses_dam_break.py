@@ -366,6 +366,20 @@ def control_rows(gate, control, run, rows, checks, notes, points):
                  "changes after the opening alone, on one packing.")
 
 
+def command_record(name, gates, controls, threads):
+    """The command that makes the report's runs: one call, or, when the controls (with
+    --sum-control) cover some of the gates only, the call that makes them and then the
+    one for every gate (--sum-control on it would run the other gates' controls too)."""
+    def call(these, control):
+        return (f"/usr/bin/python3 validation/dem/{name}.py --build BUILD"
+                + ("" if these == [4] else " --gates " + " ".join(map(str, these)))
+                + (" --sum-control" if control else "")
+                + (f" --threads {threads}" if threads != 1 else ""))
+    if not controls or sorted(controls) == sorted(gates):
+        return call(gates, bool(controls))
+    return f"{call(sorted(controls), True)}`, then `{call(gates, False)}"
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser()
     ap.add_argument("--build", default="build")
@@ -534,10 +548,8 @@ def main(argv=None):
             + " of the five of §3.2.1"
             + (f" (the others: `--gates {' '.join(map(str, others))}`, hours each)" if others else "")
             + "."),
-        "command": f"/usr/bin/python3 validation/dem/{name}.py --build BUILD"
-                   + ("" if args.gates == [4] else " --gates " + " ".join(map(str, args.gates)))
-                   + (" --sum-control" if any(k[1] for k in runs) else "")
-                   + (f" --threads {args.threads}" if args.threads != 1 else ""),
+        "command": command_record(name, args.gates, [g for g, control in runs if control],
+                                  args.threads),
         "figures": [f"docs/validation/figures/{name}.png"],
         "checks": checks,
         "tables": [{"caption": "Per run (`sanguis analyze`; coordination at the opening).",

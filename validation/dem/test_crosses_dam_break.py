@@ -113,6 +113,19 @@ class EndOfCollapse(unittest.TestCase):
             self.assertIn("still moving", db.stopped(d, opening))
 
 
+class CommandRecord(unittest.TestCase):
+    def test_controls_on_some_gates_take_a_call_of_their_own(self):
+        base = "/usr/bin/python3 validation/dem/crosses_dam_break_mean.py --build BUILD"
+        self.assertEqual(db.command_record("crosses_dam_break", [4], [], 1),
+                         "/usr/bin/python3 validation/dem/crosses_dam_break.py --build BUILD")
+        self.assertEqual(db.command_record("crosses_dam_break_mean", [4, 8], [4, 8], 2),
+                         base + " --gates 4 8 --sum-control --threads 2")
+        # --sum-control with --gates 4 8 would run an 8 cm control that the report lacks
+        self.assertEqual(db.command_record("crosses_dam_break_mean", [4, 8], [4], 2),
+                         base + " --sum-control --threads 2`, then `" + base
+                         + " --gates 4 8 --threads 2")
+
+
 class Columns(unittest.TestCase):
     def test_the_experiments_columns_set_no_depth_nor_pour_bottom(self):
         settings = db.overrides(db.column(8))
