@@ -245,11 +245,11 @@ def main():
         pour_s, collapse_s = wall_time(pour), wall_time(out, opening)
         table31_s = wall_time(table31, opening) if table31 else 0.0
         # less the stops (PAUSES.txt) that fell in the segments counted
+        poured = counted_intervals(pour)
         collapses = counted_intervals(out, opening) + (
             counted_intervals(table31, opening) if table31 else [])
-        stopped_s = (stopped_seconds(counted_intervals(pour), stop_list)
-                     + stopped_seconds(collapses, stop_list))
-        counted += counted_intervals(pour) + collapses
+        stopped_s = stopped_seconds(poured, stop_list) + stopped_seconds(collapses, stop_list)
+        counted += poured + collapses
         paused += stopped_s / 60.0
         elapsed += pour_s + collapse_s + table31_s - stopped_s
         which = describe(gate, seed, several)

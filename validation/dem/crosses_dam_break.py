@@ -491,7 +491,8 @@ def main(argv=None):
         notes.append(POINT_MODEL_30CM)
     # Each run's stops (PAUSES.txt) that fell in its counted segments: its wall time holds them.
     stop_list = stops(run_root)
-    stopped_s = {out: stopped_seconds(counted_intervals(out), stop_list) for out in runs.values()}
+    counted = {out: counted_intervals(out) for out in runs.values()}
+    stopped_s = {out: stopped_seconds(counted[out], stop_list) for out in runs.values()}
     paused = sum(stopped_s.values()) / 60.0
     if paused:
         notes.append(f"The wall times of the table include {paused:.1f} min during which the "
@@ -560,7 +561,7 @@ def main(argv=None):
         "notes": notes,
     }
     write_summary(summary, RESULTS, elapsed, args.quick, ok,
-                  [interval for out in runs.values() for interval in counted_intervals(out)])
+                  [interval for intervals in counted.values() for interval in intervals])
     print(f"{'PASS' if ok else 'FAIL'}: {len(points)} run(s), {elapsed / 3600:.2f} h")
     return 0 if ok else 1
 
