@@ -33,6 +33,9 @@ ROOT = os.path.dirname(os.path.dirname(HERE))
 RESULTS = os.path.join(HERE, "results")
 REPORT = os.path.join(ROOT, "docs", "validation", "dem.md")
 
+sys.path.insert(0, HERE)
+from _outputs import TWIST_MOMENT_FROM  # noqa: E402
+
 
 def scripts():
     # Modules shared by the scripts start with '_', their unit tests with 'test_'.
@@ -76,6 +79,9 @@ def verdict(p):
 STORAGE_SORT_SINCE = "2026-11-23 23:30"
 # When flat faces began to touch through contact patches (docs/theory/dem.md).
 CONTACT_PATCHES_SINCE = "2026-12-02 16:30"
+# When the contact patches' torsional spring was spread over the patch (_outputs'
+# TWIST_MOMENT_FROM, to the minute).
+TWIST_MOMENT_SINCE = TWIST_MOMENT_FROM[:16]
 # The cases whose runs hold non-spherical particles (their physics changed then).
 BODY_CASES = ("crosses_",)
 
@@ -95,7 +101,8 @@ def report(summaries, meta):
     older = [name for name, s in summaries if s and first_run(s) < STORAGE_SORT_SINCE]
     if older:
         out[-2:-2] = [f"{len(older)} of these {len(summaries)} cases were run before the particle "
-                      f"storage sort ({STORAGE_SORT_SINCE}) by earlier builds. The current build "
+                      f"storage sort ({STORAGE_SORT_SINCE}) by earlier builds: "
+                      + ", ".join(older) + ". The current build "
                       "runs them with another round-off (the sort, docs/performance.md, \"Storage "
                       "along a space-filling curve\", and changes to the contact code since), and "
                       "`--set simulation.storage_sort_steps=0` does not bring back their bits: "
@@ -111,6 +118,19 @@ def report(summaries, meta):
                       "That model is still there, `--set simulation.flat_contacts=\"point\"`; "
                       "the patches make flat contacts hold where the single point rocked, so these "
                       "cases' numbers are those of the point model until they are run again.", ""]
+    corners_spring = [name for name, s in summaries
+                      if s and name.startswith(BODY_CASES)
+                      and CONTACT_PATCHES_SINCE <= first_run(s) < TWIST_MOMENT_SINCE]
+    if corners_spring:
+        out[-2:-2] = [f"{len(corners_spring)} cases of crosses ran with the contact patches before "
+                      f"their torsional spring was spread over the patch ({TWIST_MOMENT_SINCE}, "
+                      "docs/theory/dem.md, \"The torsional spring until 2026-12-05 evening\"), "
+                      "with the spring at the patch's corners: " + ", ".join(corners_spring)
+                      + ". Their numbers are those of that spring until they are run again "
+                      "(where both were measured the regimes stayed and the figures moved: "
+                      "crosses_dam_break's 4 cm run-out 1.86 with the corners' spring, 2.48 with "
+                      "the spread one, fractured either way; crosses_tangential_packings' "
+                      "notes).", ""]
     for name, s in summaries:
         if s is None:
             out.append(f"| {name} | — | — | **FAIL** (no summary) | — |")

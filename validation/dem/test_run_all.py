@@ -92,7 +92,24 @@ class Report(unittest.TestCase):
     def test_flags_cases_run_before_the_storage_sort(self):
         old = summary("old", True, date="2026-11-20 10:00")
         text = run_all.report([("old", old)], self.META)
-        self.assertIn("1 of these 1 cases were run before the particle storage sort", text)
+        self.assertIn("1 of these 1 cases were run before the particle storage sort "
+                      "(2026-11-23 23:30) by earlier builds: old. ", text)
+
+    def test_names_the_cases_of_crosses_run_with_the_corners_torsional_spring(self):
+        point = summary("crosses_point", True, date="2026-12-01 10:00")
+        corners = summary("crosses_corners", True, date="2026-12-05 19:50")
+        spread = summary("crosses_spread", True, date="2026-12-05 22:25")
+        later = summary("crosses_later", True, date="2026-12-06 10:00",
+                        runs_utc=["2026-12-05 08:00", "2026-12-05 09:00"])
+        spheres = summary("spheres", True, date="2026-12-05 19:50")
+        cases = [(s["name"], s) for s in (point, corners, spread, later, spheres)]
+        flagged = [line for line in run_all.report(cases, self.META).splitlines()
+                   if "before their torsional spring was spread" in line]
+        self.assertEqual(len(flagged), 1)
+        self.assertIn("2 cases of crosses", flagged[0])
+        self.assertIn("corners: crosses_corners, crosses_later. ", flagged[0])
+        text = run_all.report([("crosses_spread", spread), ("spheres", spheres)], self.META)
+        self.assertNotIn("torsional spring", text)
 
     def test_names_the_cases_of_crosses_run_with_one_contact_point(self):
         old = summary("crosses_old", True, date="2026-11-30 10:00")
@@ -107,7 +124,7 @@ class Report(unittest.TestCase):
         self.assertNotIn("crosses_new", flagged[0])
         self.assertNotIn("spheres_old", flagged[0])
         text = run_all.report([("crosses_new", new), ("spheres_old", spheres)], self.META)
-        self.assertNotIn("contact patches", text)
+        self.assertNotIn("ran before the contact patches", text)
 
 
 class StampHardware(unittest.TestCase):
