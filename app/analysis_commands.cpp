@@ -61,6 +61,12 @@ struct SliceArgs {
   bool blocks = false;
 };
 
+struct FlowMapArgs {
+  std::vector<std::string> ensembles;
+  std::string output = "flow-map";
+  bool no_plot = false;
+};
+
 struct CalibrateArgs {
   std::string case_file, output, measure, from;
   std::vector<std::string> parameters;  // each gets the same value
@@ -128,6 +134,18 @@ int run_slice(const SliceArgs& a) {
   if (!a.at.empty()) command += " --at " + number(a.at.front());
   if (a.blocks) command += " --blocks";
   if (!a.output.empty()) command += " --output " + shell_quoted(a.output);
+  const int status = std::system(command.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 1;
+}
+
+// The map of flow regimes (thesis Fig. 3.6) from ensemble folders, CSV and PNG
+// (scripts/flow_map.py, matplotlib): returns the script's exit status (2: bad
+// input, its message printed).
+int run_flow_map(const FlowMapArgs& a) {
+  std::string command = "/usr/bin/python3 " + shell_quoted(source_dir() + "/scripts/flow_map.py");
+  for (const std::string& dir : a.ensembles) command += " " + shell_quoted(dir);
+  command += " --output " + shell_quoted(a.output);
+  if (a.no_plot) command += " --no-plot";
   const int status = std::system(command.c_str());
   return WIFEXITED(status) ? WEXITSTATUS(status) : 1;
 }
@@ -571,6 +589,7 @@ std::function<bool()> add_analysis_commands(CLI::App& app) {
   auto ensemble = std::make_shared<EnsembleArgs>();
   auto calibrate = std::make_shared<CalibrateArgs>();
   auto slice = std::make_shared<SliceArgs>();
+  auto flow_map = std::make_shared<FlowMapArgs>();
 
   auto* an = app.add_subcommand(
       "analyze", "measure DEM run folders (run-out, heights, velocity, contact network...)");
@@ -666,6 +685,17 @@ std::function<bool()> add_analysis_commands(CLI::App& app) {
   sl->add_option("--output,-o", slice->output,
                  "PNG file, the CSV beside it (default RUN/slice_FIELD_NORMALAT.png)");
 
+  auto* fm = app.add_subcommand(
+      "flow-map",
+      "map of flow regimes (thesis Fig. 3.6) from ensembles: each one (L0, H0) point, "
+      "repeatable or intermittent, as CSV and PNG");
+  fm->add_option("ensembles", flow_map->ensembles,
+                 "ensemble folders (their ensemble.csv), or folders whose subfolders are")
+      ->required();
+  fm->add_option("--output,-o", flow_map->output, "folder for flow_map.csv and flow_map.png")
+      ->capture_default_str();
+  fm->add_flag("--no-plot", flow_map->no_plot, "the CSV only");
+
   // Not the resolved path: /proc/self/exe still starts this executable when its
   // file was replaced (a rebuild) while a long study runs.
   const std::string self_path = "/proc/self/exe";
@@ -680,6 +710,18 @@ std::function<bool()> add_analysis_commands(CLI::App& app) {
       }
       if (status != 0) {
         throw std::runtime_error("slice: scripts/flow_slice.py failed (exit status " +
+                                 std::to_string(status) + ")");
+      }
+      return true;
+    }
+    if (*fm) {
+      const int status = run_flow_map(*flow_map);
+      if (status == 2) {
+        throw InputError(flow_map->ensembles.front(), "flow-map",
+                         "the flow-map script refused its input (message above)");
+      }
+      if (status != 0) {
+        throw std::runtime_error("flow-map: scripts/flow_map.py failed (exit status " +
                                  std::to_string(status) + ")");
       }
       return true;

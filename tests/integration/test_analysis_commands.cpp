@@ -132,6 +132,32 @@ TEST_F(AnalysisCommandTest, EnsembleRunsSeedsInParallelAndAggregates) {
             read_text_file(root / "seed_2" / "particles" / "particles_00000000.vtu"));
   EXPECT_NE(read_text_file(root / "seed_2" / "run.log").find("seed            2"),
             std::string::npos);
+
+  // The ensemble as one point of a flow map (Fig. 3.6): its column and how its runs ended.
+  const fs::path map = dir_ / "map";
+  const CommandResult m =
+      sanguis("flow-map " + shell_quoted(dir_.string()) + " -o " + shell_quoted(map.string()));
+  ASSERT_EQ(m.code, 0) << m.err << m.out;
+  const auto point = first_row(map / "flow_map.csv");
+  EXPECT_EQ(point.at("ensemble"), root.string());
+  EXPECT_EQ(point.at("runs"), "2");
+  const int collapsed = std::stoi(point.at("collapsed")),
+            fractured = std::stoi(point.at("fractured"));
+  EXPECT_EQ(collapsed + fractured + std::stoi(point.at("stable")), 2);
+  EXPECT_EQ(point.at("outcome"), collapsed == 2               ? "collapsed"
+                                 : fractured == 2             ? "fractured"
+                                 : collapsed + fractured == 0 ? "stable"
+                                                              : "intermittent");
+  EXPECT_GT(number(point, "H0_m"), 0.0);
+  EXPECT_EQ(read_text_file(map / "flow_map.png").substr(0, 4), "\x89PNG");
+  // A folder without ensembles is refused, naming it, and the map stays as it was.
+  const std::string before = read_text_file(map / "flow_map.csv");
+  const CommandResult bad = sanguis("flow-map " + shell_quoted((root / "seed_1").string()) +
+                                    " -o " + shell_quoted(map.string()));
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("seed_1: no ensemble.csv in it or in its subfolders"), std::string::npos)
+      << bad.err;
+  EXPECT_EQ(read_text_file(map / "flow_map.csv"), before);
 }
 
 // Friction against run-out: two values bracket a target, the estimate lies
