@@ -246,11 +246,16 @@ def stopped(run, opening):
 
 
 def run_gate(exe, gate, out, threads, hold_file=None, extra=(), collapse_extra=()):
+    """run_column for the column of one of the five gates of §3.2.1."""
+    return run_column(exe, column(gate), out, threads, hold_file, extra, collapse_extra)
+
+
+def run_column(exe, col, out, threads, hold_file=None, extra=(), collapse_extra=()):
     """pour_gate, then remove the gate and follow the collapse until at rest (at most
     COLLAPSE_S). A folder with a checkpoint (a run stopped on the way) is continued from
     it; `extra` are more overrides, in the pour and the collapse, and `collapse_extra` more
     still, in the collapse only (they come last, so they win). Returns the opening time."""
-    advance = gate_runner(exe, column(gate), out, threads, hold_file, extra)
+    advance = gate_runner(exe, col, out, threads, hold_file, extra)
     checkpoint = os.path.join(out, "checkpoint.bin")
 
     def collapse(t):
@@ -268,7 +273,7 @@ def run_gate(exe, gate, out, threads, hold_file=None, extra=(), collapse_extra=(
     if os.path.exists(checkpoint) and opening_time(out) < 1e5:  # stopped in the collapse
         t = opening_time(out)
     else:
-        t = pour_gate(exe, column(gate), out, threads, hold_file, extra)
+        t = pour_gate(exe, col, out, threads, hold_file, extra)
     collapse(t)
     return t
 

@@ -1,0 +1,62 @@
+"""Unit tests of crosses_flow_map's columns and outcomes (run by ctest
+ValidationScripts.DemHelpers)."""
+import os
+import sys
+import tomllib
+import unittest
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import crosses_dam_break as db  # noqa: E402
+import crosses_flow_map as fm  # noqa: E402
+
+
+class Columns(unittest.TestCase):
+    def test_the_memory_cases_column_sets_the_height_per_cross(self):
+        # 300 crosses behind a 4 cm gate in a 6 cm deep box stand 17.4-18.3 cm tall
+        self.assertAlmostEqual(fm.expected_height(4, 300), 0.175, places=6)
+        self.assertAlmostEqual(fm.expected_height(8, 600), 0.175, places=6)
+        self.assertAlmostEqual(fm.expected_height(4, 450), 1.5 * 0.175, places=6)
+
+    def test_one_column_of_the_default_map_is_taller_than_20_cm_and_the_others_lower(self):
+        tall = [c for c in fm.COLUMNS if fm.expected_height(*c) > fm.TALL_M + 0.03]
+        low = [c for c in fm.COLUMNS if fm.expected_height(*c) < fm.TALL_M - 0.02]
+        self.assertEqual(tall, [(4, 450)])
+        self.assertEqual(len(low), len(fm.COLUMNS) - 1)
+
+    def test_the_pour_starts_above_the_columns_top_and_the_box_is_6_cm_deep(self):
+        with open(db.CASE, "rb") as f:
+            case = tomllib.load(f)
+        top = case["particles"][0]["region_max_m"][2]
+        for gate_cm, count in fm.COLUMNS:
+            col = fm.column_of(gate_cm, count)
+            self.assertGreaterEqual(col.pour_bottom_m, fm.expected_height(gate_cm, count) + 0.05)
+            self.assertGreaterEqual(col.pour_bottom_m, 0.28)
+            self.assertLess(col.pour_bottom_m + 0.3, top)  # room left to pour
+            settings = db.overrides(col)
+            self.assertIn(f"obstacle[{db.SIDE_WALL_INDEX}].point_m=[0.0, 0.06, 0.0]", settings)
+            self.assertIn(f"particles[0].count={count}", settings)
+        self.assertEqual(case["obstacle"][db.SIDE_WALL_INDEX]["name"], "side wall, back")
+
+    def test_seeds_and_folders(self):
+        self.assertEqual(fm.seed_settings(db.SEED), [])
+        self.assertEqual(fm.seed_settings(1), ["--set", "simulation.seed=1"])
+        self.assertNotEqual(fm.folder(4, 300, 1), fm.folder(4, 300, 2))
+        self.assertNotEqual(fm.folder(4, 300, 1), fm.folder(8, 300, 1))
+
+
+class Outcomes(unittest.TestCase):
+    def test_a_repeatable_column_names_its_regime_an_intermittent_one_its_counts(self):
+        self.assertEqual(fm.outcome_text({"outcome": "collapsed", "collapsed": "3",
+                                          "fractured": "0", "stable": "0"}),
+                         "collapsed (repeatable)")
+        self.assertEqual(fm.outcome_text({"outcome": "intermittent", "collapsed": "1",
+                                          "fractured": "0", "stable": "2"}),
+                         "intermittent: 1 collapsed, 2 stable")
+
+    def test_a_map_needs_two_packings_per_column(self):
+        with self.assertRaises(SystemExit):
+            fm.main(["--seeds", "1", "--reuse"])
+
+
+if __name__ == "__main__":
+    unittest.main()
