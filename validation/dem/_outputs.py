@@ -11,6 +11,7 @@ import re
 import shutil
 import subprocess
 import sys
+from concurrent.futures import ThreadPoolExecutor
 import time
 import tomllib
 import xml.etree.ElementTree as ET
@@ -331,6 +332,20 @@ def run_two_at_a_time(jobs, base):
         proc, d = running.pop(0)
         if proc.wait() != 0:
             sys.exit(f"run failed: {d}")
+
+
+def call_two_at_a_time(calls):
+    """Runs the calls (functions of no argument, each running its jobs in this process)
+    two at a time; the first failure (or Ctrl-C) cancels the calls not yet started and is
+    raised once the running ones end."""
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        jobs = [pool.submit(call) for call in calls]
+        try:
+            for job in jobs:
+                job.result()
+        except BaseException:
+            pool.shutdown(wait=True, cancel_futures=True)
+            raise
 
 
 def two_at_a_time_span(durations):

@@ -63,11 +63,11 @@ Usage: /usr/bin/python3 validation/dem/crosses_column_width.py [--build build]
            [--element-contacts sum|mean [--flat-contacts point]]
 """
 import argparse
+import functools
 import math
 import os
 import subprocess
 import sys
-from concurrent.futures import ThreadPoolExecutor
 from typing import NamedTuple, Optional
 
 import matplotlib
@@ -75,8 +75,9 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from _outputs import (ONE_POINT_PER_PAIR, TWIST_MOMENT_EFFECT,  # noqa: E402
-                      TWIST_MOMENT_FROM, counted_intervals, element_contacts_setting,
-                      flat_contacts_setting, paused_note, pool_span, read_arrays, read_pvd,
+                      TWIST_MOMENT_FROM, call_two_at_a_time, counted_intervals,
+                      element_contacts_setting, flat_contacts_setting, paused_note,
+                      pool_span, read_arrays, read_pvd,
                       segment_starts, read_summary, regime_name, speed_landmarks,
                       stopped_seconds, stops, wall_time, write_summary)
 from crosses_calibrated_gates import (GAMMA_T, KT, collapse, finished,  # noqa: E402
@@ -224,15 +225,9 @@ def run_one(exe, size, seed, table31, threads=1):
 def run_all_jobs(exe, keys, with_table31, threads=1):
     """run_one for every (size, seed), two at a time; the first failure (or Ctrl-C)
     cancels the jobs not yet started and is raised once the running ones end."""
-    with ThreadPoolExecutor(max_workers=2) as pool:
-        jobs = [pool.submit(run_one, exe, size, seed, (size, seed) in with_table31, threads)
-                for size, seed in keys]
-        try:
-            for job in jobs:
-                job.result()
-        except BaseException:
-            pool.shutdown(wait=True, cancel_futures=True)
-            raise
+    call_two_at_a_time([functools.partial(run_one, exe, size, seed,
+                                          (size, seed) in with_table31, threads)
+                        for size, seed in keys])
 
 
 def frame_near(run, time_s):

@@ -43,16 +43,16 @@ Usage: /usr/bin/python3 validation/dem/crosses_flow_map.py [--build build] [--qu
 """
 import argparse
 import csv
+import functools
 import os
 import shutil
 import subprocess
 import sys
 import time
-from concurrent.futures import ThreadPoolExecutor
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import (counted_intervals, read_summary, regime_name, stopped_seconds,  # noqa: E402
-                      stops, wall_time, write_summary)
+from _outputs import (call_two_at_a_time, counted_intervals, read_summary,  # noqa: E402
+                      regime_name, stopped_seconds, stops, wall_time, write_summary)
 from crosses_dam_break import (RESULTS, ROOT, SEED, Column, diagnostics,  # noqa: E402
                                opening_time, run_column, stopped)
 
@@ -105,14 +105,8 @@ def run_one(exe, gate_cm, count, seed):
 def run_all(exe, columns, seeds):
     """run_one for every column and seed, two at a time; the first failure (or Ctrl-C)
     cancels the runs not yet started and is raised once the running ones end."""
-    with ThreadPoolExecutor(max_workers=2) as pool:
-        jobs = [pool.submit(run_one, exe, g, n, s) for g, n in columns for s in seeds]
-        try:
-            for job in jobs:
-                job.result()
-        except BaseException:
-            pool.shutdown(wait=True, cancel_futures=True)
-            raise
+    call_two_at_a_time([functools.partial(run_one, exe, g, n, s)
+                        for g, n in columns for s in seeds])
 
 
 def point_folder(gate_cm, count):

@@ -2,12 +2,15 @@
 validation script relies on. Run by ctest (ValidationScripts.DemHelpers) or by hand:
 /usr/bin/python3 -m unittest discover -s validation/dem -p 'test_*.py'"""
 import base64
+import functools
 import json
 import os
 import shutil
 import struct
 import sys
 import tempfile
+import threading
+import time
 import unittest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -248,6 +251,36 @@ class TwoAtATime(unittest.TestCase):
         # ... even when the second ended sooner.
         self.assertEqual(_outputs.two_at_a_time_span([10, 2, 1]), 11)
         self.assertEqual(_outputs.two_at_a_time_span([1, 1, 1, 1]), 2)
+
+
+class CallTwoAtATime(unittest.TestCase):
+    def test_every_call_runs_never_more_than_two_at_once(self):
+        lock, running, most, done = threading.Lock(), [0], [0], []
+
+        def call(k):
+            with lock:
+                running[0] += 1
+                most[0] = max(most[0], running[0])
+            time.sleep(0.02)
+            with lock:
+                running[0] -= 1
+                done.append(k)
+        _outputs.call_two_at_a_time([functools.partial(call, k) for k in range(5)])
+        self.assertEqual(sorted(done), list(range(5)))
+        self.assertEqual(most[0], 2)
+
+    def test_a_failure_cancels_the_calls_not_started_and_is_raised(self):
+        started = []
+
+        def call(k):
+            started.append(k)
+            time.sleep(0.0 if k == 0 else 0.05)
+            if k == 0:
+                raise RuntimeError("run failed")
+        with self.assertRaisesRegex(RuntimeError, "run failed"):
+            _outputs.call_two_at_a_time([functools.partial(call, k) for k in range(6)])
+        self.assertIn(1, started)  # the one running beside the failure ran to its end
+        self.assertLess(len(started), 6)
 
 
 class PoolSpan(unittest.TestCase):
