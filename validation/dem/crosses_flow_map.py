@@ -103,10 +103,12 @@ def run_one(exe, gate_cm, count, seed):
 
 
 def run_all(exe, columns, seeds):
-    """run_one for every column and seed, two at a time; the first failure (or Ctrl-C)
-    cancels the runs not yet started and is raised once the running ones end."""
+    """run_one for every column and seed, two at a time, the columns of most crosses
+    first (the longest runs: two-at-a-time then ends with short ones); the first failure
+    (or Ctrl-C) cancels the runs not yet started and is raised once the running ones end."""
+    by_size = sorted(columns, key=lambda c: -c[1])
     call_two_at_a_time([functools.partial(run_one, exe, g, n, s)
-                        for g, n in columns for s in seeds])
+                        for g, n in by_size for s in seeds])
 
 
 def point_folder(gate_cm, count):
