@@ -717,8 +717,7 @@ std::function<bool()> add_analysis_commands(CLI::App& app) {
     if (*fm) {
       const int status = run_flow_map(*flow_map);
       if (status == 2) {
-        throw InputError(flow_map->ensembles.front(), "flow-map",
-                         "the flow-map script refused its input (message above)");
+        throw InputError("", "flow-map", "the flow-map script refused its input (message above)");
       }
       if (status != 0) {
         throw std::runtime_error("flow-map: scripts/flow_map.py failed (exit status " +

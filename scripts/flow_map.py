@@ -45,8 +45,8 @@ def ensemble_files(paths):
                        if os.path.isfile(os.path.join(path, d, "ensemble.csv")))
         if not below:
             raise InputError(f"{path}: no ensemble.csv in it or in its subfolders (make one "
-                             "with `sanguis ensemble CASE --seeds N` or `sanguis analyze "
-                             "RUN... --out DIR`)")
+                             "with `sanguis ensemble CASE --seeds N`, or `sanguis analyze "
+                             "RUN RUN... --out DIR` of two runs or more)")
         found += below
     return found
 
@@ -99,6 +99,7 @@ def outcome(point):
 
 
 def write_csv(points, path):
+    """The map's table as `path` + ".tmp" (main moves it into place)."""
     with open(path + ".tmp", "w", newline="") as f:
         w = csv.writer(f, lineterminator="\n")  # as sanguis writes its CSV files
         w.writerow(["ensemble", "L0_m", "H0_m", "aspect_ratio_H0_over_L0", "runs"]
@@ -107,7 +108,6 @@ def write_csv(points, path):
             w.writerow([p["ensemble"], f"{p['L0_m']:.6g}", f"{p['H0_m']:.6g}",
                         f"{p['H0_m'] / p['L0_m']:.4g}", p["runs"]]
                        + [p[r] for r in REGIMES] + [outcome(p)])
-    os.replace(path + ".tmp", path)
 
 
 STYLE = {"collapsed": ("o", "tab:blue", "collapsed (repeatable)"),
@@ -117,6 +117,7 @@ STYLE = {"collapsed": ("o", "tab:blue", "collapsed (repeatable)"),
 
 
 def draw(points, path):
+    """The map's figure as `path` + ".tmp.png" (main moves it into place)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -150,7 +151,6 @@ def draw(points, path):
     fig.tight_layout()
     fig.savefig(path + ".tmp.png", dpi=130)
     plt.close(fig)
-    os.replace(path + ".tmp.png", path)
 
 
 def main(argv=None):
@@ -169,15 +169,20 @@ def main(argv=None):
         return 2
     os.makedirs(args.output, exist_ok=True)
     table = os.path.join(args.output, "flow_map.csv")
+    figure = os.path.join(args.output, "flow_map.png")
+    # Both files made aside first, then moved into place: a failure leaves the last map
+    # whole, and a map without a figure leaves no older figure beside it.
     write_csv(points, table)
+    if not args.no_plot:
+        draw(points, figure)
+        os.replace(figure + ".tmp.png", figure)
+    elif os.path.exists(figure):
+        os.remove(figure)
+    os.replace(table + ".tmp", table)
     for p in points:
         print(f"{p['ensemble']}: L0 {100 * p['L0_m']:.1f} cm, H0 {100 * p['H0_m']:.1f} cm, "
               f"{p['runs']} runs, {outcome(p)}")
-    print(f"flow map: {table}")
-    if not args.no_plot:
-        figure = os.path.join(args.output, "flow_map.png")
-        draw(points, figure)
-        print(f"flow map: {figure}")
+    print(f"flow map: {table}" + ("" if args.no_plot else f", {figure}"))
     return 0
 
 

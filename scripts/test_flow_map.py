@@ -93,6 +93,15 @@ class FlowMap(unittest.TestCase):
                 self.assertIn(message, err)
                 self.assertFalse(os.path.exists(out), "nothing is written on bad input")
 
+    def test_a_map_without_its_figure_leaves_no_older_figure_beside_it(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            write_ensemble(os.path.join(tmp, "a"), 0.04, 0.2, 2, 1, 0)
+            out = os.path.join(tmp, "map")
+            self.assertEqual(run([os.path.join(tmp, "a"), "--output", out])[0], 0)
+            self.assertTrue(os.path.exists(os.path.join(out, "flow_map.png")))
+            self.assertEqual(run([os.path.join(tmp, "a"), "--output", out, "--no-plot"])[0], 0)
+            self.assertEqual(sorted(os.listdir(out)), ["flow_map.csv"])
+
     def test_an_earlier_map_stays_when_the_input_is_bad(self):
         with tempfile.TemporaryDirectory() as tmp:
             good = os.path.join(tmp, "good")

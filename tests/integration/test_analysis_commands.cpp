@@ -132,8 +132,15 @@ TEST_F(AnalysisCommandTest, EnsembleRunsSeedsInParallelAndAggregates) {
             read_text_file(root / "seed_2" / "particles" / "particles_00000000.vtu"));
   EXPECT_NE(read_text_file(root / "seed_2" / "run.log").find("seed            2"),
             std::string::npos);
+}
 
-  // The ensemble as one point of a flow map (Fig. 3.6): its column and how its runs ended.
+// An ensemble as one point of a flow map (Fig. 3.6): its column and how its runs ended;
+// a folder without ensembles is refused and the map left as it was.
+TEST_F(AnalysisCommandTest, FlowMapMapsEnsemblesAndRefusesFoldersWithout) {
+  const fs::path root = dir_ / "ens";
+  const CommandResult e = sanguis("ensemble " + kTinyCase + " --seeds 2 --jobs 2 -o " +
+                                  shell_quoted(root.string()) + " --set simulation.end_time_s=0.3");
+  ASSERT_EQ(e.code, 0) << e.err << e.out;
   const fs::path map = dir_ / "map";
   const CommandResult m =
       sanguis("flow-map " + shell_quoted(dir_.string()) + " -o " + shell_quoted(map.string()));

@@ -105,10 +105,10 @@ def report(summaries, meta):
                       + ", ".join(older) + ". The current build "
                       "runs them with another round-off (the sort, docs/performance.md, \"Storage "
                       "along a space-filling curve\", and changes to the contact code since), and "
-                      "`--set simulation.storage_sort_steps=0` does not bring back their bits: "
-                      "crosses_memory, rerun so on 2026-11-24, poured to H0 18.0 cm against 17.9 "
-                      "in its run of 2026-11-22. Pours of crosses are chaotic, so such a rerun is "
-                      "another packing (see crosses_memory's notes).", ""]
+                      "`--set simulation.storage_sort_steps=0` does not bring back their bits "
+                      "(for example crosses_memory, rerun so on 2026-11-24, poured to H0 18.0 cm "
+                      "against 17.9 in its run of 2026-11-22; pours of crosses are chaotic, so "
+                      "such a rerun is another packing: see crosses_memory's notes).", ""]
     point_model = [name for name, s in summaries
                    if s and name.startswith(BODY_CASES) and first_run(s) < CONTACT_PATCHES_SINCE]
     if point_model:

@@ -2,6 +2,7 @@
 ValidationScripts.DemHelpers)."""
 import os
 import sys
+import tempfile
 import tomllib
 import unittest
 
@@ -42,6 +43,38 @@ class Columns(unittest.TestCase):
         self.assertEqual(fm.seed_settings(1), ["--set", "simulation.seed=1"])
         self.assertNotEqual(fm.folder(4, 300, 1), fm.folder(4, 300, 2))
         self.assertNotEqual(fm.folder(4, 300, 1), fm.folder(8, 300, 1))
+
+
+def fake_run(folder, gate_removed_at, last_time, settled):
+    """A run folder as run_column leaves it, as far as `unfinished` reads it."""
+    os.makedirs(folder)
+    with open(os.path.join(folder, "obstacles.csv"), "w") as f:
+        f.write(f"index,type,remove_at_s,name\n0,plane,inf,floor\n5,box,{gate_removed_at},gate\n")
+    with open(os.path.join(folder, "diagnostics.csv"), "w") as f:
+        f.write(f"time_s,mean_velocity_m_s\n0,0\n{last_time},1e-4\n")
+    with open(os.path.join(folder, "run.log"), "w") as f:
+        f.write(f"done: t = {last_time} s, 20000 steps in 1m13s, ended 2026-12-06 17:51:34 UTC"
+                + (", settled" if settled else "") + "\n")
+
+
+class Runs(unittest.TestCase):
+    def test_the_columns_of_most_crosses_run_first_each_over_every_seed(self):
+        self.assertEqual(fm.in_run_order([(4, 150), (8, 600), (4, 300)], [1, 2]),
+                         [(8, 600, 1), (8, 600, 2), (4, 300, 1), (4, 300, 2), (4, 150, 1),
+                          (4, 150, 2)])
+
+    def test_only_finished_runs_are_mapped(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            self.assertEqual(fm.unfinished(os.path.join(tmp, "absent")), "not run")
+            fake_run(os.path.join(tmp, "pouring"), 1e6, 1.2, False)
+            self.assertEqual(fm.unfinished(os.path.join(tmp, "pouring")), "stopped in the pour")
+            fake_run(os.path.join(tmp, "collapsing"), 2.0, 3.1, False)
+            self.assertIn("stopped in the collapse at 3.1 s",
+                          fm.unfinished(os.path.join(tmp, "collapsing")))
+            fake_run(os.path.join(tmp, "at_rest"), 2.0, 3.6, True)
+            self.assertIsNone(fm.unfinished(os.path.join(tmp, "at_rest")))
+            fake_run(os.path.join(tmp, "full"), 2.0, 2.0 + db.COLLAPSE_S, False)
+            self.assertIsNone(fm.unfinished(os.path.join(tmp, "full")))
 
 
 class Outcomes(unittest.TestCase):

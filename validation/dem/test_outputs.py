@@ -270,16 +270,17 @@ class CallTwoAtATime(unittest.TestCase):
         self.assertEqual(most[0], 2)
 
     def test_a_failure_cancels_the_calls_not_started_and_is_raised(self):
-        started = []
+        started, finished = [], []
 
         def call(k):
             started.append(k)
             time.sleep(0.0 if k == 0 else 0.05)
             if k == 0:
                 raise RuntimeError("run failed")
+            finished.append(k)
         with self.assertRaisesRegex(RuntimeError, "run failed"):
             _outputs.call_two_at_a_time([functools.partial(call, k) for k in range(6)])
-        self.assertIn(1, started)  # the one running beside the failure ran to its end
+        self.assertIn(1, finished)  # the one running beside the failure ran to its end
         self.assertLess(len(started), 6)
 
 
