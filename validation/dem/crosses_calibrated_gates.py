@@ -49,7 +49,7 @@ from _outputs import (continue_or_copy, counted_intervals, read_summary, regime_
 from crosses_dam_break import (COLLAPSE_S, CROSSES, GATE_INDEX, RESULTS, ROOT,  # noqa: E402
                                SEED, at_rest_settings, column, diagnostics,
                                draw_velocity_bands, gate_runner, lajeunesse, pour_gate,
-                               stopped, velocity_curve)
+                               seed_settings, stopped, velocity_curve)
 from crosses_tangential_map import tangential_settings  # noqa: E402
 
 matplotlib.use("Agg")
@@ -75,11 +75,6 @@ def k_passes(k):
 def describe(gate, seed, several):
     """A run's name in the report (the seed only when there are several)."""
     return f"gate {gate} cm" + (f", seed {seed}" if several else "")
-
-
-def seed_settings(seed):
-    """The override that pours another packing (none for the case's own seed)."""
-    return [] if seed == SEED else ["--set", f"simulation.seed={seed}"]
 
 
 def folders(gate, seed):

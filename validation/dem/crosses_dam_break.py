@@ -245,6 +245,11 @@ def stopped(run, opening):
     return f"came to rest {after:.2f} s after the opening"
 
 
+def seed_settings(seed):
+    """The override that pours another packing (none for the case's own seed)."""
+    return [] if seed == SEED else ["--set", f"simulation.seed={seed}"]
+
+
 def run_gate(exe, gate, out, threads, hold_file=None, extra=(), collapse_extra=()):
     """run_column for the column of one of the five gates of §3.2.1."""
     return run_column(exe, column(gate), out, threads, hold_file, extra, collapse_extra)

@@ -54,8 +54,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from _outputs import (call_two_at_a_time, counted_intervals, paused_note,  # noqa: E402
                       pool_span, read_summary, regime_name, stopped_seconds, stops,
                       wall_time, write_summary)
-from crosses_dam_break import (COLLAPSE_S, RESULTS, ROOT, SEED, Column,  # noqa: E402
-                               diagnostics, ended_at_rest, opening_time, run_column,
+from crosses_dam_break import (COLLAPSE_S, RESULTS, ROOT, Column, diagnostics,  # noqa: E402
+                               ended_at_rest, opening_time, run_column, seed_settings,
                                stopped)
 
 NAME = "crosses_flow_map"
@@ -90,11 +90,6 @@ def column_of(gate_cm, count):
 
 def folder(gate_cm, count, seed):
     return os.path.join(RUNS, f"L{gate_cm:g}cm_{count}", f"seed_{seed}")
-
-
-def seed_settings(seed):
-    """The override that pours another packing (none for the case's own seed)."""
-    return [] if seed == SEED else ["--set", f"simulation.seed={seed}"]
 
 
 def run_one(exe, gate_cm, count, seed):
@@ -156,9 +151,8 @@ def map_columns(exe, columns, seeds):
     return {key: row for key, row in zip(columns, rows)}
 
 
-def at_rest_at_opening(run):
-    """The mean speed [m/s] of the last diagnostics row at or before the opening."""
-    opening = opening_time(run)
+def at_rest_at_opening(run, opening):
+    """The mean speed [m/s] of the last diagnostics row at or before the opening [s]."""
     return [r for r in diagnostics(run) if r["time_s"] <= opening + 1e-9][-1]["mean_velocity_m_s"]
 
 
@@ -218,7 +212,8 @@ def main(argv=None):
         for seed in seeds:
             run = folder(gate_cm, count, seed)
             s = read_summary(run)
-            end = stopped(run, opening_time(run))
+            opening = opening_time(run)
+            end = stopped(run, opening)
             if end.startswith("ran the full"):
                 unsettled.append(f"Gate {gate_cm:g} cm, {count} crosses, seed {seed}: the "
                                  f"collapse {end}.")
@@ -229,7 +224,7 @@ def main(argv=None):
             paused += stopped_s
             counted += intervals
             table.append(run_row(gate_cm, count, seed, s, seconds))
-            sanity.append(at_rest_at_opening(run))
+            sanity.append(at_rest_at_opening(run, opening))
             if s["H0_m"] > TALL_M:
                 tall_runs.append((gate_cm, count, seed, regime_name(s)))
     # The runs' wall times laid out two at a time in the order they started.

@@ -286,6 +286,7 @@ def main():
                    "measured": ", ".join(map(str, at_once)), "thesis": "—",
                    "tolerance": "reported", "pass": None})
     runout_changes = lift_changes(results, seeds, "runout_ratio")
+    near = near_the_line(results, seeds)  # the runs on the region test's line, in words
     for seed, runout, height in zip(seeds, runout_changes,
                                     lift_changes(results, seeds, "height_ratio")):
         checks.append({
@@ -341,9 +342,8 @@ def main():
             + ", ".join(f"{100 * results[(x, 'lifted')]['height_loss']:.2f}" for x in seeds)
             + " % (seeds " + ", ".join(map(str, seeds)) + "). The region test's line is "
             "5 %"
-            + (", and " + near_the_line(results, seeds) + " it: the check's verdict rests on "
-               "margins far below a cross's 3 mm thickness" if near_the_line(results, seeds)
-               else "")
+            + (", and " + near + " it: the check's verdict rests on margins far below a "
+               "cross's 3 mm thickness" if near else "")
             + ". Of the runs over it, "
             f"{sum(r['region'] == 1 for r in results.values())} moved their bottom quarter in "
             f"one τc at least {BASE_DRIVEN_SHARE:g} of the sphere column's "
