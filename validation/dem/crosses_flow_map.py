@@ -36,10 +36,18 @@ box's depth, so the rest is not graded.
 `--quick`: the 4 cm gate's 150 crosses, seeds 1 and 2 (no column above 20 cm: the tall
 check is reported as not run).
 
+`--element-contacts mean` pours and collapses with the element contacts of two crosses
+averaged, as Grains3D, the code of the thesis' crosses, does; with `--flat-contacts point`
+too, one contact point per pair of touching elements, Grains3D's whole model. Each model
+maps in its own folders and report (crosses_flow_map_mean, crosses_flow_map_mean_point;
+the wrappers of those names run them).
+
 Writes validation/dem/results/crosses_flow_map.json, the map's CSV in the runs' folder
-(results/runs/crosses_flow_map/map) and docs/validation/figures/crosses_flow_map.png.
+(results/runs/crosses_flow_map/map) and docs/validation/figures/crosses_flow_map.png
+(with another model, its name for crosses_flow_map).
 Usage: /usr/bin/python3 validation/dem/crosses_flow_map.py [--build build] [--quick]
            [--columns 4:150 4:300 ...] [--seeds 1 2 3] [--reuse]
+           [--element-contacts sum|mean [--flat-contacts point]]
 """
 import argparse
 import csv
@@ -49,19 +57,51 @@ import shutil
 import subprocess
 import sys
 import time
+from typing import NamedTuple
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import (call_two_at_a_time, counted_intervals, paused_note,  # noqa: E402
-                      pool_span, read_summary, regime_name, stopped_seconds, stops,
-                      wall_time, write_summary)
+from _outputs import (ONE_POINT_PER_PAIR, call_two_at_a_time, counted_intervals,  # noqa: E402
+                      element_contacts_setting, flat_contacts_setting, paused_note, pool_span,
+                      read_summary, regime_name, stopped_seconds, stops, wall_time,
+                      write_summary)
 from crosses_dam_break import (COLLAPSE_S, RESULTS, ROOT, Column, diagnostics,  # noqa: E402
                                ended_at_rest, opening_time, run_column, seed_settings,
                                stopped)
 
-NAME = "crosses_flow_map"
-RUNS = os.path.join(RESULTS, "runs", NAME)
-MAP = os.path.join(RUNS, "map")
-FIGURE = os.path.join(ROOT, "docs", "validation", "figures", f"{NAME}.png")
+
+
+class Model(NamedTuple):
+    """The contact model a map is made with: the report's name (also of the runs' folder
+    and the figure), its overrides (in the pours and the collapses) and how the report
+    names it."""
+    name: str
+    settings: list
+    words: str
+
+    def runs(self):
+        return os.path.join(RESULTS, "runs", self.name)
+
+    def map(self):
+        return os.path.join(self.runs(), "map")
+
+    def figure(self):
+        return os.path.join(ROOT, "docs", "validation", "figures", f"{self.name}.png")
+
+    def script(self):
+        return f"validation/dem/{self.name}.py"
+
+
+# The model's defaults, and the element contacts of two crosses averaged as Grains3D, the
+# code of the thesis' crosses, averages them: alone, and with its one contact point per
+# pair of touching elements (its whole model). main() chooses one.
+SUM = Model("crosses_flow_map", [], "the element contacts summed, contact patches")
+MEAN = Model("crosses_flow_map_mean", element_contacts_setting("mean"),
+             "the element contacts of two crosses averaged as in Grains3D, contact patches")
+MEAN_POINT = Model("crosses_flow_map_mean_point",
+                   element_contacts_setting("mean") + flat_contacts_setting("point"),
+                   "Grains3D's model: the element contacts of two crosses averaged, one "
+                   "contact point per pair of touching elements")
+model = SUM
 DEPTH_M = 0.06          # the box's depth: the memory case's column (cases/dem/README.md)
 COLUMNS = [(4, 150), (4, 300), (4, 450), (8, 300), (8, 600)]  # (gate [cm], crosses)
 QUICK_COLUMNS = [(4, 150)]
@@ -89,13 +129,13 @@ def column_of(gate_cm, count):
 
 
 def folder(gate_cm, count, seed):
-    return os.path.join(RUNS, f"L{gate_cm:g}cm_{count}", f"seed_{seed}")
+    return os.path.join(model.runs(), f"L{gate_cm:g}cm_{count}", f"seed_{seed}")
 
 
 def run_one(exe, gate_cm, count, seed):
     """Pour, open and collapse one column and seed (one thread; map_columns analyses it)."""
     run_column(exe, column_of(gate_cm, count), folder(gate_cm, count, seed), 1,
-               extra=seed_settings(seed))
+               extra=model.settings + seed_settings(seed))
 
 
 def unfinished(run):
@@ -128,7 +168,7 @@ def run_all(exe, columns, seeds):
 
 def point_folder(gate_cm, count):
     """The folder of a column's ensemble.csv (`sanguis analyze` of its runs)."""
-    return os.path.join(RUNS, "points", f"L{gate_cm:g}cm_{count}")
+    return os.path.join(model.runs(), "points", f"L{gate_cm:g}cm_{count}")
 
 
 def map_columns(exe, columns, seeds):
@@ -142,11 +182,11 @@ def map_columns(exe, columns, seeds):
         subprocess.run([exe, "analyze", *runs, "--out", point], check=True,
                        stdout=subprocess.DEVNULL)
         points.append(point)
-    subprocess.run([exe, "flow-map", *points, "--output", MAP], check=True,
+    subprocess.run([exe, "flow-map", *points, "--output", model.map()], check=True,
                    stdout=subprocess.DEVNULL)
-    os.makedirs(os.path.dirname(FIGURE), exist_ok=True)
-    shutil.copyfile(os.path.join(MAP, "flow_map.png"), FIGURE)
-    with open(os.path.join(MAP, "flow_map.csv"), newline="") as f:
+    os.makedirs(os.path.dirname(model.figure()), exist_ok=True)
+    shutil.copyfile(os.path.join(model.map(), "flow_map.png"), model.figure())
+    with open(os.path.join(model.map(), "flow_map.csv"), newline="") as f:
         rows = list(csv.DictReader(f))
     return {key: row for key, row in zip(columns, rows)}
 
@@ -180,7 +220,20 @@ def main(argv=None):
                     + ")")
     ap.add_argument("--seeds", type=int, nargs="+", help="packings (default 1 2 3)")
     ap.add_argument("--reuse", action="store_true", help="analyse the runs on disk")
+    ap.add_argument("--element-contacts", choices=["sum", "mean"], default="sum",
+                    help="mean: pour and collapse with the element contacts of two crosses "
+                         "averaged, as Grains3D (simulation.element_contacts), in its own "
+                         "folders and report (crosses_flow_map_mean)")
+    ap.add_argument("--flat-contacts", choices=["patch", "point"], default="patch",
+                    help="with --element-contacts mean, point: one contact point per element "
+                         "pair too (simulation.flat_contacts), Grains3D's whole model "
+                         "(crosses_flow_map_mean_point)")
     args = ap.parse_args(argv)
+    global model
+    if args.flat_contacts == "point" and args.element_contacts != "mean":
+        ap.error("--flat-contacts point runs with --element-contacts mean (Grains3D's model)")
+    model = ((MEAN_POINT if args.flat_contacts == "point" else MEAN)
+             if args.element_contacts == "mean" else SUM)
     columns = QUICK_COLUMNS if args.quick else COLUMNS
     if args.columns:
         try:
@@ -205,7 +258,7 @@ def main(argv=None):
                  + "\n".join(left))
     rows = map_columns(exe, columns, seeds)
 
-    stop_list = stops(RUNS)
+    stop_list = stops(model.runs())
     counted, table, sanity, tall_runs, unsettled = [], [], [], [], []
     durations, paused = {}, 0.0
     for gate_cm, count in columns:
@@ -267,29 +320,34 @@ def main(argv=None):
         ("Columns taller than 20 cm: " + f"{tall_moved} of {len(tall_runs)} runs avalanched "
          "at all (collapsed or fractured, not stable)." if tall_runs else
          "No column above 20 cm in this run (--quick or --columns)."),
+    ] + (["The element contacts of two crosses (up to four pairs of arms), and of a cross "
+          "and a wall, are averaged, as Grains3D, the code of the thesis' crosses, does for "
+          "composite particles (simulation.element_contacts = \"mean\"), in the pours and "
+          "the collapses" + (f"; and {ONE_POINT_PER_PAIR}." if model is MEAN_POINT else ".")]
+         if model is not SUM else []) + [
         "The box is 6 cm deep (the back side wall moved, the memory case's column), not the "
         "experiments' 20 cm: the same heights with 3.3 times fewer crosses. The thesis does "
         "not give the depth of the columns of its map.",
         "Runs on one thread, two at a time, on the 2-core VM; the run time lays their wall "
         "times (finished segments: a run stopped and continued counts once) two at a time "
         "in the order they started, the columns of most crosses first.",
-    ] + ([paused_note(paused / 60, NAME)] if paused > 0 else [])
+    ] + ([paused_note(paused / 60, model.name)] if paused > 0 else [])
     summary = {
-        "name": NAME,
+        "name": model.name,
         "title": "Flow-regime map of crosses: repeatable and intermittent columns",
         "thesis": "§3.3.1, Fig. 3.6",
         "description": "Columns of crosses behind the gates of crosses_dam_break's box "
-                       "(Table 3.1, the element contacts summed), 6 cm deep: "
+                       f"(Table 3.1, {model.words}), 6 cm deep: "
                        + ", ".join(f"{n} crosses at {g:g} cm" for g, n in columns)
                        + f", each poured with seeds {', '.join(map(str, seeds))} and "
                        "released at rest with the gate removed at once; each run classified "
                        "by `sanguis analyze`, each column's runs mapped by `sanguis flow-map`.",
-        "command": "/usr/bin/python3 validation/dem/crosses_flow_map.py --build BUILD"
+        "command": f"/usr/bin/python3 {model.script()} --build BUILD"
                    + (" --quick" if args.quick else "")
                    + (" --columns " + " ".join(f"{g:g}:{n}" for g, n in columns)
                       if args.columns else "")
                    + (" --seeds " + " ".join(map(str, seeds)) if args.seeds else ""),
-        "figures": [os.path.relpath(FIGURE, ROOT)],
+        "figures": [os.path.relpath(model.figure(), ROOT)],
         "checks": checks,
         "tables": [{"caption": "Per run (`sanguis analyze`).",
                     "header": ["gate [cm]", "crosses", "seed", "H0 [cm]", "a", "(L∞−L0)/L0",

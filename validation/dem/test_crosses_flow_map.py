@@ -57,6 +57,42 @@ def fake_run(folder, gate_removed_at, last_time, settled):
                 + (", settled" if settled else "") + "\n")
 
 
+class Models(unittest.TestCase):
+    def tearDown(self):
+        fm.model = fm.SUM
+
+    def test_each_model_runs_in_its_own_folders_with_its_overrides(self):
+        folders = set()
+        for m in (fm.SUM, fm.MEAN, fm.MEAN_POINT):
+            fm.model = m
+            folders.add(fm.folder(4, 300, 1))
+            self.assertTrue(fm.folder(4, 300, 1).startswith(m.runs() + os.sep))
+            self.assertTrue(fm.point_folder(4, 300).startswith(m.runs() + os.sep))
+            self.assertTrue(m.figure().endswith(os.path.join("figures", m.name + ".png")))
+        self.assertEqual(len(folders), 3)
+        self.assertEqual(fm.SUM.settings, [])
+        self.assertEqual(fm.MEAN.settings, ["--set", 'simulation.element_contacts="mean"'])
+        self.assertEqual(fm.MEAN_POINT.settings, ["--set", 'simulation.element_contacts="mean"',
+                                                  "--set", 'simulation.flat_contacts="point"'])
+
+    def test_each_model_has_a_wrapper_of_its_name(self):
+        here = os.path.dirname(os.path.abspath(__file__))
+        for m in (fm.SUM, fm.MEAN, fm.MEAN_POINT):
+            self.assertTrue(os.path.exists(os.path.join(here, m.name + ".py")), m.name)
+
+    def test_the_options_choose_the_model_and_one_point_needs_the_mean(self):
+        for argv, chosen in ((["--element-contacts", "mean"], fm.MEAN),
+                             (["--element-contacts", "mean", "--flat-contacts", "point"],
+                              fm.MEAN_POINT),
+                             ([], fm.SUM)):
+            # too few seeds: the model is chosen, then the call is refused before any run
+            with self.assertRaises(SystemExit):
+                fm.main(argv + ["--seeds", "1", "--reuse"])
+            self.assertIs(fm.model, chosen)
+        with self.assertRaises(SystemExit):
+            fm.main(["--flat-contacts", "point", "--reuse"])
+
+
 class Runs(unittest.TestCase):
     def test_the_columns_of_most_crosses_run_first_each_over_every_seed(self):
         self.assertEqual(fm.in_run_order([(4, 150), (8, 600), (4, 300)], [1, 2]),
