@@ -94,6 +94,30 @@ def flat_contacts_setting(kind):
     return ["--set", f'simulation.flat_contacts="{kind}"']
 
 
+def add_contact_model_options(ap, name):
+    """The options every cross script takes to run with Grains3D's contact model, in the
+    folders and report NAME_mean (--element-contacts mean) or NAME_mean_point (and
+    --flat-contacts point); read them back with contact_model()."""
+    ap.add_argument("--element-contacts", choices=["sum", "mean"], default="sum",
+                    help="how the element contacts of two crosses add up (simulation."
+                         "element_contacts): mean, as Grains3D, with Table 3.1, in its own "
+                         f"folders and report ({name}_mean)")
+    ap.add_argument("--flat-contacts", choices=["patch", "point"], default="patch",
+                    help="with --element-contacts mean, point: one contact point per element "
+                         "pair (simulation.flat_contacts) too, Grains3D's whole model, in its "
+                         f"own folders and report ({name}_mean_point)")
+
+
+def contact_model(ap, args):
+    """(mean, point) from the options of add_contact_model_options: the element contacts
+    averaged, one contact point per element pair. One point alone is refused (exit 2):
+    only Grains3D's whole model takes it."""
+    mean, point = args.element_contacts == "mean", args.flat_contacts == "point"
+    if point and not mean:
+        ap.error("--flat-contacts point runs with --element-contacts mean (Grains3D's model)")
+    return mean, point
+
+
 # What one contact point per element pair is, for the notes of the cases that run
 # Grains3D's whole model (the mean and one point).
 ONE_POINT_PER_PAIR = ("one contact point per pair of touching elements (simulation.flat_contacts "

@@ -74,12 +74,12 @@ import matplotlib
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import (ONE_POINT_PER_PAIR, TWIST_MOMENT_EFFECT,  # noqa: E402
-                      TWIST_MOMENT_FROM, call_two_at_a_time, counted_intervals,
-                      element_contacts_setting, flat_contacts_setting, paused_note,
-                      pool_span, read_arrays, read_pvd,
-                      segment_starts, read_summary, regime_name, speed_landmarks,
-                      stopped_seconds, stops, wall_time, write_summary)
+from _outputs import (ONE_POINT_PER_PAIR, TWIST_MOMENT_EFFECT, TWIST_MOMENT_FROM,  # noqa: E402
+                      add_contact_model_options, call_two_at_a_time, contact_model,
+                      counted_intervals, element_contacts_setting, flat_contacts_setting,
+                      paused_note, pool_span, read_arrays, read_pvd, read_summary, regime_name,
+                      segment_starts, speed_landmarks, stopped_seconds, stops, wall_time,
+                      write_summary)
 from crosses_calibrated_gates import (GAMMA_T, KT, collapse, finished,  # noqa: E402
                                       seed_settings)
 from crosses_dam_break import (RESULTS, ROOT, Column, diagnostics, draw_velocity_bands,  # noqa: E402
@@ -436,19 +436,10 @@ def main(argv=None):
     ap.add_argument("--threads", type=int, default=1,
                     help="threads of each run (two run at a time; one run alone on two "
                          "threads gives its result in half the time, and the same bits)")
-    ap.add_argument("--element-contacts", choices=["sum", "mean"], default="sum",
-                    help="mean: pour and collapse with the element contacts of two crosses "
-                         "averaged, as Grains3D, and Table 3.1 (no calibration), in their own "
-                         "folders and report (crosses_column_width_mean)")
-    ap.add_argument("--flat-contacts", choices=["patch", "point"], default="patch",
-                    help="with --element-contacts mean, point: one contact point per element "
-                         "pair (simulation.flat_contacts) too, Grains3D's model, in its own "
-                         "folders and report (crosses_column_width_mean_point)")
+    add_contact_model_options(ap, SUM.name)
     args = ap.parse_args(argv)
-    point = args.flat_contacts == "point"
-    if point and args.element_contacts != "mean":
-        ap.error("--flat-contacts point runs with --element-contacts mean (Grains3D's model)")
-    variant = (MEAN_POINT if point else MEAN) if args.element_contacts == "mean" else SUM
+    mean, point = contact_model(ap, args)
+    variant = (MEAN_POINT if point else MEAN) if mean else SUM
     if args.finished_only and not args.reuse:
         ap.error("--finished-only reports runs on disk: give --reuse as well")
     if args.quick:

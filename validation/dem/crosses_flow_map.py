@@ -60,7 +60,8 @@ import time
 from typing import NamedTuple
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import (ONE_POINT_PER_PAIR, call_two_at_a_time, counted_intervals,  # noqa: E402
+from _outputs import (ONE_POINT_PER_PAIR, add_contact_model_options,  # noqa: E402
+                      call_two_at_a_time, contact_model, counted_intervals,
                       element_contacts_setting, flat_contacts_setting, paused_note, pool_span,
                       read_summary, regime_name, stopped_seconds, stops, wall_time,
                       write_summary)
@@ -220,20 +221,11 @@ def main(argv=None):
                     + ")")
     ap.add_argument("--seeds", type=int, nargs="+", help="packings (default 1 2 3)")
     ap.add_argument("--reuse", action="store_true", help="analyse the runs on disk")
-    ap.add_argument("--element-contacts", choices=["sum", "mean"], default="sum",
-                    help="mean: pour and collapse with the element contacts of two crosses "
-                         "averaged, as Grains3D (simulation.element_contacts), in its own "
-                         "folders and report (crosses_flow_map_mean)")
-    ap.add_argument("--flat-contacts", choices=["patch", "point"], default="patch",
-                    help="with --element-contacts mean, point: one contact point per element "
-                         "pair too (simulation.flat_contacts), Grains3D's whole model "
-                         "(crosses_flow_map_mean_point)")
+    add_contact_model_options(ap, SUM.name)
     args = ap.parse_args(argv)
     global model
-    if args.flat_contacts == "point" and args.element_contacts != "mean":
-        ap.error("--flat-contacts point runs with --element-contacts mean (Grains3D's model)")
-    model = ((MEAN_POINT if args.flat_contacts == "point" else MEAN)
-             if args.element_contacts == "mean" else SUM)
+    mean, point = contact_model(ap, args)
+    model = (MEAN_POINT if point else MEAN) if mean else SUM
     columns = QUICK_COLUMNS if args.quick else COLUMNS
     if args.columns:
         try:

@@ -51,10 +51,11 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import (ONE_POINT_PER_PAIR, continuation_command,  # noqa: E402
-                      counted_intervals, element_contacts_setting, flat_contacts_setting,
-                      paused_note, pour_command, read_summary, run_two_at_a_time, span,
-                      stopped_seconds, stops, two_at_a_time_span, wall_time, write_summary)
+from _outputs import (ONE_POINT_PER_PAIR, add_contact_model_options, contact_model,  # noqa: E402
+                      continuation_command, counted_intervals, element_contacts_setting,
+                      flat_contacts_setting, paused_note, pour_command, read_summary,
+                      run_two_at_a_time, span, stopped_seconds, stops, two_at_a_time_span,
+                      wall_time, write_summary)
 from crosses_tangential_map import (CASE, GATE_TIME, LOCAL_GAMMA, LOCAL_KT, RESULTS,  # noqa: E402
                                     ROOT, TABLE_31, classify, settings, sphere_reference)
 
@@ -199,15 +200,7 @@ def main(argv=None):
     ap.add_argument("--rerun-pours", action="store_true", help="pour again (and run again)")
     ap.add_argument("--rerun", action="store_true", help="run every continuation again")
     ap.add_argument("--quick", action="store_true", help="same as the full run")
-    ap.add_argument("--element-contacts", choices=["sum", "mean"], default="sum",
-                    help="how the element contacts of two crosses add up (simulation."
-                         "element_contacts): mean, as Grains3D, runs in its own folders and "
-                         "summary (crosses_tangential_packings_mean)")
-    ap.add_argument("--flat-contacts", choices=["patch", "point"], default="patch",
-                    help="with --element-contacts mean, point: one contact point per element "
-                         "pair (simulation.flat_contacts) in the pours and the continuations "
-                         "too, Grains3D's model, in its own folders and summary "
-                         "(crosses_tangential_packings_mean_point)")
+    add_contact_model_options(ap, "crosses_tangential_packings")
     ap.add_argument("--table31-only", action="store_true",
                     help="pour and run the Table 3.1 point only, print its regions, no report")
     ap.add_argument("--open-with-sum", action="store_true",
@@ -219,9 +212,7 @@ def main(argv=None):
                          "with one contact point per element pair and the mean, the model of "
                          "the thesis' Grains3D (folders *_opened_point)")
     args = ap.parse_args(argv)
-    mean, point = args.element_contacts == "mean", args.flat_contacts == "point"
-    if point and not mean:
-        ap.error("--flat-contacts point runs with --element-contacts mean (Grains3D's model)")
+    mean, point = contact_model(ap, args)
     if point and (args.open_with_sum or args.open_with_point):
         ap.error("--open-with-sum and --open-with-point open pours made with the patches: "
                  "leave out --flat-contacts point")
