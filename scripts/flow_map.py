@@ -131,8 +131,10 @@ def draw(points, path):
                    marker=marker, s=70, color=colour, label=label, zorder=3)
         if kind == INTERMITTENT:
             for p in chosen:
-                ax.annotate(" " + "/".join(f"{p[r]}{r[0]}" for r in REGIMES if p[r]),
-                            (100 * p["L0_m"], 100 * p["H0_m"]), fontsize=7)
+                # offset clear of the marker (s=70 is about 8 points across)
+                ax.annotate("/".join(f"{p[r]}{r[0]}" for r in REGIMES if p[r]),
+                            (100 * p["L0_m"], 100 * p["H0_m"]), xytext=(7, 5),
+                            textcoords="offset points", fontsize=7)
     top = 1.15 * max(100 * p["H0_m"] for p in points)
     right = 1.15 * max(100 * p["L0_m"] for p in points)
     for a in (1, 3, 10):  # lines of constant aspect ratio H0 / L0
