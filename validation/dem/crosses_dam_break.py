@@ -34,10 +34,12 @@ folder left with a checkpoint by a stopped run is continued from it (hours-long 
 can span several sessions).
 `--element-contacts mean` pours and collapses with the element contacts of two crosses
 averaged, as Grains3D does (crosses_dam_break_mean.py runs it), and with it `--sum-control`
-pours each column again (the same steps, checked row by row) and opens it with the sum.
+pours each column again (the same steps, checked row by row) and opens it with the sum;
+`--element-contacts mean --flat-contacts point` runs Grains3D's whole model, one contact point
+per element pair too (crosses_dam_break_mean_point.py runs it).
 Usage: /usr/bin/python3 validation/dem/crosses_dam_break.py [--build build] [--hold-file F]
            [--gates 4 8 ...] [--threads T] [--reuse] [--quick]
-           [--element-contacts sum|mean [--sum-control]]
+           [--element-contacts sum|mean [--sum-control | --flat-contacts point]]
 """
 import argparse
 import csv
@@ -52,8 +54,10 @@ from typing import NamedTuple
 import matplotlib
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import (counted_intervals, element_contacts_setting, read_summary,  # noqa: E402
-                      regime_name, stopped_seconds, stops, wall_time, write_summary)
+from _outputs import (ONE_POINT_PER_PAIR, add_contact_model_options,  # noqa: E402
+                      contact_model, counted_intervals, element_contacts_setting,
+                      flat_contacts_setting, read_summary, regime_name, stopped_seconds, stops,
+                      wall_time, write_summary)
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -398,23 +402,24 @@ def main(argv=None):
     ap.add_argument("--reuse", action="store_true", help="analyse the runs already on disk")
     ap.add_argument("--quick", action="store_true", help="same as the default (the 4 cm gate)")
     ap.add_argument("--hold-file", help="before each run segment, wait while this file exists")
-    ap.add_argument("--element-contacts", choices=["sum", "mean"], default="sum",
-                    help="how the element contacts of two crosses add up (simulation."
-                         "element_contacts): mean, as Grains3D, runs in its own folders and "
-                         "report (crosses_dam_break_mean)")
+    add_contact_model_options(ap, "crosses_dam_break")
     ap.add_argument("--sum-control", action="store_true",
                     help="with --element-contacts mean: pour each column again with the mean "
                          "(the same bits) and open it with the sum (folders *_opened_sum): "
                          "what the rule changes after the opening alone")
     args = ap.parse_args(argv)
-    if args.sum_control and args.element_contacts != "mean":
+    mean, point = contact_model(ap, args)
+    if args.sum_control and not mean:
         ap.error("--sum-control opens pours made with the mean: give --element-contacts mean")
+    if args.sum_control and point:
+        ap.error("--sum-control opens the mean's pours with the sum and the patches: leave "
+                 "out --flat-contacts point")
     exe = os.path.join(ROOT, args.build, "app", "sanguis")
-    mean = args.element_contacts == "mean"
-    name = "crosses_dam_break" + ("_mean" if mean else "")
+    name = "crosses_dam_break" + ("_mean" if mean else "") + ("_point" if point else "")
     run_root = os.path.join(RESULTS, "runs", name)
     figure = os.path.join(ROOT, "docs", "validation", "figures", name + ".png")
-    rule = element_contacts_setting("mean") if mean else []
+    rule = (element_contacts_setting("mean") if mean else []) + (
+        flat_contacts_setting("point") if point else [])
     runs = {}  # (gate, opened with the sum after a pour with the mean) -> folder
     for gate in args.gates:
         out = os.path.join(run_root, f"L{gate}cm_seed{SEED}")
@@ -496,7 +501,8 @@ def main(argv=None):
                         "of a cross and one wall, averaged as Grains3D, the thesis' code, does "
                         "for composite particles: simulation.element_contacts = \"mean\" in "
                         "the pour and the collapse (crosses_dam_break sums them, the model's "
-                        "default).")
+                        "default)" + (f"; and {ONE_POINT_PER_PAIR}: Grains3D's whole contact "
+                                      "model." if point else "."))
     elif 30 not in args.gates:
         notes.append(POINT_MODEL_30CM)
     # Each run's stops (PAUSES.txt) that fell in its counted segments: its wall time holds them.
@@ -548,7 +554,8 @@ def main(argv=None):
     summary = {
         "name": name,
         "title": "Dam break of crosses in the experiments' box"
-                 + (", element contacts averaged as in Grains3D" if mean else ""),
+                 + (", element contacts averaged as in Grains3D" if mean else "")
+                 + (", one contact point per element pair" if point else ""),
         "thesis": "§3.2-3.3, Table 3.1, Fig. 3.7-3.9, Table B.1",
         "description": (
             "cases/dem/dam-break-crosses.toml: box 64 x 30 x 20 cm, Table 3.1 crosses poured "

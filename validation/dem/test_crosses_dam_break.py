@@ -183,6 +183,20 @@ class SumControl(unittest.TestCase):
         with self.assertRaises(SystemExit):
             db.main(["--sum-control"])
 
+    def test_one_point_needs_the_mean_and_has_no_control(self):
+        # both refused before any run (exit 2): one point alone is not Grains3D's model, and
+        # the control opens the mean's patch-made pours with the sum
+        for argv in (["--flat-contacts", "point"],
+                     ["--element-contacts", "mean", "--flat-contacts", "point",
+                      "--sum-control"]):
+            with self.assertRaises(SystemExit) as raised:
+                db.main(argv)
+            self.assertEqual(raised.exception.code, 2)
+
+    def test_grains3d_model_has_a_wrapper(self):
+        here = os.path.dirname(os.path.abspath(__file__))
+        self.assertTrue(os.path.exists(os.path.join(here, "crosses_dam_break_mean_point.py")))
+
 
 if __name__ == "__main__":
     unittest.main()
