@@ -70,7 +70,6 @@ from crosses_dam_break import (COLLAPSE_S, RESULTS, ROOT, Column, diagnostics,  
                                stopped)
 
 
-
 class Model(NamedTuple):
     """The contact model a map is made with: the report's name (also of the runs' folder
     and the figure), its overrides (in the pours and the collapses) and how the report
@@ -92,9 +91,9 @@ class Model(NamedTuple):
         return f"validation/dem/{self.name}.py"
 
 
-# The model's defaults, and the element contacts of two crosses averaged as Grains3D, the
-# code of the thesis' crosses, averages them: alone, and with its one contact point per
-# pair of touching elements (its whole model). main() chooses one.
+# The model's defaults (the sum, the patches); the element contacts of two crosses averaged,
+# as Grains3D, the code of the thesis' crosses, does; and that with one contact point per
+# pair of touching elements, Grains3D's whole model. main() chooses one.
 SUM = Model("crosses_flow_map", [], "the element contacts summed, contact patches")
 MEAN = Model("crosses_flow_map_mean", element_contacts_setting("mean"),
              "the element contacts of two crosses averaged as in Grains3D, contact patches")
