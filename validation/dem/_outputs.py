@@ -94,13 +94,15 @@ def flat_contacts_setting(kind):
     return ["--set", f'simulation.flat_contacts="{kind}"']
 
 
-def add_contact_model_options(ap, name):
-    """The options every cross script takes to run with Grains3D's contact model, in the
-    folders and report NAME_mean (--element-contacts mean) or NAME_mean_point (and
-    --flat-contacts point); read them back with contact_model()."""
+def add_contact_model_options(ap, name, detail):
+    """--element-contacts and --flat-contacts, the options with which crosses_column_width,
+    crosses_dam_break, crosses_flow_map and crosses_tangential_packings run Grains3D's
+    contact model, in the folders and report NAME_mean (--element-contacts mean) or
+    NAME_mean_point (and --flat-contacts point); `detail` says what else those runs take
+    (their tangential parameters). Read them back with contact_model()."""
     ap.add_argument("--element-contacts", choices=["sum", "mean"], default="sum",
                     help="how the element contacts of two crosses add up (simulation."
-                         "element_contacts): mean, as Grains3D, with Table 3.1, in its own "
+                         f"element_contacts): mean, as Grains3D, {detail}, in its own "
                          f"folders and report ({name}_mean)")
     ap.add_argument("--flat-contacts", choices=["patch", "point"], default="patch",
                     help="with --element-contacts mean, point: one contact point per element "
@@ -116,6 +118,18 @@ def contact_model(ap, args):
     if point and not mean:
         ap.error("--flat-contacts point runs with --element-contacts mean (Grains3D's model)")
     return mean, point
+
+
+def contact_model_suffix(mean, point):
+    """What the model adds to a case's name (its runs' folder, figure and report)."""
+    return ("_mean" if mean else "") + ("_point" if point else "")
+
+
+def contact_model_settings(mean, point):
+    """The `sanguis run` overrides of the model (none for the defaults, the sum and the
+    patches)."""
+    return ((element_contacts_setting("mean") if mean else [])
+            + (flat_contacts_setting("point") if point else []))
 
 
 # What one contact point per element pair is, for the notes of the cases that run

@@ -436,7 +436,7 @@ def main(argv=None):
     ap.add_argument("--threads", type=int, default=1,
                     help="threads of each run (two run at a time; one run alone on two "
                          "threads gives its result in half the time, and the same bits)")
-    add_contact_model_options(ap, SUM.name)
+    add_contact_model_options(ap, SUM.name, "with Table 3.1 throughout (no calibration)")
     args = ap.parse_args(argv)
     mean, point = contact_model(ap, args)
     variant = (MEAN_POINT if point else MEAN) if mean else SUM

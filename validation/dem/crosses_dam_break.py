@@ -54,10 +54,10 @@ from typing import NamedTuple
 import matplotlib
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import (ONE_POINT_PER_PAIR, add_contact_model_options,  # noqa: E402
-                      contact_model, counted_intervals, element_contacts_setting,
-                      flat_contacts_setting, read_summary, regime_name, stopped_seconds, stops,
-                      wall_time, write_summary)
+from _outputs import (ONE_POINT_PER_PAIR, add_contact_model_options, contact_model,  # noqa: E402
+                      contact_model_settings, contact_model_suffix, counted_intervals,
+                      element_contacts_setting, read_summary, regime_name, stopped_seconds,
+                      stops, wall_time, write_summary)
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -402,7 +402,7 @@ def main(argv=None):
     ap.add_argument("--reuse", action="store_true", help="analyse the runs already on disk")
     ap.add_argument("--quick", action="store_true", help="same as the default (the 4 cm gate)")
     ap.add_argument("--hold-file", help="before each run segment, wait while this file exists")
-    add_contact_model_options(ap, "crosses_dam_break")
+    add_contact_model_options(ap, "crosses_dam_break", "with Table 3.1")
     ap.add_argument("--sum-control", action="store_true",
                     help="with --element-contacts mean: pour each column again with the mean "
                          "(the same bits) and open it with the sum (folders *_opened_sum): "
@@ -415,11 +415,10 @@ def main(argv=None):
         ap.error("--sum-control opens the mean's pours with the sum and the patches: leave "
                  "out --flat-contacts point")
     exe = os.path.join(ROOT, args.build, "app", "sanguis")
-    name = "crosses_dam_break" + ("_mean" if mean else "") + ("_point" if point else "")
+    name = "crosses_dam_break" + contact_model_suffix(mean, point)
     run_root = os.path.join(RESULTS, "runs", name)
     figure = os.path.join(ROOT, "docs", "validation", "figures", name + ".png")
-    rule = (element_contacts_setting("mean") if mean else []) + (
-        flat_contacts_setting("point") if point else [])
+    rule = contact_model_settings(mean, point)
     runs = {}  # (gate, opened with the sum after a pour with the mean) -> folder
     for gate in args.gates:
         out = os.path.join(run_root, f"L{gate}cm_seed{SEED}")

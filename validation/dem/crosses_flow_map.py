@@ -60,11 +60,10 @@ import time
 from typing import NamedTuple
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import (ONE_POINT_PER_PAIR, add_contact_model_options,  # noqa: E402
-                      call_two_at_a_time, contact_model, counted_intervals,
-                      element_contacts_setting, flat_contacts_setting, paused_note, pool_span,
-                      read_summary, regime_name, stopped_seconds, stops, wall_time,
-                      write_summary)
+from _outputs import (ONE_POINT_PER_PAIR, add_contact_model_options, call_two_at_a_time,  # noqa: E402
+                      contact_model, contact_model_settings, counted_intervals, paused_note,
+                      pool_span, read_summary, regime_name, stopped_seconds, stops,
+                      wall_time, write_summary)
 from crosses_dam_break import (COLLAPSE_S, RESULTS, ROOT, Column, diagnostics,  # noqa: E402
                                ended_at_rest, opening_time, run_column, seed_settings,
                                stopped)
@@ -95,10 +94,9 @@ class Model(NamedTuple):
 # as Grains3D, the code of the thesis' crosses, does; and that with one contact point per
 # pair of touching elements, Grains3D's whole model. main() chooses one.
 SUM = Model("crosses_flow_map", [], "the element contacts summed, contact patches")
-MEAN = Model("crosses_flow_map_mean", element_contacts_setting("mean"),
+MEAN = Model("crosses_flow_map_mean", contact_model_settings(True, False),
              "the element contacts of two crosses averaged as in Grains3D, contact patches")
-MEAN_POINT = Model("crosses_flow_map_mean_point",
-                   element_contacts_setting("mean") + flat_contacts_setting("point"),
+MEAN_POINT = Model("crosses_flow_map_mean_point", contact_model_settings(True, True),
                    "Grains3D's model: the element contacts of two crosses averaged, one "
                    "contact point per pair of touching elements")
 model = SUM
@@ -220,7 +218,7 @@ def main(argv=None):
                     + ")")
     ap.add_argument("--seeds", type=int, nargs="+", help="packings (default 1 2 3)")
     ap.add_argument("--reuse", action="store_true", help="analyse the runs on disk")
-    add_contact_model_options(ap, SUM.name)
+    add_contact_model_options(ap, SUM.name, "with Table 3.1")
     args = ap.parse_args(argv)
     global model
     mean, point = contact_model(ap, args)
@@ -325,7 +323,9 @@ def main(argv=None):
     ] + ([paused_note(paused / 60, model.name)] if paused > 0 else [])
     summary = {
         "name": model.name,
-        "title": "Flow-regime map of crosses: repeatable and intermittent columns",
+        "title": "Flow-regime map of crosses: repeatable and intermittent columns"
+                 + (", element contacts averaged as in Grains3D" if model is not SUM else "")
+                 + (", one contact point per element pair" if model is MEAN_POINT else ""),
         "thesis": "§3.3.1, Fig. 3.6",
         "description": "Columns of crosses behind the gates of crosses_dam_break's box "
                        f"(Table 3.1, {model.words}), 6 cm deep: "

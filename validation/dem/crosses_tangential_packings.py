@@ -52,10 +52,10 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from _outputs import (ONE_POINT_PER_PAIR, add_contact_model_options, contact_model,  # noqa: E402
-                      continuation_command, counted_intervals, element_contacts_setting,
-                      flat_contacts_setting, paused_note, pour_command, read_summary,
-                      run_two_at_a_time, span, stopped_seconds, stops, two_at_a_time_span,
-                      wall_time, write_summary)
+                      contact_model_settings, contact_model_suffix, continuation_command,
+                      counted_intervals, flat_contacts_setting, paused_note, pour_command,
+                      read_summary, run_two_at_a_time, span, stopped_seconds, stops,
+                      two_at_a_time_span, wall_time, write_summary)
 from crosses_tangential_map import (CASE, GATE_TIME, LOCAL_GAMMA, LOCAL_KT, RESULTS,  # noqa: E402
                                     ROOT, TABLE_31, classify, settings, sphere_reference)
 
@@ -200,7 +200,8 @@ def main(argv=None):
     ap.add_argument("--rerun-pours", action="store_true", help="pour again (and run again)")
     ap.add_argument("--rerun", action="store_true", help="run every continuation again")
     ap.add_argument("--quick", action="store_true", help="same as the full run")
-    add_contact_model_options(ap, "crosses_tangential_packings")
+    add_contact_model_options(ap, "crosses_tangential_packings",
+                              "the same 3 x 3 in the pours and the continuations")
     ap.add_argument("--table31-only", action="store_true",
                     help="pour and run the Table 3.1 point only, print its regions, no report")
     ap.add_argument("--open-with-sum", action="store_true",
@@ -224,11 +225,10 @@ def main(argv=None):
         ap.error("--open-with-sum and --open-with-point open the mean's pours at Table 3.1 "
                  "only: give --element-contacts mean --table31-only")
     exe = os.path.join(ROOT, args.build, "app", "sanguis")
-    name = "crosses_tangential_packings" + ("_mean" if mean else "") + ("_point" if point else "")
+    name = "crosses_tangential_packings" + contact_model_suffix(mean, point)
     runs = os.path.join(RESULTS, "runs", name)
     figure = os.path.join(ROOT, "docs", "validation", "figures", name + ".png")
-    rule = (element_contacts_setting("mean") if mean else []) + (
-        flat_contacts_setting("point") if point else [])
+    rule = contact_model_settings(mean, point)
     t0 = time.time()
     pours = {seed: os.path.join(runs, f"pour_seed_{seed}") for seed in SEEDS}
     reused = []  # wall times of runs kept from an earlier call: they count in the run time

@@ -1,11 +1,14 @@
 """Unit tests of crosses_dam_break's end of a collapse (run by ctest
 ValidationScripts.DemHelpers)."""
+import contextlib
+import io
 import math
 import os
 import sys
 import tempfile
 import tomllib
 import unittest
+from unittest import mock
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import crosses_dam_break as db  # noqa: E402
@@ -179,24 +182,35 @@ class SumControl(unittest.TestCase):
             self.assertEqual(db.same_pour(other, run), (False, 2))
             self.assertFalse(db.same_pour(late, run)[0])  # opened elsewhere
 
+    def refused(self, argv):
+        """The exit code and message of db.main(argv); a run started fails the test."""
+        err = io.StringIO()
+        with mock.patch.object(db, "run_gate", side_effect=AssertionError("a run started")), \
+                contextlib.redirect_stderr(err), self.assertRaises(SystemExit) as raised:
+            db.main(argv)
+        return raised.exception.code, err.getvalue()
+
     def test_the_control_needs_the_mean(self):
-        with self.assertRaises(SystemExit):
-            db.main(["--sum-control"])
+        code, message = self.refused(["--sum-control"])
+        self.assertEqual(code, 2)
+        self.assertIn("--sum-control opens pours made with the mean", message)
 
     def test_one_point_needs_the_mean_and_has_no_control(self):
-        # both refused before any run (exit 2): one point alone is not Grains3D's model, and
-        # the control opens the mean's patch-made pours with the sum
-        for argv in (["--flat-contacts", "point"],
-                     ["--element-contacts", "mean", "--flat-contacts", "point",
-                      "--sum-control"]):
-            with self.assertRaises(SystemExit) as raised:
-                db.main(argv)
-            self.assertEqual(raised.exception.code, 2)
+        # one point alone is not Grains3D's model; the control opens the mean's patch-made
+        # pours with the sum
+        code, message = self.refused(["--flat-contacts", "point"])
+        self.assertEqual(code, 2)
+        self.assertIn("--flat-contacts point runs with", message)
+        code, message = self.refused(["--element-contacts", "mean", "--flat-contacts", "point",
+                                      "--sum-control"])
+        self.assertEqual(code, 2)
+        self.assertIn("leave out --flat-contacts point", message)
 
-    def test_grains3d_model_has_a_wrapper(self):
+    def test_grains3d_model_has_a_wrapper_that_chooses_it(self):
         here = os.path.dirname(os.path.abspath(__file__))
-        self.assertTrue(os.path.exists(os.path.join(here, "crosses_dam_break_mean_point.py")))
-
+        with open(os.path.join(here, "crosses_dam_break_mean_point.py")) as f:
+            self.assertIn('crosses_dam_break.main(["--element-contacts", "mean", '
+                          '"--flat-contacts", "point"]', f.read())
 
 if __name__ == "__main__":
     unittest.main()

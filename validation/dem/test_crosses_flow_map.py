@@ -1,10 +1,13 @@
 """Unit tests of crosses_flow_map's columns and outcomes (run by ctest
 ValidationScripts.DemHelpers)."""
+import contextlib
+import io
 import os
 import sys
 import tempfile
 import tomllib
 import unittest
+from unittest import mock
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import crosses_dam_break as db  # noqa: E402
@@ -75,22 +78,45 @@ class Models(unittest.TestCase):
         self.assertEqual(fm.MEAN_POINT.settings, ["--set", 'simulation.element_contacts="mean"',
                                                   "--set", 'simulation.flat_contacts="point"'])
 
-    def test_each_model_has_a_wrapper_of_its_name(self):
+    def test_each_model_has_a_wrapper_of_its_name_that_chooses_it(self):
         here = os.path.dirname(os.path.abspath(__file__))
-        for m in (fm.SUM, fm.MEAN, fm.MEAN_POINT):
-            self.assertTrue(os.path.exists(os.path.join(here, m.name + ".py")), m.name)
+        flags = [(fm.SUM, None), (fm.MEAN, '["--element-contacts", "mean"]'),
+                 (fm.MEAN_POINT, '["--element-contacts", "mean", "--flat-contacts", "point"]')]
+        for m, chosen_by in flags:
+            path = os.path.join(here, m.name + ".py")
+            self.assertTrue(os.path.exists(path), m.name)
+            if chosen_by:
+                with open(path) as f:
+                    self.assertIn(f"crosses_flow_map.main({chosen_by}", f.read())
+
+    def test_a_run_takes_the_models_overrides(self):
+        calls = []
+        with mock.patch.object(fm, "run_column",
+                               lambda exe, col, out, threads, extra: calls.append(extra)):
+            for m in (fm.SUM, fm.MEAN_POINT):
+                fm.model = m
+                fm.run_one("sanguis", 4, 150, 1)
+        self.assertEqual(calls, [["--set", "simulation.seed=1"],
+                                 fm.MEAN_POINT.settings + ["--set", "simulation.seed=1"]])
 
     def test_the_options_choose_the_model_and_one_point_needs_the_mean(self):
-        for argv, chosen in ((["--element-contacts", "mean"], fm.MEAN),
-                             (["--element-contacts", "mean", "--flat-contacts", "point"],
-                              fm.MEAN_POINT),
-                             ([], fm.SUM)):
-            # too few seeds: the model is chosen, then the call is refused before any run
-            with self.assertRaises(SystemExit):
-                fm.main(argv + ["--seeds", "1", "--reuse"])
-            self.assertIs(fm.model, chosen)
-        with self.assertRaises(SystemExit):
-            fm.main(["--flat-contacts", "point", "--reuse"])
+        # Results go to a scratch folder and one seed ends every call before any run or
+        # mapping: a lost check cannot touch the maps on disk.
+        with tempfile.TemporaryDirectory() as tmp, mock.patch.object(fm, "RESULTS", tmp):
+            for argv, chosen in ((["--element-contacts", "mean"], fm.MEAN),
+                                 (["--element-contacts", "mean", "--flat-contacts", "point"],
+                                  fm.MEAN_POINT),
+                                 ([], fm.SUM)):
+                err = io.StringIO()
+                with contextlib.redirect_stderr(err), self.assertRaises(SystemExit):
+                    fm.main(argv + ["--seeds", "1", "--reuse"])
+                self.assertIn("at least two packings", err.getvalue())
+                self.assertIs(fm.model, chosen)
+            err = io.StringIO()
+            with contextlib.redirect_stderr(err), self.assertRaises(SystemExit) as raised:
+                fm.main(["--flat-contacts", "point", "--seeds", "1", "--reuse"])
+            self.assertEqual(raised.exception.code, 2)
+            self.assertIn("--flat-contacts point runs with", err.getvalue())
 
 
 class Runs(unittest.TestCase):

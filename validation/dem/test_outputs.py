@@ -1,8 +1,11 @@
 """Tests of validation/dem/_outputs.py, the readers and run-folder helpers every DEM
 validation script relies on. Run by ctest (ValidationScripts.DemHelpers) or by hand:
 /usr/bin/python3 -m unittest discover -s validation/dem -p 'test_*.py'"""
+import argparse
 import base64
+import contextlib
 import functools
+import io
 import json
 import os
 import shutil
@@ -38,6 +41,33 @@ def write_text(folder, name, text):
 def write_run_log(folder, lines):
     os.makedirs(folder, exist_ok=True)
     write_text(folder, "run.log", "\n".join(lines) + "\n")
+
+
+class ContactModel(unittest.TestCase):
+    def parse(self, argv):
+        ap = argparse.ArgumentParser()
+        _outputs.add_contact_model_options(ap, "case", "with Table 3.1")
+        return _outputs.contact_model(ap, ap.parse_args(argv))
+
+    def test_the_options_give_the_model_its_name_and_overrides(self):
+        self.assertEqual(self.parse([]), (False, False))
+        self.assertEqual(self.parse(["--element-contacts", "mean"]), (True, False))
+        self.assertEqual(self.parse(["--element-contacts", "mean", "--flat-contacts", "point"]),
+                         (True, True))
+        self.assertEqual(_outputs.contact_model_suffix(False, False), "")
+        self.assertEqual(_outputs.contact_model_suffix(True, False), "_mean")
+        self.assertEqual(_outputs.contact_model_suffix(True, True), "_mean_point")
+        self.assertEqual(_outputs.contact_model_settings(False, False), [])
+        self.assertEqual(_outputs.contact_model_settings(True, True),
+                         ["--set", 'simulation.element_contacts="mean"',
+                          "--set", 'simulation.flat_contacts="point"'])
+
+    def test_one_point_without_the_mean_is_refused_with_exit_2(self):
+        err = io.StringIO()
+        with contextlib.redirect_stderr(err), self.assertRaises(SystemExit) as raised:
+            self.parse(["--flat-contacts", "point"])
+        self.assertEqual(raised.exception.code, 2)
+        self.assertIn("--flat-contacts point runs with --element-contacts mean", err.getvalue())
 
 
 class ReadArrays(unittest.TestCase):
