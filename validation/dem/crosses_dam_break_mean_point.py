@@ -7,7 +7,7 @@ the collapse (thesis §2.3, §3.2-3.3, Fig. 3.7-3.9).
 In the experiments' box (20 cm deep) the 4 cm gate's column collapses with the mean and
 the patches (crosses_dam_break_mean) and fractures with the sum (crosses_dam_break); in the
 6 cm deep box of crosses_flow_map_mean_point the tall column (450 crosses, H0 26 cm)
-fractured with this model on its first two pours (2026-12-06).
+fractures with this model on all three pours (2026-12-06).
 This case runs the same gates and checks as crosses_dam_break with Grains3D's whole model,
 in its own folders (validation/dem/results/runs/crosses_dam_break_mean_point).
 
