@@ -125,6 +125,12 @@ def contact_model_suffix(mean, point):
     return ("_mean" if mean else "") + ("_point" if point else "")
 
 
+def contact_model_title(mean, point):
+    """What the model adds to a report's title (nothing for the defaults)."""
+    return ((", element contacts averaged as in Grains3D" if mean else "")
+            + (", one contact point per element pair" if point else ""))
+
+
 def contact_model_settings(mean, point):
     """The `sanguis run` overrides of the model (none for the defaults, the sum and the
     patches)."""

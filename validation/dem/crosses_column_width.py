@@ -76,10 +76,10 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from _outputs import (ONE_POINT_PER_PAIR, TWIST_MOMENT_EFFECT, TWIST_MOMENT_FROM,  # noqa: E402
                       add_contact_model_options, call_two_at_a_time, contact_model,
-                      counted_intervals, element_contacts_setting, flat_contacts_setting,
-                      paused_note, pool_span, read_arrays, read_pvd, read_summary, regime_name,
-                      segment_starts, speed_landmarks, stopped_seconds, stops, wall_time,
-                      write_summary)
+                      contact_model_title, counted_intervals, element_contacts_setting,
+                      flat_contacts_setting, paused_note, pool_span, read_arrays, read_pvd,
+                      read_summary, regime_name, segment_starts, speed_landmarks,
+                      stopped_seconds, stops, wall_time, write_summary)
 from crosses_calibrated_gates import (GAMMA_T, KT, collapse, finished,  # noqa: E402
                                       seed_settings)
 from crosses_dam_break import (RESULTS, ROOT, Column, diagnostics, draw_velocity_bands,  # noqa: E402
@@ -527,8 +527,7 @@ def main(argv=None):
     summary = {
         "name": variant.name,
         "title": "Narrow and wide columns of crosses at a = 3.2"
-                 + ("" if variant.tangential else ", element contacts averaged as in Grains3D")
-                 + (", one contact point per element pair" if point else ""),
+                 + contact_model_title(mean, point),
         "thesis": "§3.3.2, Fig. 3.9",
         "description": (
             "The box of crosses_dam_break 15 cm deep; columns of a = 3.2 of "

@@ -55,9 +55,9 @@ import matplotlib
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from _outputs import (ONE_POINT_PER_PAIR, add_contact_model_options, contact_model,  # noqa: E402
-                      contact_model_settings, contact_model_suffix, counted_intervals,
-                      element_contacts_setting, read_summary, regime_name, stopped_seconds,
-                      stops, wall_time, write_summary)
+                      contact_model_settings, contact_model_suffix, contact_model_title,
+                      counted_intervals, element_contacts_setting, read_summary,
+                      regime_name, stopped_seconds, stops, wall_time, write_summary)
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -553,8 +553,7 @@ def main(argv=None):
     summary = {
         "name": name,
         "title": "Dam break of crosses in the experiments' box"
-                 + (", element contacts averaged as in Grains3D" if mean else "")
-                 + (", one contact point per element pair" if point else ""),
+                 + contact_model_title(mean, point),
         "thesis": "§3.2-3.3, Table 3.1, Fig. 3.7-3.9, Table B.1",
         "description": (
             "cases/dem/dam-break-crosses.toml: box 64 x 30 x 20 cm, Table 3.1 crosses poured "

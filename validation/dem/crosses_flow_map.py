@@ -61,9 +61,9 @@ from typing import NamedTuple
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from _outputs import (ONE_POINT_PER_PAIR, add_contact_model_options, call_two_at_a_time,  # noqa: E402
-                      contact_model, contact_model_settings, counted_intervals, paused_note,
-                      pool_span, read_summary, regime_name, stopped_seconds, stops,
-                      wall_time, write_summary)
+                      contact_model, contact_model_settings, contact_model_title,
+                      counted_intervals, paused_note, pool_span, read_summary, regime_name,
+                      stopped_seconds, stops, wall_time, write_summary)
 from crosses_dam_break import (COLLAPSE_S, RESULTS, ROOT, Column, diagnostics,  # noqa: E402
                                ended_at_rest, opening_time, run_column, seed_settings,
                                stopped)
@@ -324,8 +324,7 @@ def main(argv=None):
     summary = {
         "name": model.name,
         "title": "Flow-regime map of crosses: repeatable and intermittent columns"
-                 + (", element contacts averaged as in Grains3D" if model is not SUM else "")
-                 + (", one contact point per element pair" if model is MEAN_POINT else ""),
+                 + contact_model_title(model is not SUM, model is MEAN_POINT),
         "thesis": "§3.3.1, Fig. 3.6",
         "description": "Columns of crosses behind the gates of crosses_dam_break's box "
                        f"(Table 3.1, {model.words}), 6 cm deep: "

@@ -52,10 +52,10 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from _outputs import (ONE_POINT_PER_PAIR, add_contact_model_options, contact_model,  # noqa: E402
-                      contact_model_settings, contact_model_suffix, continuation_command,
-                      counted_intervals, flat_contacts_setting, paused_note, pour_command,
-                      read_summary, run_two_at_a_time, span, stopped_seconds, stops,
-                      two_at_a_time_span, wall_time, write_summary)
+                      contact_model_settings, contact_model_suffix, contact_model_title,
+                      continuation_command, counted_intervals, flat_contacts_setting,
+                      paused_note, pour_command, read_summary, run_two_at_a_time, span,
+                      stopped_seconds, stops, two_at_a_time_span, wall_time, write_summary)
 from crosses_tangential_map import (CASE, GATE_TIME, LOCAL_GAMMA, LOCAL_KT, RESULTS,  # noqa: E402
                                     ROOT, TABLE_31, classify, settings, sphere_reference)
 
@@ -330,8 +330,7 @@ def main(argv=None):
     summary = {
         "name": name,
         "title": "Cross column: the 3 x 3 around Table 3.1 on six packings"
-                 + (", element contacts averaged as in Grains3D" if mean else "")
-                 + (", one contact point per element pair" if point else ""),
+                 + contact_model_title(mean, point),
         "thesis": "§3.4.3, Fig. 3.17",
         "description": (
             f"The 300-cross column of the memory case poured with seeds {seeds_text} and "
