@@ -64,9 +64,9 @@ from _outputs import (ONE_POINT_PER_PAIR, add_contact_model_options, call_two_at
                       contact_model, contact_model_settings, contact_model_title,
                       counted_intervals, paused_note, pool_span, read_summary, regime_name,
                       stopped_seconds, stops, wall_time, write_summary)
-from crosses_dam_break import (COLLAPSE_S, RESULTS, ROOT, Column, diagnostics,  # noqa: E402
-                               ended_at_rest, opening_time, run_column, seed_settings,
-                               stopped)
+from crosses_dam_break import (COLLAPSE_S, CROSSES, RESULTS, ROOT, SEED, Column,  # noqa: E402
+                               column, copied_from, diagnostics, ended_at_rest, opening_time,
+                               run_column, seed_settings, stopped)
 
 
 class Model(NamedTuple):
@@ -100,39 +100,92 @@ MEAN_POINT = Model("crosses_flow_map_mean_point", contact_model_settings(True, T
                    "Grains3D's model: the element contacts of two crosses averaged, one "
                    "contact point per pair of touching elements")
 model = SUM
+DEEP_SUFFIX = "_deep"   # of the maps in the experiments' box (--depth-cm 20)
 DEPTH_M = 0.06          # the box's depth: the memory case's column (cases/dem/README.md)
+DEEP_M = 0.20           # the experiments' box, the case's own (`--depth-cm 20`)
+depth_m = DEPTH_M       # main() sets it
 COLUMNS = [(4, 150), (4, 300), (4, 450), (8, 300), (8, 600)]  # (gate [cm], crosses)
 QUICK_COLUMNS = [(4, 150)]
+# The same heights in the experiments' box (3.3 times the crosses); the tall column and the
+# 8 cm gate's 2000 are crosses_dam_break's own columns (column_of).
+DEEP_COLUMNS = [(4, 500), (4, 1000), (4, 1300), (8, 1000), (8, 2000)]
+DEEP_QUICK_COLUMNS = [(4, 500)]
 SEEDS = [1, 2, 3]
 QUICK_SEEDS = [1, 2]
 TALL_M = 0.20           # §3.3.1: columns taller than 20 cm always avalanche
-# Crosses per metre of column height per metre of gate length in this box: the memory
-# case's 300 crosses stand 17.4-18.3 cm tall behind its 4 cm gate (crosses_gate_effect).
-CROSSES_PER_M2 = 300 / (0.175 * 0.04)
+# Crosses per cubic metre of column: the memory case's 300 crosses stand 17.4-18.3 cm tall
+# behind its 4 cm gate in the 6 cm deep box (crosses_gate_effect).
+CROSSES_PER_M3 = 300 / (0.175 * 0.04 * DEPTH_M)
 POUR_ABOVE_M = 0.06     # the pour region starts this far above the column's expected top
 
 
 def expected_height(gate_cm, count):
-    """The column's height [m] from its crosses, as the memory case's column packs."""
-    return count / (CROSSES_PER_M2 * gate_cm / 100.0)
+    """The column's height [m] from its crosses in the map's box, as the memory case's
+    column packs."""
+    return count / (CROSSES_PER_M3 * gate_cm / 100.0 * depth_m)
 
 
 def column_of(gate_cm, count):
-    """The Column of crosses_dam_break for this gate and count in the 6 cm deep box, the
-    pour region (up to the case's 0.72 m) starting POUR_ABOVE_M above the column's
-    expected top, or at the case's 0.28 m where that is higher: no cross is placed where
-    the pile will stand."""
+    """The Column of crosses_dam_break for this gate and count in the map's box, the pour
+    region (up to the case's 0.72 m) starting POUR_ABOVE_M above the column's expected top,
+    or at the case's 0.28 m where that is higher: no cross is placed where the pile will
+    stand. In the experiments' box, a gate with the crosses of crosses_dam_break's column
+    (1300 behind the 4 cm gate) is that column, pour region and all: its run with the
+    case's seed is the dam break's own (experiments_run)."""
+    if depth_m == DEEP_M and CROSSES.get(gate_cm) == count:
+        return column(gate_cm)
     bottom = max(0.28, round(expected_height(gate_cm, count) + POUR_ABOVE_M, 2))
-    return Column(gate_cm, count, DEPTH_M, bottom)
+    return Column(gate_cm, count, depth_m, bottom)
 
 
 def folder(gate_cm, count, seed):
     return os.path.join(model.runs(), f"L{gate_cm:g}cm_{count}", f"seed_{seed}")
 
 
+def command_script(mean, point, deep):
+    """The script (and its options) that runs this map: the wrapper of the model's name
+    where there is one, else crosses_flow_map.py with the options."""
+    if os.path.exists(os.path.join(ROOT, model.script())):
+        return model.script()
+    return (f"validation/dem/{SUM.name}.py" + (" --element-contacts mean" if mean else "")
+            + (" --flat-contacts point" if point else "") + (" --depth-cm 20" if deep else ""))
+
+
+def experiments_run(gate_cm, count, seed):
+    """The folder of crosses_dam_break's run (with the map's model) that is this column and
+    seed, or None: in the experiments' box its columns are among the map's (column_of),
+    and its runs pour with the case's seed."""
+    if seed != SEED or gate_cm not in CROSSES or column_of(gate_cm, count) != column(gate_cm):
+        return None
+    name = "crosses_dam_break" + model.name[len(SUM.name):].removesuffix(DEEP_SUFFIX)
+    return os.path.join(RESULTS, "runs", name, f"L{gate_cm:g}cm_seed{seed}")
+
+
+def copy_experiments_run(source, out):
+    """Copies crosses_dam_break's finished run `source` as the map's run `out` (the same
+    column, seed and model: the same steps, so it is not run twice), with a note of where
+    it came from, and the stops of its runs' PAUSES.txt added to the map's (the run time
+    leaves out those that fall in its segments)."""
+    shutil.copytree(source, out)
+    with open(os.path.join(out, "copied_from.txt"), "w") as f:
+        f.write(f"copied from {os.path.relpath(source, ROOT)}, a finished run of the same "
+                "column, seed and model\n")
+    pauses = os.path.join(os.path.dirname(source), "PAUSES.txt")
+    if os.path.exists(pauses):
+        with open(pauses) as f, open(os.path.join(model.runs(), "PAUSES.txt"), "a") as g:
+            g.writelines(line.rstrip("\n") + f" [{os.path.basename(source)} of "
+                         f"{os.path.basename(os.path.dirname(source))}]\n" for line in f)
+
+
 def run_one(exe, gate_cm, count, seed):
-    """Pour, open and collapse one column and seed (one thread; map_columns analyses it)."""
-    run_column(exe, column_of(gate_cm, count), folder(gate_cm, count, seed), 1,
+    """Pour, open and collapse one column and seed (one thread; map_columns analyses it),
+    or copy crosses_dam_break's finished run of it (experiments_run)."""
+    out = folder(gate_cm, count, seed)
+    source = experiments_run(gate_cm, count, seed)
+    if source and not os.path.exists(out) and unfinished(source) is None:
+        copy_experiments_run(source, out)
+        return
+    run_column(exe, column_of(gate_cm, count), out, 1,
                extra=model.settings + seed_settings(seed))
 
 
@@ -218,12 +271,22 @@ def main(argv=None):
                     + ")")
     ap.add_argument("--seeds", type=int, nargs="+", help="packings (default 1 2 3)")
     ap.add_argument("--reuse", action="store_true", help="analyse the runs on disk")
+    ap.add_argument("--depth-cm", type=int, choices=(6, 20), default=6,
+                    help="the box's depth: 6 (the memory case's column, the default) or 20 "
+                    "(the experiments' box; the map's runs, folder and report get the "
+                    f"suffix {DEEP_SUFFIX}, and its default columns are "
+                    + " ".join(f"{g}:{n}" for g, n in DEEP_COLUMNS) + ")")
     add_contact_model_options(ap, SUM.name, "with Table 3.1")
     args = ap.parse_args(argv)
-    global model
+    global model, depth_m
     mean, point = contact_model(ap, args)
     model = (MEAN_POINT if point else MEAN) if mean else SUM
-    columns = QUICK_COLUMNS if args.quick else COLUMNS
+    depth_m = args.depth_cm / 100.0
+    deep = args.depth_cm == 20
+    if deep:
+        model = model._replace(name=model.name + DEEP_SUFFIX)
+    columns = ((DEEP_QUICK_COLUMNS if args.quick else DEEP_COLUMNS) if deep else
+               (QUICK_COLUMNS if args.quick else COLUMNS))
     if args.columns:
         try:
             columns = [(float(g), int(n)) for g, n in (c.split(":") for c in args.columns)]
@@ -312,27 +375,36 @@ def main(argv=None):
     ] + (["The element contacts of two crosses (up to four pairs of arms), and of a cross "
           "and a wall, are averaged, as Grains3D, the code of the thesis' crosses, does for "
           "composite particles (simulation.element_contacts = \"mean\"), in the pours and "
-          "the collapses" + (f"; and {ONE_POINT_PER_PAIR}." if model is MEAN_POINT else ".")]
-         if model is not SUM else []) + [
-        "The box is 6 cm deep (the back side wall moved, the memory case's column), not the "
-        "experiments' 20 cm: the same heights with 3.3 times fewer crosses. The thesis does "
-        "not give the depth of the columns of its map.",
+          "the collapses" + (f"; and {ONE_POINT_PER_PAIR}." if point else ".")]
+         if mean else []) + [
+        ("The box is the experiments' 20 cm deep one, the case's own (--depth-cm 20), as in "
+         "crosses_dam_break: 3.3 times the crosses of the 6 cm deep map for the same "
+         "heights. The thesis does not give the depth of the columns of its map; its "
+         "simulations of the experiments' box hold 1300 to 7000 crosses (§3.2.3)." if deep
+         else "The box is 6 cm deep (the back side wall moved, the memory case's column), "
+         "not the experiments' 20 cm: the same heights with 3.3 times fewer crosses. The "
+         "thesis does not give the depth of the columns of its map."),
         "Runs on one thread, two at a time, on the 2-core VM; the run time lays their wall "
         "times (finished segments: a run stopped and continued counts once) two at a time "
         "in the order they started, the columns of most crosses first.",
-    ] + ([paused_note(paused / 60, model.name)] if paused > 0 else [])
+    ] + [f"Gate {g:g} cm, {n} crosses, seed {x}: crosses_dam_break's column and seed with "
+         "this model, so its run there is this one (not run twice)." + copied_from(run)
+         for g, n, x in in_run_order(columns, seeds)
+         if os.path.exists(os.path.join(run := folder(g, n, x), "copied_from.txt"))
+         ] + ([paused_note(paused / 60, model.name)] if paused > 0 else [])
     summary = {
         "name": model.name,
         "title": "Flow-regime map of crosses: repeatable and intermittent columns"
-                 + contact_model_title(model is not SUM, model is MEAN_POINT),
+                 + contact_model_title(mean, point)
+                 + (", in the experiments' 20 cm deep box" if deep else ""),
         "thesis": "§3.3.1, Fig. 3.6",
         "description": "Columns of crosses behind the gates of crosses_dam_break's box "
-                       f"(Table 3.1, {model.words}), 6 cm deep: "
+                       f"(Table 3.1, {model.words}), {args.depth_cm} cm deep: "
                        + ", ".join(f"{n} crosses at {g:g} cm" for g, n in columns)
                        + f", each poured with seeds {', '.join(map(str, seeds))} and "
                        "released at rest with the gate removed at once; each run classified "
                        "by `sanguis analyze`, each column's runs mapped by `sanguis flow-map`.",
-        "command": f"/usr/bin/python3 {model.script()} --build BUILD"
+        "command": f"/usr/bin/python3 {command_script(mean, point, deep)} --build BUILD"
                    + (" --quick" if args.quick else "")
                    + (" --columns " + " ".join(f"{g:g}:{n}" for g, n in columns)
                       if args.columns else "")
