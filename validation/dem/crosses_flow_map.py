@@ -42,12 +42,20 @@ too, one contact point per pair of touching elements, Grains3D's whole model. Ea
 maps in its own folders and report (crosses_flow_map_mean, crosses_flow_map_mean_point;
 the wrappers of those names run them).
 
+`--depth-cm 20` maps in the experiments' 20 cm deep box, the case's own, instead: the same
+heights with 3.3 times the crosses (4 cm gate 500, 1000 and 1300, 8 cm gate 1000 and 2000;
+1300 rather than 1500 for the tall column, H0 about 22 cm, since that is crosses_dam_break's
+own column, as the 8 cm gate's 2000 are). Its runs, map and report get the suffix _deep
+(crosses_flow_map_mean_point_deep.py runs Grains3D's model so). A column that is one of
+crosses_dam_break's is poured as the dam break pours it, and the dam break's finished run
+with the same model and the case's seed (3) is copied as the map's run of that seed.
+
 Writes validation/dem/results/crosses_flow_map.json, the map's CSV in the runs' folder
 (results/runs/crosses_flow_map/map) and docs/validation/figures/crosses_flow_map.png
 (with another model, its name for crosses_flow_map).
 Usage: /usr/bin/python3 validation/dem/crosses_flow_map.py [--build build] [--quick]
            [--columns 4:150 4:300 ...] [--seeds 1 2 3] [--reuse]
-           [--element-contacts sum|mean [--flat-contacts point]]
+           [--element-contacts sum|mean [--flat-contacts point]] [--depth-cm 6|20]
 """
 import argparse
 import csv

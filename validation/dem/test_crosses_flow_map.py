@@ -119,6 +119,107 @@ class Models(unittest.TestCase):
             self.assertIn("--flat-contacts point runs with", err.getvalue())
 
 
+class ExperimentsBox(unittest.TestCase):
+    """--depth-cm 20: the map in crosses_dam_break's own 20 cm deep box."""
+
+    def setUp(self):
+        fm.depth_m = fm.DEEP_M
+        fm.model = fm.MEAN_POINT._replace(name=fm.MEAN_POINT.name + fm.DEEP_SUFFIX)
+
+    def tearDown(self):
+        fm.depth_m = fm.DEPTH_M
+        fm.model = fm.SUM
+
+    def test_the_deep_columns_have_the_narrow_maps_heights(self):
+        deep = [fm.expected_height(*c) for c in fm.DEEP_COLUMNS]
+        fm.depth_m = fm.DEPTH_M
+        narrow = [fm.expected_height(*c) for c in fm.COLUMNS]
+        for d, n in zip(deep[:2] + deep[3:], narrow[:2] + narrow[3:]):
+            self.assertAlmostEqual(d, n, places=9)
+        # the tall one is the dam break's 1300 crosses, lower than 1500 would stand
+        self.assertGreater(deep[2], fm.TALL_M + 0.02)
+
+    def test_the_dam_breaks_columns_are_its_own_and_the_others_are_poured_above_their_top(self):
+        self.assertEqual(fm.column_of(4, 1300), db.column(4))
+        self.assertEqual(fm.column_of(8, 2000), db.column(8))
+        for gate_cm, count in fm.DEEP_COLUMNS:
+            col = fm.column_of(gate_cm, count)
+            self.assertEqual(col.depth_m, 0.20)
+            self.assertNotIn(f"obstacle[{db.SIDE_WALL_INDEX}].point_m", " ".join(db.overrides(col)))
+            if (gate_cm, count) not in ((4, 1300), (8, 2000)):
+                self.assertGreaterEqual(col.pour_bottom_m,
+                                        fm.expected_height(gate_cm, count) + 0.05)
+
+    def test_only_the_dam_breaks_column_and_seed_with_the_same_model_is_its_run(self):
+        runs = os.path.join(fm.RESULTS, "runs")
+        self.assertEqual(fm.experiments_run(4, 1300, db.SEED),
+                         os.path.join(runs, "crosses_dam_break_mean_point", "L4cm_seed3"))
+        self.assertIsNone(fm.experiments_run(4, 1300, 1))
+        self.assertIsNone(fm.experiments_run(4, 1000, db.SEED))
+        self.assertIsNone(fm.experiments_run(4, 1200, db.SEED))
+        # the 12 cm gate's 3000 crosses would be poured as the dam break pours them
+        self.assertEqual(fm.column_of(12, 3000), db.column(12))
+        self.assertIsNotNone(fm.experiments_run(12, 3000, db.SEED))
+        fm.model = fm.SUM._replace(name=fm.SUM.name + fm.DEEP_SUFFIX)
+        self.assertEqual(fm.experiments_run(8, 2000, db.SEED),
+                         os.path.join(runs, "crosses_dam_break", "L8cm_seed3"))
+        fm.depth_m = fm.DEPTH_M
+        fm.model = fm.SUM
+        self.assertIsNone(fm.experiments_run(4, 1300, db.SEED))  # another box
+
+    def test_a_finished_dam_break_run_is_copied_with_its_stops_and_an_unfinished_one_is_not(self):
+        calls = []
+        with tempfile.TemporaryDirectory() as tmp, mock.patch.object(fm, "RESULTS", tmp), \
+                mock.patch.object(fm, "run_column",
+                                  lambda exe, col, out, threads, extra: calls.append(out)):
+            source = fm.experiments_run(4, 1300, db.SEED)
+            fake_run(source, 2.6, 4.1, True)
+            with open(os.path.join(os.path.dirname(source), "PAUSES.txt"), "w") as f:
+                f.write("2026-12-06T23:43 stopped for the clean-clone CI (5.2 min)\n")
+            os.makedirs(fm.model.runs())
+            fm.run_one("sanguis", 4, 1300, db.SEED)
+            out = fm.folder(4, 1300, db.SEED)
+            self.assertEqual(calls, [])
+            self.assertTrue(os.path.exists(os.path.join(out, "run.log")))
+            self.assertIn("crosses_dam_break_mean_point", db.copied_from(out))
+            self.assertEqual(len(fm.stops(fm.model.runs())), 1)
+            fm.run_one("sanguis", 4, 1300, 1)  # another seed: run
+            self.assertEqual(calls, [fm.folder(4, 1300, 1)])
+            other = fm.MEAN._replace(name=fm.MEAN.name + fm.DEEP_SUFFIX)
+            fm.model = other
+            fake_run(fm.experiments_run(4, 1300, db.SEED), 2.6, 3.5, False)  # in its collapse
+            fm.run_one("sanguis", 4, 1300, db.SEED)
+            self.assertEqual(calls[-1], fm.folder(4, 1300, db.SEED))
+            self.assertFalse(os.path.exists(os.path.join(calls[-1], "copied_from.txt")))
+
+    def test_the_option_chooses_the_box_and_names_the_map_after_it(self):
+        with tempfile.TemporaryDirectory() as tmp, mock.patch.object(fm, "RESULTS", tmp):
+            err = io.StringIO()
+            with contextlib.redirect_stderr(err), self.assertRaises(SystemExit):
+                fm.main(["--element-contacts", "mean", "--flat-contacts", "point",
+                         "--depth-cm", "20", "--seeds", "1", "--reuse"])
+            self.assertEqual(fm.model.name, "crosses_flow_map_mean_point_deep")
+            self.assertEqual(fm.depth_m, 0.20)
+            self.assertEqual(fm.command_script(True, True, True),
+                             "validation/dem/crosses_flow_map_mean_point_deep.py")
+            with contextlib.redirect_stderr(io.StringIO()), self.assertRaises(SystemExit):
+                fm.main(["--depth-cm", "20", "--seeds", "1", "--reuse"])
+            self.assertEqual(fm.model.name, "crosses_flow_map_deep")
+            self.assertEqual(fm.command_script(False, False, True),
+                             "validation/dem/crosses_flow_map.py --depth-cm 20")
+            err = io.StringIO()
+            with contextlib.redirect_stderr(err), self.assertRaises(SystemExit) as raised:
+                fm.main(["--depth-cm", "12", "--seeds", "1", "2", "--reuse"])
+            self.assertEqual(raised.exception.code, 2)
+            self.assertIn("--depth-cm", err.getvalue())
+
+    def test_the_wrapper_maps_grains3ds_model_in_the_deep_box(self):
+        here = os.path.dirname(os.path.abspath(__file__))
+        with open(os.path.join(here, "crosses_flow_map_mean_point_deep.py")) as f:
+            self.assertIn('"--flat-contacts", "point",\n                                    '
+                          '"--depth-cm", "20"]', f.read())
+
+
 class Runs(unittest.TestCase):
     def test_the_columns_of_most_crosses_run_first_each_over_every_seed(self):
         self.assertEqual(fm.in_run_order([(4, 150), (8, 600), (4, 300)], [1, 2]),
