@@ -33,7 +33,7 @@ ended in which), the runs' run-out (L_inf - L0)/L0 and H0/H_inf, and how many of
 columns' runs avalanched at all (not stable). The thesis' map is qualitative ("to report
 qualitative trends rather than to provide accurate flow transitions") and in another
 box's depth, so the rest is not graded.
-`--quick`: the 4 cm gate's 150 crosses, seeds 1 and 2 (no column above 20 cm: the tall
+`--quick`: the 4 cm gate's 150 crosses (500 in the deep box), seeds 1 and 2 (no column above 20 cm: the tall
 check is reported as not run).
 
 `--element-contacts mean` pours and collapses with the element contacts of two crosses
@@ -48,7 +48,9 @@ heights with 3.3 times the crosses (4 cm gate 500, 1000 and 1300, 8 cm gate 1000
 own column, as the 8 cm gate's 2000 are). Its runs, map and report get the suffix _deep
 (crosses_flow_map_mean_point_deep.py runs Grains3D's model so). A column that is one of
 crosses_dam_break's is poured as the dam break pours it, and the dam break's finished run
-with the same model and the case's seed (3) is copied as the map's run of that seed.
+with the same model and the case's seed (3) is copied as the map's run of that seed (it
+must be of the current build, as every run of the report; its note gives its own wall
+time and threads, and says if the dam break's run has changed since the copy).
 
 Writes validation/dem/results/crosses_flow_map.json, the map's CSV in the runs' folder
 (results/runs/crosses_flow_map/map) and docs/validation/figures/crosses_flow_map.png
@@ -61,6 +63,7 @@ import argparse
 import csv
 import functools
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -73,17 +76,22 @@ from _outputs import (ONE_POINT_PER_PAIR, add_contact_model_options, call_two_at
                       counted_intervals, paused_note, pool_span, read_summary, regime_name,
                       stopped_seconds, stops, wall_time, write_summary)
 from crosses_dam_break import (COLLAPSE_S, CROSSES, RESULTS, ROOT, SEED, Column,  # noqa: E402
-                               column, copied_from, diagnostics, ended_at_rest, opening_time,
+                               column, diagnostics, ended_at_rest, opening_time,
                                run_column, seed_settings, stopped)
 
 
 class Model(NamedTuple):
     """The contact model a map is made with: the report's name (also of the runs' folder
-    and the figure), its overrides (in the pours and the collapses) and how the report
-    names it."""
+    and the figure), its overrides (in the pours and the collapses), how the report names
+    it, and the crosses_dam_break case of the same model (experiments_run)."""
     name: str
     settings: list
     words: str
+    dam_break: str
+
+    def in_experiments_box(self):
+        """The same model's map in the experiments' 20 cm deep box (--depth-cm 20)."""
+        return self._replace(name=self.name + DEEP_SUFFIX)
 
     def runs(self):
         return os.path.join(RESULTS, "runs", self.name)
@@ -101,14 +109,17 @@ class Model(NamedTuple):
 # The model's defaults (the sum, the patches); the element contacts of two crosses averaged,
 # as Grains3D, the code of the thesis' crosses, does; and that with one contact point per
 # pair of touching elements, Grains3D's whole model. main() chooses one.
-SUM = Model("crosses_flow_map", [], "the element contacts summed, contact patches")
+SUM = Model("crosses_flow_map", [], "the element contacts summed, contact patches",
+            "crosses_dam_break")
 MEAN = Model("crosses_flow_map_mean", contact_model_settings(True, False),
-             "the element contacts of two crosses averaged as in Grains3D, contact patches")
+             "the element contacts of two crosses averaged as in Grains3D, contact patches",
+             "crosses_dam_break_mean")
 MEAN_POINT = Model("crosses_flow_map_mean_point", contact_model_settings(True, True),
                    "Grains3D's model: the element contacts of two crosses averaged, one "
-                   "contact point per pair of touching elements")
+                   "contact point per pair of touching elements", "crosses_dam_break_mean_point")
 model = SUM
 DEEP_SUFFIX = "_deep"   # of the maps in the experiments' box (--depth-cm 20)
+COPIED_FROM = "copy_of.txt"  # in a run copied from crosses_dam_break (copy_experiments_run)
 DEPTH_M = 0.06          # the box's depth: the memory case's column (cases/dem/README.md)
 DEEP_M = 0.20           # the experiments' box, the case's own (`--depth-cm 20`)
 depth_m = DEPTH_M       # main() sets it
@@ -125,6 +136,14 @@ TALL_M = 0.20           # §3.3.1: columns taller than 20 cm always avalanche
 # behind its 4 cm gate in the 6 cm deep box (crosses_gate_effect).
 CROSSES_PER_M3 = 300 / (0.175 * 0.04 * DEPTH_M)
 POUR_ABOVE_M = 0.06     # the pour region starts this far above the column's expected top
+
+
+def default_columns(deep, quick):
+    """The columns a map runs without --columns: of the 6 cm deep box or (deep) of the
+    experiments' box, all or (quick) the one of --quick."""
+    if deep:
+        return DEEP_QUICK_COLUMNS if quick else DEEP_COLUMNS
+    return QUICK_COLUMNS if quick else COLUMNS
 
 
 def expected_height(gate_cm, count):
@@ -165,30 +184,77 @@ def experiments_run(gate_cm, count, seed):
     and its runs pour with the case's seed."""
     if seed != SEED or gate_cm not in CROSSES or column_of(gate_cm, count) != column(gate_cm):
         return None
-    name = "crosses_dam_break" + model.name[len(SUM.name):].removesuffix(DEEP_SUFFIX)
-    return os.path.join(RESULTS, "runs", name, f"L{gate_cm:g}cm_seed{seed}")
+    return os.path.join(RESULTS, "runs", model.dam_break, f"L{gate_cm:g}cm_seed{seed}")
+
+
+def last_segment(run):
+    """The last `done:` line of the run's run.log ('' if none): what identifies a run."""
+    path = os.path.join(run, "run.log")
+    if not os.path.exists(path):
+        return ""
+    done = [line.strip() for line in open(path) if line.startswith("done:")]
+    return done[-1] if done else ""
 
 
 def copy_experiments_run(source, out):
     """Copies crosses_dam_break's finished run `source` as the map's run `out` (the same
-    column, seed and model: the same steps, so it is not run twice), with a note of where
-    it came from, and the stops of its runs' PAUSES.txt added to the map's (the run time
-    leaves out those that fall in its segments)."""
-    shutil.copytree(source, out)
-    with open(os.path.join(out, "copied_from.txt"), "w") as f:
-        f.write(f"copied from {os.path.relpath(source, ROOT)}, a finished run of the same "
-                "column, seed and model\n")
-    pauses = os.path.join(os.path.dirname(source), "PAUSES.txt")
-    if os.path.exists(pauses):
-        with open(pauses) as f, open(os.path.join(model.runs(), "PAUSES.txt"), "a") as g:
-            g.writelines(line.rstrip("\n") + f" [{os.path.basename(source)} of "
-                         f"{os.path.basename(os.path.dirname(source))}]\n" for line in f)
+    column, seed and model: the same steps, so it is not run twice), with COPIED_FROM
+    saying from where, when, and the source's last segment (copied_source). The copy is
+    made under another name and renamed once whole: an interrupted copy leaves no folder
+    that could pass for the map's own run. The source is taken as it is: it must be of the
+    current build, like every run the report names."""
+    partial = out + ".partial"
+    shutil.rmtree(partial, ignore_errors=True)
+    shutil.copytree(source, partial)
+    with open(os.path.join(partial, COPIED_FROM), "w") as f:
+        f.write(f"{os.path.relpath(source, ROOT)}\n"
+                f"{time.strftime('%Y-%m-%d %H:%M', time.gmtime())} UTC\n{last_segment(source)}\n")
+    os.rename(partial, out)
+
+
+def copied_source(run):
+    """(source folder, copy date, the source's last segment when copied) of a run copied by
+    copy_experiments_run, or None for a run of the map's own."""
+    path = os.path.join(run, COPIED_FROM)
+    if not os.path.exists(path):
+        return None
+    source, date, segment = (open(path).read().split("\n") + ["", ""])[:3]
+    return os.path.join(ROOT, source), date, segment
+
+
+def copy_note(gate_cm, count, seed, run):
+    """The report's note on a copied run: whose it is, its own wall time and threads (its
+    stops, listed in its case's PAUSES.txt, left out), and whether the source has changed."""
+    source, date, segment = copied_source(run)
+    threads = re.findall(r"^threads\s+(\d+) requested", open(os.path.join(run, "run.log")).read(),
+                         re.M)
+    stopped_s = stopped_seconds(counted_intervals(run), stops(os.path.dirname(source)))
+    changed = ("" if last_segment(source) == segment else
+               " The dam break's run has changed (or gone) since: this is the earlier run.")
+    return (f"Gate {gate_cm:g} cm, {count} crosses, seed {seed}: crosses_dam_break's column "
+            f"and seed with this model, so its run {os.path.relpath(source, ROOT)} is copied "
+            f"({date}), not run again: {(wall_time(run) - stopped_s) / 3600:.2f} h on "
+            f"{threads[-1] if threads else '?'} thread(s), not in this map's run time "
+            f"({stopped_s / 60:.1f} min of stops left out, its case's PAUSES.txt).{changed}")
+
+
+def accounted(gate_cm, count, seed, run, stop_list):
+    """What the map's run time counts of a run: (its wall time less its stops [s], those
+    stops [s], its counted_intervals, None); a run copied from crosses_dam_break counts
+    nothing, (0, 0, [], copy_note), since this map did not run it."""
+    if copied_source(run):
+        return 0.0, 0.0, [], copy_note(gate_cm, count, seed, run)
+    intervals = counted_intervals(run)
+    stopped_s = stopped_seconds(intervals, stop_list)
+    return wall_time(run) - stopped_s, stopped_s, intervals, None
 
 
 def run_one(exe, gate_cm, count, seed):
     """Pour, open and collapse one column and seed (one thread; map_columns analyses it),
     or copy crosses_dam_break's finished run of it (experiments_run)."""
     out = folder(gate_cm, count, seed)
+    if copied_source(out):  # copied already: finished, and not the map's to continue
+        return
     source = experiments_run(gate_cm, count, seed)
     if source and not os.path.exists(out) and unfinished(source) is None:
         copy_experiments_run(source, out)
@@ -273,7 +339,7 @@ def main(argv=None):
     ap = argparse.ArgumentParser()
     ap.add_argument("--build", default="build")
     ap.add_argument("--quick", action="store_true",
-                    help="the 4 cm gate's 150 crosses, seeds 1 and 2")
+                    help="the 4 cm gate's 150 crosses (500 with --depth-cm 20), seeds 1 and 2")
     ap.add_argument("--columns", nargs="+", metavar="GATE_CM:CROSSES",
                     help="columns to run (default " + " ".join(f"{g}:{n}" for g, n in COLUMNS)
                     + ")")
@@ -292,9 +358,8 @@ def main(argv=None):
     depth_m = args.depth_cm / 100.0
     deep = args.depth_cm == 20
     if deep:
-        model = model._replace(name=model.name + DEEP_SUFFIX)
-    columns = ((DEEP_QUICK_COLUMNS if args.quick else DEEP_COLUMNS) if deep else
-               (QUICK_COLUMNS if args.quick else COLUMNS))
+        model = model.in_experiments_box()
+    columns = default_columns(deep, args.quick)
     if args.columns:
         try:
             columns = [(float(g), int(n)) for g, n in (c.split(":") for c in args.columns)]
@@ -319,7 +384,7 @@ def main(argv=None):
     rows = map_columns(exe, columns, seeds)
 
     stop_list = stops(model.runs())
-    counted, table, sanity, tall_runs, unsettled = [], [], [], [], []
+    counted, table, sanity, tall_runs, unsettled, copies = [], [], [], [], [], []
     durations, paused = {}, 0.0
     for gate_cm, count in columns:
         for seed in seeds:
@@ -331,11 +396,12 @@ def main(argv=None):
                 unsettled.append(f"Gate {gate_cm:g} cm, {count} crosses, seed {seed}: the "
                                  f"collapse {end}.")
             seconds = wall_time(run)
-            intervals = counted_intervals(run)
-            stopped_s = stopped_seconds(intervals, stop_list)
-            durations[(gate_cm, count, seed)] = seconds - stopped_s
+            duration, stopped_s, intervals, note = accounted(gate_cm, count, seed, run,
+                                                             stop_list)
+            durations[(gate_cm, count, seed)] = duration
             paused += stopped_s
             counted += intervals
+            copies += [note] if note else []
             table.append(run_row(gate_cm, count, seed, s, seconds))
             sanity.append(at_rest_at_opening(run, opening))
             if s["H0_m"] > TALL_M:
@@ -387,19 +453,18 @@ def main(argv=None):
          if mean else []) + [
         ("The box is the experiments' 20 cm deep one, the case's own (--depth-cm 20), as in "
          "crosses_dam_break: 3.3 times the crosses of the 6 cm deep map for the same "
-         "heights. The thesis does not give the depth of the columns of its map; its "
+         "heights, but for the tall column, crosses_dam_break's own 1300 crosses (about "
+         "22 cm, against the narrow map's 26). The thesis does not give the depth of the columns of its map; its "
          "simulations of the experiments' box hold 1300 to 7000 crosses (§3.2.3)." if deep
          else "The box is 6 cm deep (the back side wall moved, the memory case's column), "
          "not the experiments' 20 cm: the same heights with 3.3 times fewer crosses. The "
          "thesis does not give the depth of the columns of its map."),
         "Runs on one thread, two at a time, on the 2-core VM; the run time lays their wall "
         "times (finished segments: a run stopped and continued counts once) two at a time "
-        "in the order they started, the columns of most crosses first.",
-    ] + [f"Gate {g:g} cm, {n} crosses, seed {x}: crosses_dam_break's column and seed with "
-         "this model, so its run there is this one (not run twice)." + copied_from(run)
-         for g, n, x in in_run_order(columns, seeds)
-         if os.path.exists(os.path.join(run := folder(g, n, x), "copied_from.txt"))
-         ] + ([paused_note(paused / 60, model.name)] if paused > 0 else [])
+        "in the order they started, the columns of most crosses first"
+        + (" (a run copied from crosses_dam_break counts nothing: see its note)." if copies
+           else "."),
+    ] + copies + ([paused_note(paused / 60, model.name)] if paused > 0 else [])
     summary = {
         "name": model.name,
         "title": "Flow-regime map of crosses: repeatable and intermittent columns"

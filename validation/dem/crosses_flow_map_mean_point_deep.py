@@ -4,13 +4,14 @@ the case's own): Grains3D's contact model (the element contacts of two crosses a
 one contact point per pair of touching elements), Table 3.1 (thesis §2.3, §3.3.1,
 Fig. 3.6).
 
-In the map's 6 cm deep box every column of Grains3D's model fractures, the tall ones (H0
-26 cm) included, where the thesis' tall columns always avalanche; in the 20 cm deep box
-the same model collapses the 4 cm gate's 1300 crosses (H0 21.6 cm,
-crosses_dam_break_mean_point). This map asks whether the box's depth is what holds the
-narrow box's columns: the same heights with 3.3 times the crosses. Its tall column is the
-dam break's own (1300 crosses behind the 4 cm gate), whose run with the case's seed (3) is
-copied from crosses_dam_break_mean_point when that has finished.
+In the map's 6 cm deep box every column of Grains3D's model behind the 4 cm gate
+fractures, the tall ones (H0 26 cm) included, where the thesis' tall columns always
+avalanche; in the 20 cm deep box the same model collapses the 4 cm gate's 1300 crosses (H0
+21.6 cm, crosses_dam_break_mean_point). This map asks whether the box's depth is what holds
+the narrow box's columns: the same heights with 3.3 times the crosses, but for the tall
+column, the dam break's own (1300 crosses behind the 4 cm gate, about 22 cm), whose run
+with the case's seed (3) is copied from crosses_dam_break_mean_point when that has
+finished.
 
 Writes validation/dem/results/crosses_flow_map_mean_point_deep.json and
 docs/validation/figures/crosses_flow_map_mean_point_deep.png.

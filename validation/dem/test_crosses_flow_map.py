@@ -3,6 +3,7 @@ ValidationScripts.DemHelpers)."""
 import contextlib
 import io
 import os
+import runpy
 import sys
 import tempfile
 import tomllib
@@ -63,6 +64,7 @@ def fake_run(folder, gate_removed_at, last_time, settled):
 class Models(unittest.TestCase):
     def tearDown(self):
         fm.model = fm.SUM
+        fm.depth_m = fm.DEPTH_M
 
     def test_each_model_runs_in_its_own_folders_with_its_overrides(self):
         folders = set()
@@ -124,7 +126,7 @@ class ExperimentsBox(unittest.TestCase):
 
     def setUp(self):
         fm.depth_m = fm.DEEP_M
-        fm.model = fm.MEAN_POINT._replace(name=fm.MEAN_POINT.name + fm.DEEP_SUFFIX)
+        fm.model = fm.MEAN_POINT.in_experiments_box()
 
     def tearDown(self):
         fm.depth_m = fm.DEPTH_M
@@ -160,37 +162,78 @@ class ExperimentsBox(unittest.TestCase):
         # the 12 cm gate's 3000 crosses would be poured as the dam break pours them
         self.assertEqual(fm.column_of(12, 3000), db.column(12))
         self.assertIsNotNone(fm.experiments_run(12, 3000, db.SEED))
-        fm.model = fm.SUM._replace(name=fm.SUM.name + fm.DEEP_SUFFIX)
+        fm.model = fm.SUM.in_experiments_box()
         self.assertEqual(fm.experiments_run(8, 2000, db.SEED),
                          os.path.join(runs, "crosses_dam_break", "L8cm_seed3"))
+        fm.model = fm.MEAN.in_experiments_box()
+        self.assertEqual(fm.experiments_run(4, 1300, db.SEED),
+                         os.path.join(runs, "crosses_dam_break_mean", "L4cm_seed3"))
         fm.depth_m = fm.DEPTH_M
         fm.model = fm.SUM
         self.assertIsNone(fm.experiments_run(4, 1300, db.SEED))  # another box
 
-    def test_a_finished_dam_break_run_is_copied_with_its_stops_and_an_unfinished_one_is_not(self):
+    def test_a_finished_dam_break_run_is_copied_whole_and_an_unfinished_one_is_not(self):
         calls = []
         with tempfile.TemporaryDirectory() as tmp, mock.patch.object(fm, "RESULTS", tmp), \
                 mock.patch.object(fm, "run_column",
                                   lambda exe, col, out, threads, extra: calls.append(out)):
             source = fm.experiments_run(4, 1300, db.SEED)
             fake_run(source, 2.6, 4.1, True)
-            with open(os.path.join(os.path.dirname(source), "PAUSES.txt"), "w") as f:
-                f.write("2026-12-06T23:43 stopped for the clean-clone CI (5.2 min)\n")
-            os.makedirs(fm.model.runs())
             fm.run_one("sanguis", 4, 1300, db.SEED)
             out = fm.folder(4, 1300, db.SEED)
             self.assertEqual(calls, [])
-            self.assertTrue(os.path.exists(os.path.join(out, "run.log")))
-            self.assertIn("crosses_dam_break_mean_point", db.copied_from(out))
-            self.assertEqual(len(fm.stops(fm.model.runs())), 1)
+            self.assertEqual(sorted(os.listdir(out)), sorted(os.listdir(source) + [fm.COPIED_FROM]))
+            self.assertFalse(os.path.exists(out + ".partial"))
+            copied, date, segment = fm.copied_source(out)
+            self.assertEqual(os.path.realpath(copied), os.path.realpath(source))
+            self.assertTrue(segment.startswith("done: t = 4.1 s"))
+            self.assertIsNone(fm.copied_source(source))
+            fm.run_one("sanguis", 4, 1300, db.SEED)  # copied already: neither run nor copied
+            self.assertEqual(calls, [])
             fm.run_one("sanguis", 4, 1300, 1)  # another seed: run
             self.assertEqual(calls, [fm.folder(4, 1300, 1)])
-            other = fm.MEAN._replace(name=fm.MEAN.name + fm.DEEP_SUFFIX)
-            fm.model = other
+            fm.model = fm.MEAN.in_experiments_box()
             fake_run(fm.experiments_run(4, 1300, db.SEED), 2.6, 3.5, False)  # in its collapse
             fm.run_one("sanguis", 4, 1300, db.SEED)
             self.assertEqual(calls[-1], fm.folder(4, 1300, db.SEED))
-            self.assertFalse(os.path.exists(os.path.join(calls[-1], "copied_from.txt")))
+            self.assertFalse(os.path.exists(calls[-1]))  # run_column, mocked, made nothing
+
+    def test_a_copied_run_is_noted_with_its_own_time_threads_and_stops(self):
+        with tempfile.TemporaryDirectory() as tmp, mock.patch.object(fm, "RESULTS", tmp):
+            source = fm.experiments_run(4, 1300, db.SEED)
+            fake_run(source, 2.6, 4.1, True)  # one segment, 17:50:21-17:51:34 UTC, 73 s
+            with open(os.path.join(source, "run.log"), "a") as f:
+                f.write("threads         2 requested (small systems use fewer)\n")
+            with open(os.path.join(os.path.dirname(source), "PAUSES.txt"), "w") as f:
+                f.write("2026-12-06T17:51 stopped for the CI (0.5 min)\n")
+            fm.copy_experiments_run(source, fm.folder(4, 1300, db.SEED))
+            note = fm.copy_note(4, 1300, db.SEED, fm.folder(4, 1300, db.SEED))
+            self.assertIn("crosses_dam_break_mean_point/L4cm_seed3 is copied", note)
+            self.assertIn(f"{(73 - 30) / 3600:.2f} h on 2 thread(s), not in this map's run time",
+                          note)
+            self.assertIn("0.5 min of stops left out", note)
+            self.assertNotIn("changed", note)
+            with open(os.path.join(source, "run.log"), "a") as f:  # the source ran on
+                f.write("done: t = 4.6 s, 20000 steps in 10s, ended 2026-12-07 01:00:00 UTC\n")
+            self.assertIn("has changed (or gone) since",
+                          fm.copy_note(4, 1300, db.SEED, fm.folder(4, 1300, db.SEED)))
+
+    def test_the_run_time_counts_the_maps_own_runs_less_their_stops_and_no_copy(self):
+        with tempfile.TemporaryDirectory() as tmp, mock.patch.object(fm, "RESULTS", tmp):
+            with open(os.path.join(tmp, "PAUSES.txt"), "w") as f:
+                f.write("2026-12-06T17:51 stopped for the CI (0.5 min)\n")
+            stop_list = fm.stops(tmp)
+            own = fm.folder(4, 1300, 1)
+            fake_run(own, 2.6, 4.1, True)  # 17:50:21-17:51:34 UTC
+            duration, stopped_s, intervals, note = fm.accounted(4, 1300, 1, own, stop_list)
+            self.assertEqual((duration, stopped_s, len(intervals), note), (43.0, 30.0, 1, None))
+            source = fm.experiments_run(4, 1300, db.SEED)
+            fake_run(source, 2.6, 4.1, True)
+            fm.copy_experiments_run(source, fm.folder(4, 1300, db.SEED))
+            duration, stopped_s, intervals, note = fm.accounted(
+                4, 1300, db.SEED, fm.folder(4, 1300, db.SEED), stop_list)
+            self.assertEqual((duration, stopped_s, intervals), (0.0, 0.0, []))
+            self.assertIn("is copied", note)
 
     def test_the_option_chooses_the_box_and_names_the_map_after_it(self):
         with tempfile.TemporaryDirectory() as tmp, mock.patch.object(fm, "RESULTS", tmp):
@@ -213,11 +256,23 @@ class ExperimentsBox(unittest.TestCase):
             self.assertEqual(raised.exception.code, 2)
             self.assertIn("--depth-cm", err.getvalue())
 
+    def test_the_default_columns_follow_the_box(self):
+        self.assertEqual(fm.default_columns(False, False), fm.COLUMNS)
+        self.assertEqual(fm.default_columns(False, True), fm.QUICK_COLUMNS)
+        self.assertEqual(fm.default_columns(True, False), fm.DEEP_COLUMNS)
+        self.assertEqual(fm.default_columns(True, True), fm.DEEP_QUICK_COLUMNS)
+
     def test_the_wrapper_maps_grains3ds_model_in_the_deep_box(self):
         here = os.path.dirname(os.path.abspath(__file__))
-        with open(os.path.join(here, "crosses_flow_map_mean_point_deep.py")) as f:
-            self.assertIn('"--flat-contacts", "point",\n                                    '
-                          '"--depth-cm", "20"]', f.read())
+        given = []
+        with mock.patch.object(fm, "main", lambda argv: given.append(argv) or 0), \
+                mock.patch.object(sys, "argv", ["wrapper", "--columns", "4:1300"]), \
+                self.assertRaises(SystemExit) as raised:
+            runpy.run_path(os.path.join(here, "crosses_flow_map_mean_point_deep.py"),
+                           run_name="__main__")
+        self.assertEqual(raised.exception.code, 0)
+        self.assertEqual(given, [["--element-contacts", "mean", "--flat-contacts", "point",
+                                  "--depth-cm", "20", "--columns", "4:1300"]])
 
 
 class Runs(unittest.TestCase):
