@@ -249,7 +249,10 @@ class ExperimentsBox(unittest.TestCase):
                 fm.main(["--depth-cm", "20", "--seeds", "1", "--reuse"])
             self.assertEqual(fm.model.name, "crosses_flow_map_deep")
             self.assertEqual(fm.command_script(False, False, True),
-                             "validation/dem/crosses_flow_map.py --depth-cm 20")
+                             "validation/dem/crosses_flow_map_deep.py")
+            fm.model = fm.MEAN.in_experiments_box()  # no wrapper: the options
+            self.assertEqual(fm.command_script(True, False, True), "validation/dem/"
+                             "crosses_flow_map.py --element-contacts mean --depth-cm 20")
             err = io.StringIO()
             with contextlib.redirect_stderr(err), self.assertRaises(SystemExit) as raised:
                 fm.main(["--depth-cm", "12", "--seeds", "1", "2", "--reuse"])
@@ -262,17 +265,18 @@ class ExperimentsBox(unittest.TestCase):
         self.assertEqual(fm.default_columns(True, False), fm.DEEP_COLUMNS)
         self.assertEqual(fm.default_columns(True, True), fm.DEEP_QUICK_COLUMNS)
 
-    def test_the_wrapper_maps_grains3ds_model_in_the_deep_box(self):
+    def test_the_wrappers_map_their_model_in_the_deep_box(self):
         here = os.path.dirname(os.path.abspath(__file__))
-        given = []
-        with mock.patch.object(fm, "main", lambda argv: given.append(argv) or 0), \
-                mock.patch.object(sys, "argv", ["wrapper", "--columns", "4:1300"]), \
-                self.assertRaises(SystemExit) as raised:
-            runpy.run_path(os.path.join(here, "crosses_flow_map_mean_point_deep.py"),
-                           run_name="__main__")
-        self.assertEqual(raised.exception.code, 0)
-        self.assertEqual(given, [["--element-contacts", "mean", "--flat-contacts", "point",
-                                  "--depth-cm", "20", "--columns", "4:1300"]])
+        for m, flags in ((fm.MEAN_POINT, ["--element-contacts", "mean", "--flat-contacts",
+                                          "point"]), (fm.SUM, [])):
+            given = []
+            with mock.patch.object(fm, "main", lambda argv: given.append(argv) or 0), \
+                    mock.patch.object(sys, "argv", ["wrapper", "--columns", "4:1300"]), \
+                    self.assertRaises(SystemExit) as raised:
+                runpy.run_path(os.path.join(here, m.in_experiments_box().name + ".py"),
+                               run_name="__main__")
+            self.assertEqual(raised.exception.code, 0)
+            self.assertEqual(given, [flags + ["--depth-cm", "20", "--columns", "4:1300"]])
 
 
 class Runs(unittest.TestCase):
