@@ -33,8 +33,8 @@ ended in which), the runs' run-out (L_inf - L0)/L0 and H0/H_inf, and how many of
 columns' runs avalanched at all (not stable). The thesis' map is qualitative ("to report
 qualitative trends rather than to provide accurate flow transitions") and in another
 box's depth, so the rest is not graded.
-`--quick`: the 4 cm gate's 150 crosses (500 in the deep box), seeds 1 and 2 (no column above 20 cm: the tall
-check is reported as not run).
+`--quick`: the 4 cm gate's 150 crosses (500 in the deep box), seeds 1 and 2 (no column
+above 20 cm: the tall check is reported as not run).
 
 `--element-contacts mean` pours and collapses with the element contacts of two crosses
 averaged, as Grains3D, the code of the thesis' crosses, does; with `--flat-contacts point`
@@ -46,7 +46,8 @@ the wrappers of those names run them).
 heights with 3.3 times the crosses (4 cm gate 500, 1000 and 1300, 8 cm gate 1000 and 2000;
 1300 rather than 1500 for the tall column, H0 about 22 cm, since that is crosses_dam_break's
 own column, as the 8 cm gate's 2000 are). Its runs, map and report get the suffix _deep
-(crosses_flow_map_mean_point_deep.py runs Grains3D's model so). A column that is one of
+(crosses_flow_map_deep.py and crosses_flow_map_mean_point_deep.py run the defaults and
+Grains3D's model so). A column that is one of
 crosses_dam_break's is poured as the dam break pours it, and the dam break's finished run
 with the same model and the case's seed (3) is copied as the map's run of that seed (it
 must be of the current build, as every run of the report; its note gives its own wall
