@@ -455,8 +455,9 @@ def main(argv=None):
         ("The box is the experiments' 20 cm deep one, the case's own (--depth-cm 20), as in "
          "crosses_dam_break: 3.3 times the crosses of the 6 cm deep map for the same "
          "heights, but for the tall column, crosses_dam_break's own 1300 crosses (about "
-         "22 cm, against the narrow map's 26). The thesis does not give the depth of the columns of its map; its "
-         "simulations of the experiments' box hold 1300 to 7000 crosses (§3.2.3)." if deep
+         "22 cm, against the narrow map's 26). The thesis does not give the depth of the "
+         "columns of its map; its simulations of the experiments' box hold 1300 to 7000 "
+         "crosses (§3.2.3)." if deep
          else "The box is 6 cm deep (the back side wall moved, the memory case's column), "
          "not the experiments' 20 cm: the same heights with 3.3 times fewer crosses. The "
          "thesis does not give the depth of the columns of its map."),
