@@ -73,9 +73,10 @@ from typing import NamedTuple
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from _outputs import (ONE_POINT_PER_PAIR, add_contact_model_options, call_two_at_a_time,  # noqa: E402
-                      contact_model, contact_model_settings, contact_model_title,
-                      counted_intervals, paused_note, pool_span, read_summary, regime_name,
-                      stopped_seconds, stops, wall_time, write_summary)
+                      contact_model, contact_model_settings, contact_model_suffix,
+                      contact_model_title, counted_intervals, paused_note, pool_span,
+                      read_summary, regime_name, stopped_seconds, stops, wall_time,
+                      write_summary)
 from crosses_dam_break import (COLLAPSE_S, CROSSES, RESULTS, ROOT, SEED, Column,  # noqa: E402
                                column, diagnostics, ended_at_rest, opening_time,
                                run_column, seed_settings, stopped)
@@ -110,14 +111,19 @@ class Model(NamedTuple):
 # The model's defaults (the sum, the patches); the element contacts of two crosses averaged,
 # as Grains3D, the code of the thesis' crosses, does; and that with one contact point per
 # pair of touching elements, Grains3D's whole model. main() chooses one.
-SUM = Model("crosses_flow_map", [], "the element contacts summed, contact patches",
-            "crosses_dam_break")
-MEAN = Model("crosses_flow_map_mean", contact_model_settings(True, False),
-             "the element contacts of two crosses averaged as in Grains3D, contact patches",
-             "crosses_dam_break_mean")
-MEAN_POINT = Model("crosses_flow_map_mean_point", contact_model_settings(True, True),
-                   "Grains3D's model: the element contacts of two crosses averaged, one "
-                   "contact point per pair of touching elements", "crosses_dam_break_mean_point")
+def model_of(mean, point, words):
+    """The map of a contact model: its name and its dam break's, suffixed as every cross
+    case's (contact_model_suffix), and its overrides (contact_model_settings)."""
+    suffix = contact_model_suffix(mean, point)
+    return Model("crosses_flow_map" + suffix, contact_model_settings(mean, point), words,
+                 "crosses_dam_break" + suffix)
+
+
+SUM = model_of(False, False, "the element contacts summed, contact patches")
+MEAN = model_of(True, False, "the element contacts of two crosses averaged as in Grains3D, "
+                "contact patches")
+MEAN_POINT = model_of(True, True, "Grains3D's model: the element contacts of two crosses "
+                      "averaged, one contact point per pair of touching elements")
 model = SUM
 DEEP_SUFFIX = "_deep"   # of the maps in the experiments' box (--depth-cm 20)
 COPIED_FROM = "copy_of.txt"  # in a run copied from crosses_dam_break (copy_experiments_run)
