@@ -11,6 +11,7 @@ import sys
 import tempfile
 import time
 import unittest
+from unittest import mock
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import run_all  # noqa: E402
@@ -106,13 +107,29 @@ class Report(unittest.TestCase):
         # Ungraded checks (pass None) do not count: 1 of 1 graded.
         self.assertIn("| [Case good](#good) | §2.6 | 1/1 | **PASS** | 75 s |", text)
         self.assertIn("| [Case bad](#bad) | §2.6 | 0/1 | **FAIL** | 75 s |", text)
-        self.assertIn("| missing | — | — | **FAIL** (no summary) | — |", text)
+        self.assertIn("| [missing](#missing) | — | — | **not run** | — |", text)
+        self.assertIn("It counts as not passed.", text)
         self.assertIn("on Xeon (2 cores), commit `f00`", text)
         self.assertIn("| angle \\| deg | 35.12 | 36 | ±3 | **PASS** |", text)
         self.assertIn("- a note", text)
         # A case without a machine stamp says nothing about one.
         bad = text[text.index('<a id="bad">'):]
         self.assertIn("Run on 2026-12-02 05:00, run time 75 s. Result: **FAIL**.", bad)
+
+    def test_a_case_without_summary_says_whether_its_runs_were_started(self):
+        with tempfile.TemporaryDirectory() as tmp, \
+                mock.patch.object(run_all, "RESULTS", tmp):
+            os.makedirs(os.path.join(tmp, "runs", "started", "L4cm_1300"))
+            os.makedirs(os.path.join(tmp, "runs", "empty"))
+            text = run_all.report([("started", None), ("empty", None), ("never", None)],
+                                  self.META)
+        self.assertIn("| [started](#started) | — | — | **FAIL** (unfinished: no summary) | — |",
+                      text)
+        self.assertIn("| [empty](#empty) | — | — | **not run** | — |", text)
+        self.assertIn("| [never](#never) | — | — | **not run** | — |", text)
+        started = text[text.index('<a id="started">'):text.index('<a id="empty">')]
+        self.assertIn("its runs so far are in", started)
+        self.assertIn("runs/started", started)
 
     def test_a_summary_written_from_older_runs_gives_when_they_ran(self):
         later = summary("crosses_later", True, date="2026-12-06 16:47",
