@@ -120,6 +120,17 @@ def contact_model(ap, args):
     return mean, point
 
 
+# Lajeunesse, Monnier & Homsy, Phys. Fluids 17 (2005), quasi-2D channel on a rough bottom:
+# (L_inf - L0)/L0 = 1.2 a for a < 1.8 and 1.9 a^(2/3) for a > 2.8. The two fits differ by
+# 20 % in between, so the reference takes each as published and switches halfway.
+LAJEUNESSE_SWITCH = 2.3
+
+
+def lajeunesse(a):
+    """Lajeunesse et al.'s run-out (L_inf - L0)/L0 of spheres at aspect ratio a."""
+    return 1.2 * a if a < LAJEUNESSE_SWITCH else 1.9 * a ** (2.0 / 3.0)
+
+
 def contact_model_suffix(mean, point):
     """What the model adds to a case's name (its runs' folder, figure and report)."""
     return ("_mean" if mean else "") + ("_point" if point else "")
@@ -183,7 +194,7 @@ def _segments(lines):
     return [(end, seconds) for end, seconds, _ in _stamped_segments(lines)]
 
 
-def _utc_seconds(text, fmt="%Y-%m-%d %H:%M:%S"):
+def utc_seconds(text, fmt="%Y-%m-%d %H:%M:%S"):
     return calendar.timegm(time.strptime(text, fmt))
 
 
@@ -205,7 +216,7 @@ def _stamped_segments(lines):
         stamp = re.search(r"(\d{4}-\d{2}-\d{2} \d{2}:\d{2}:\d{2}) UTC", line)
         segment = (float(end.group(1)),
                    sum(int(n) * units[u] for n, u in re.findall(r"(\d+)([hms])", m.group(1))),
-                   _utc_seconds(stamp.group(1)) if stamp else None)
+                   utc_seconds(stamp.group(1)) if stamp else None)
         if line.startswith("done:"):
             out.append(segment)
             kept = None
@@ -426,7 +437,7 @@ def stops(runs_dir):
                          "begin the line with YYYY-MM-DDTHH:MM, when the runs were stopped "
                          "(the run time leaves out the stops that fall in its runs)")
             clock = date.group(2) + ("" if date.group(2).count(":") == 2 else ":00")
-            start = _utc_seconds(f"{date.group(1)} {clock}")
+            start = utc_seconds(f"{date.group(1)} {clock}")
             out.append((start, start + 60.0 * float(length.group(1))))
     return out
 

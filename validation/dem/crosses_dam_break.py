@@ -56,7 +56,7 @@ import matplotlib
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from _outputs import (ONE_POINT_PER_PAIR, add_contact_model_options, contact_model,  # noqa: E402
                       contact_model_settings, contact_model_suffix, contact_model_title,
-                      counted_intervals, element_contacts_setting, read_summary,
+                      counted_intervals, element_contacts_setting, lajeunesse, read_summary,
                       regime_name, stopped_seconds, stops, wall_time, write_summary)
 
 matplotlib.use("Agg")
@@ -297,10 +297,6 @@ def copied_from(run):
     """The run folder's record of where it was copied from, as a sentence ('' if none)."""
     path = os.path.join(run, "copied_from.txt")
     return f" The folder is {open(path).read().strip()}." if os.path.exists(path) else ""
-
-
-def lajeunesse(a):
-    return 1.2 * a if a < 2.3 else 1.9 * a ** (2.0 / 3.0)
 
 
 def diagnostics(run):

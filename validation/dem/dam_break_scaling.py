@@ -39,7 +39,8 @@ import matplotlib
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import read_arrays, read_pvd, read_summary, regime_name, speed_landmarks  # noqa: E402
+from _outputs import (lajeunesse, read_arrays, read_pvd, read_summary, regime_name,  # noqa: E402
+                      speed_landmarks)
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -56,10 +57,6 @@ COLUMNS = [(0.015, 1500), (0.02, 1500), (0.04, 3000), (0.041, 3500), (0.06, 3000
 FIG39_GATE = 0.041
 VELOCITY_FIGURE = os.path.join(ROOT, "docs", "validation", "figures", "dam_break_velocity.png")
 GATE_INDEX = 5  # [[obstacle]] number of the gate in the case
-
-
-def lajeunesse(a):
-    return 1.2 * a if a < 2.3 else 1.9 * a ** (2.0 / 3.0)
 
 
 def overrides(l0, count):

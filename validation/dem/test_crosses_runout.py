@@ -49,24 +49,44 @@ class Collect(unittest.TestCase):
         write(self.dir, "crosses_dam_break", DAM_HEADER,
               [dam_row("4", "1300", "5.46", "2.48", "fractured"),
                dam_row("8", "2000", "1.95", "0.54", "fractured")])
-        pours, sources = crosses_runout.collect(self.dir)
-        self.assertEqual(sources, ["crosses_flow_map_deep", "crosses_dam_break"])
+        pours, sources, _ = crosses_runout.collect(self.dir)
+        self.assertEqual(list(sources), ["crosses_dam_break", "crosses_flow_map_deep"])
+        # The dam break's own run is kept, the map's copy of it dropped.
         self.assertEqual([(p.gate_cm, p.crosses, p.seed, p.source) for p in pours],
-                         [(4.0, 1300, 1, "crosses_flow_map_deep"),
-                          (4.0, 1300, 3, "crosses_flow_map_deep"),
-                          (8.0, 2000, 3, "crosses_dam_break")])
-        self.assertTrue(all(p.model == "sum" for p in pours))
+                         [(4.0, 1300, 3, "crosses_dam_break"),
+                          (8.0, 2000, 3, "crosses_dam_break"),
+                          (4.0, 1300, 1, "crosses_flow_map_deep")])
+        self.assertTrue(all(p.model == "sum (defaults)" for p in pours))
 
-    def test_a_pour_opened_with_another_model_and_quick_summaries_are_left_out(self):
+    def test_the_same_column_and_seed_of_two_models_are_two_pours(self):
+        write(self.dir, "crosses_dam_break", DAM_HEADER,
+              [dam_row("4", "1300", "5.46", "2.48", "fractured")])
+        write(self.dir, "crosses_dam_break_mean", DAM_HEADER,
+              [dam_row("4", "1300", "5.42", "6.21", "collapsed")])
+        pours, _, _ = crosses_runout.collect(self.dir)
+        self.assertEqual([(p.model, p.seed, p.runout) for p in pours],
+                         [("sum (defaults)", 3, 2.48), ("mean", 3, 6.21)])
+
+    def test_a_pour_opened_with_another_model_is_left_out_and_quick_ones_marked(self):
         write(self.dir, "crosses_dam_break_mean", DAM_HEADER,
               [dam_row("4", "1300", "5.42", "6.21", "collapsed"),
                dam_row("4, the same pour opened with the sum", "1300", "5.42", "2.48",
                        "fractured")])
         write(self.dir, "crosses_flow_map_mean_point_deep", MAP_HEADER,
               [map_row("4", "500", "1", "2.19", "0.28", "fractured")], quick=True)
-        pours, sources = crosses_runout.collect(self.dir)
-        self.assertEqual(sources, ["crosses_dam_break_mean"])
-        self.assertEqual([(p.model, p.runout) for p in pours], [("mean", 6.21)])
+        pours, sources, others = crosses_runout.collect(self.dir)
+        self.assertEqual(list(sources), ["crosses_dam_break_mean",
+                                         "crosses_flow_map_mean_point_deep"])
+        self.assertEqual([(p.model, p.runout) for p in pours],
+                         [("mean", 6.21), ("mean, point", 0.28)])
+        self.assertEqual(others, ['crosses_dam_break_mean\'s "4, the same pour opened with '
+                                  'the sum" (2.48, fractured)'])
+        s, _, spans = crosses_runout.summary_of(pours, sources, others)
+        self.assertTrue(s["quick"])
+        self.assertIn("Written in quick mode: crosses_flow_map_mean_point_deep hold fewer "
+                      "pours than their full runs.", s["notes"])
+        self.assertIn(others[0], s["notes"][2])
+        self.assertEqual(len(spans), 2)
 
 
 class Checks(unittest.TestCase):
@@ -82,25 +102,35 @@ class Checks(unittest.TestCase):
         self.assertEqual(c["measured"], "2.60 (3 pours: 1.10, 3.86, 2.60)")
         runs = [self.pour(5.46, 3.90, 1), self.pour(5.46, 7.9, 2), self.pour(5.46, 1.0, 3)]
         self.assertTrue(crosses_runout.column_check("sum", 4.0, 1300, runs)["pass"])
+        # Median 4.0 passes where the mean, 2.7, would not.
+        runs = [self.pour(5.46, 0.1, 1), self.pour(5.46, 4.0, 2), self.pour(5.46, 4.1, 3)]
+        self.assertTrue(crosses_runout.column_check("sum", 4.0, 1300, runs)["pass"])
 
     def test_a_column_below_a_4_is_reported_not_graded(self):
         c = crosses_runout.column_check("sum", 8.0, 2000, [self.pour(1.95, 0.54)])
         self.assertIsNone(c["pass"])
         self.assertEqual(c["tolerance"], "reported")
         self.assertIn("2.34", c["thesis"])  # 1.2 a
+        self.assertIsNone(crosses_runout.column_check("sum", 4.0, 900, [self.pour(3.5, 9.)])
+                          ["pass"])  # above the fits' switch, below a = 4
+        self.assertFalse(crosses_runout.column_check("sum", 4.0, 900, [self.pour(4.0, 9.)])
+                         ["pass"])  # graded from a = 4: 1.9 4^(2/3) = 4.79
 
     def test_the_case_passes_only_when_every_graded_column_does(self):
         good = [self.pour(5.4, 6.2, model="mean")]
         bad = [self.pour(5.4, 2.5, model="sum")]
         low = [crosses_runout.Pour("sum", 8.0, 2000, 3, 15.6, 1.95, 0.5, 1.0, "fractured",
                                    "x")]
-        _, ok, _ = crosses_runout.summary_of(good + low, [])
+        _, ok, _ = crosses_runout.summary_of(good + low, {})
         self.assertTrue(ok)
-        _, ok, _ = crosses_runout.summary_of(good + bad + low, [])
+        _, ok, _ = crosses_runout.summary_of(good + bad + low, {})
         self.assertFalse(ok)
-        s, ok, _ = crosses_runout.summary_of(low, [])
+        s, ok, _ = crosses_runout.summary_of(low, {})
         self.assertFalse(ok)  # nothing graded is not a pass
         self.assertIn("No column with a ≥ 4 has a pour yet: nothing graded.", s["notes"])
+        s, ok, _ = crosses_runout.summary_of([], {})
+        self.assertFalse(ok)
+        self.assertIn("none yet", s["description"])
 
 
 if __name__ == "__main__":

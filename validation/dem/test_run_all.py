@@ -54,7 +54,8 @@ class SharedFunctions(unittest.TestCase):
         # to the function's signature here, with placeholders for the arguments.
         checked = 0
         for path in run_all.scripts() + [os.path.join(run_all.HERE, "_outputs.py")]:
-            tree = ast.parse(open(path).read(), path)
+            with open(path) as f:
+                tree = ast.parse(f.read(), path)
             imported = {}
             for node in ast.walk(tree):
                 if (isinstance(node, ast.ImportFrom) and node.module
@@ -126,6 +127,10 @@ class Report(unittest.TestCase):
         self.assertIn("| [started](#started) | — | — | **FAIL** (unfinished: no summary) | — |",
                       text)
         self.assertIn("| [empty](#empty) | — | — | **not run** | — |", text)
+        # A script that failed in this call without a summary says so, runs or none.
+        failed = run_all.report([("never", None)], self.META, failed_now={"never"})
+        self.assertIn("| [never](#never) | — | — | **FAIL** (no summary) | — |", failed)
+        self.assertIn("its script failed in this run of run_all.py", failed)
         self.assertIn("| [never](#never) | — | — | **not run** | — |", text)
         started = text[text.index('<a id="started">'):text.index('<a id="empty">')]
         self.assertIn("its runs so far are in", started)
