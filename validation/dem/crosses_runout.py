@@ -236,9 +236,9 @@ def summary_of(pours, sources, others=()):
                                 "ratio, every model and pour in the experiments' box",
          "thesis": "§3.3.2, Fig. 3.7-3.8",
          "description": "Every pour of crosses in the experiments' 20 cm deep box with "
-                        "Table 3.1 (" + (", ".join(sources) or "none yet") + "), read from those cases' "
-                        "summaries (no run), on the axes of the thesis' Fig. 3.7 and 3.8 "
-                        "against Lajeunesse et al.'s run-out of spheres.",
+                        "Table 3.1 (" + (", ".join(sources) or "none yet") + "), read from "
+                        "those cases' summaries (no run), on the axes of the thesis' Fig. 3.7 "
+                        "and 3.8 against Lajeunesse et al.'s run-out of spheres.",
          "command": "/usr/bin/python3 validation/dem/crosses_runout.py",
          "figures": [os.path.relpath(FIGURE, ROOT)],
          "checks": checks,

@@ -152,7 +152,8 @@ def report(summaries, meta, failed_now=()):
                       "notes).", ""]
     for name, s in summaries:
         if s is None:
-            out.append(f"| [{name}](#{name}) | — | — | {unsummarised(name, failed_now)} | — |")
+            result = unsummarised(name, failed_now)
+            out.append(f"| [{name}](#{name}) | — | — | {result} | — |")
             continue
         graded = [c for c in s["checks"] if c["pass"] is not None]
         passed = sum(1 for c in graded if c["pass"])
