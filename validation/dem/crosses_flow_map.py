@@ -40,14 +40,16 @@ above 20 cm: the tall check is reported as not run).
 averaged, as Grains3D, the code of the thesis' crosses, does; with `--flat-contacts point`
 too, one contact point per pair of touching elements, Grains3D's whole model. Each model
 maps in its own folders and report (crosses_flow_map_mean, crosses_flow_map_mean_point;
-the wrappers of those names run them).
+the second's wrapper of that name runs it; the narrow box's walls hold its columns whatever
+the model, so the mean with the patches has its wrapper in the deep box only).
 
 `--depth-cm 20` maps in the experiments' 20 cm deep box, the case's own, instead: the same
 heights with 3.3 times the crosses (4 cm gate 500, 1000 and 1300, 8 cm gate 1000 and 2000;
 1300 rather than 1500 for the tall column, H0 about 22 cm, since that is crosses_dam_break's
 own column, as the 8 cm gate's 2000 are). Its runs, map and report get the suffix _deep
-(crosses_flow_map_deep.py and crosses_flow_map_mean_point_deep.py run the defaults and
-Grains3D's model so). A column that is one of
+(crosses_flow_map_deep.py, crosses_flow_map_mean_deep.py and
+crosses_flow_map_mean_point_deep.py run the defaults, the mean and Grains3D's model so). A
+column that is one of
 crosses_dam_break's is poured as the dam break pours it, and the dam break's finished run
 with the same model and the case's seed (3) is copied as the map's run of that seed (it
 must be of the current build, as every run of the report; its note gives its own wall

@@ -80,9 +80,11 @@ class Models(unittest.TestCase):
         self.assertEqual(fm.MEAN_POINT.settings, ["--set", 'simulation.element_contacts="mean"',
                                                   "--set", 'simulation.flat_contacts="point"'])
 
-    def test_each_model_has_a_wrapper_of_its_name_that_chooses_it(self):
+    def test_each_narrow_model_has_a_wrapper_of_its_name_that_chooses_it(self):
+        # The mean with the patches is mapped in the deep box only (its wrapper:
+        # test_the_wrappers_map_their_model_in_the_deep_box).
         here = os.path.dirname(os.path.abspath(__file__))
-        flags = [(fm.SUM, None), (fm.MEAN, '["--element-contacts", "mean"]'),
+        flags = [(fm.SUM, None),
                  (fm.MEAN_POINT, '["--element-contacts", "mean", "--flat-contacts", "point"]')]
         for m, chosen_by in flags:
             path = os.path.join(here, m.name + ".py")
@@ -250,9 +252,13 @@ class ExperimentsBox(unittest.TestCase):
             self.assertEqual(fm.model.name, "crosses_flow_map_deep")
             self.assertEqual(fm.command_script(False, False, True),
                              "validation/dem/crosses_flow_map_deep.py")
-            fm.model = fm.MEAN.in_experiments_box()  # no wrapper: the options
-            self.assertEqual(fm.command_script(True, False, True), "validation/dem/"
-                             "crosses_flow_map.py --element-contacts mean --depth-cm 20")
+            fm.model = fm.MEAN  # the narrow box's mean has no wrapper: the options
+            self.assertEqual(fm.command_script(True, False, False), "validation/dem/"
+                             "crosses_flow_map.py --element-contacts mean")
+            fm.model = fm.MEAN_POINT.in_experiments_box()._replace(name="crosses_flow_map_x")
+            self.assertEqual(fm.command_script(True, True, True), "validation/dem/"
+                             "crosses_flow_map.py --element-contacts mean --flat-contacts "
+                             "point --depth-cm 20")
             err = io.StringIO()
             with contextlib.redirect_stderr(err), self.assertRaises(SystemExit) as raised:
                 fm.main(["--depth-cm", "12", "--seeds", "1", "2", "--reuse"])
@@ -268,7 +274,8 @@ class ExperimentsBox(unittest.TestCase):
     def test_the_wrappers_map_their_model_in_the_deep_box(self):
         here = os.path.dirname(os.path.abspath(__file__))
         for m, flags in ((fm.MEAN_POINT, ["--element-contacts", "mean", "--flat-contacts",
-                                          "point"]), (fm.SUM, [])):
+                                          "point"]), (fm.MEAN, ["--element-contacts", "mean"]),
+                         (fm.SUM, [])):
             given = []
             with mock.patch.object(fm, "main", lambda argv: given.append(argv) or 0), \
                     mock.patch.object(sys, "argv", ["wrapper", "--columns", "4:1300"]), \
