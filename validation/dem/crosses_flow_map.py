@@ -18,10 +18,12 @@ core, for the 4 cm gate's 21 cm): behind the 4 cm gate 150, 300 and 450 crosses 
 seeds 1, 2 and 3 (`--columns GATE_CM:CROSSES ...`, `--seeds`). Each run pours, settles and
 collapses as crosses_dam_break runs its gates (pour until at rest, gate removed at once,
 collapse until at rest, at most 3 s), on one thread, two runs at a time; a run stopped on
-the way goes on from its checkpoint with the same command. `sanguis analyze` of a
-column's runs classifies each (collapsed: H_inf below 95 % of H0; fractured: otherwise,
-the front moved more than 10 % of L0; stable: neither) and writes the column's
-ensemble.csv, and `sanguis flow-map` the map.
+the way goes on from its checkpoint with the same command. The map reports every column
+of its folder whose runs have finished, those of earlier calls with other --columns too
+(its command then lists them all). `sanguis analyze` of a column's runs classifies each
+(collapsed: H_inf below 95 % of H0; fractured: otherwise, the front moved more than 10 %
+of L0; stable: neither) and writes the column's ensemble.csv, and `sanguis flow-map` the
+map.
 
 Checks (fixed before the runs):
 - tall columns: every run of a column with H0 above 20 cm collapses (§3.3.1: "always
@@ -287,6 +289,22 @@ def unfinished(run):
     return None
 
 
+def finished_columns(seeds):
+    """The columns of this map's folder whose runs of every seed have finished: those of
+    earlier calls with other --columns too. The map reports them all, so that a call that
+    runs one more column does not drop the others from the report."""
+    found = []
+    runs = model.runs()
+    for name in sorted(os.listdir(runs)) if os.path.isdir(runs) else []:
+        m = re.fullmatch(r"L(\d+(?:\.\d+)?)cm_(\d+)", name)
+        if m:
+            gate = float(m.group(1))
+            key = (int(gate) if gate == int(gate) else gate, int(m.group(2)))
+            if all(unfinished(folder(*key, s)) is None for s in seeds):
+                found.append(key)
+    return found
+
+
 def in_run_order(columns, seeds):
     """(gate, count, seed) of every run in the order run_all starts them: the columns of
     most crosses first (the longest runs: two at a time then ends with short ones)."""
@@ -390,6 +408,8 @@ def main(argv=None):
     if left:
         sys.exit("not mapped, runs not finished (run without --reuse to finish them):\n"
                  + "\n".join(left))
+    if not args.quick:  # a quick map stays the quick columns
+        columns = sorted(set(columns) | set(finished_columns(seeds)))
     rows = map_columns(exe, columns, seeds)
 
     stop_list = stops(model.runs())
@@ -490,7 +510,7 @@ def main(argv=None):
         "command": f"/usr/bin/python3 {command_script(mean, point, deep)} --build BUILD"
                    + (" --quick" if args.quick else "")
                    + (" --columns " + " ".join(f"{g:g}:{n}" for g, n in columns)
-                      if args.columns else "")
+                      if set(columns) != set(default_columns(deep, args.quick)) else "")
                    + (" --seeds " + " ".join(map(str, seeds)) if args.seeds else ""),
         "figures": [os.path.relpath(model.figure(), ROOT)],
         "checks": checks,

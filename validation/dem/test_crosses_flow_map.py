@@ -287,6 +287,21 @@ class ExperimentsBox(unittest.TestCase):
 
 
 class Runs(unittest.TestCase):
+    def test_the_map_reports_every_column_finished_on_disk(self):
+        with tempfile.TemporaryDirectory() as tmp, mock.patch.object(fm, "RESULTS", tmp):
+            fm.model = fm.MEAN_POINT.in_experiments_box()
+            for name in ("L4cm_500", "L4cm_1300", "L8cm_1000", "L2.5cm_100", "points", "map"):
+                for seed in (1, 2, 3):
+                    os.makedirs(os.path.join(fm.model.runs(), name, f"seed_{seed}"))
+            unfinished = {fm.folder(8, 1000, 3)}  # its seed 3 still running
+            with mock.patch.object(fm, "unfinished",
+                                   lambda run: "not run" if run in unfinished else None):
+                self.assertEqual(fm.finished_columns([1, 2, 3]),
+                                 [(2.5, 100), (4, 1300), (4, 500)])
+                self.assertEqual(fm.finished_columns([1, 2]),
+                                 [(2.5, 100), (4, 1300), (4, 500), (8, 1000)])
+        fm.model = fm.SUM
+
     def test_the_columns_of_most_crosses_run_first_each_over_every_seed(self):
         self.assertEqual(fm.in_run_order([(4, 150), (8, 600), (4, 300)], [1, 2]),
                          [(8, 600, 1), (8, 600, 2), (4, 300, 1), (4, 300, 2), (4, 150, 1),
