@@ -287,6 +287,34 @@ class ExperimentsBox(unittest.TestCase):
 
 
 class Runs(unittest.TestCase):
+    def test_a_call_for_one_column_maps_every_finished_one(self):
+        summary = {"H0_m": 0.21, "aspect_ratio_H0_over_L0": 5.4, "runout_ratio": 6.0,
+                   "height_ratio_H0_over_Hinf": 3.0, "peak_mean_speed_over_sqrt_gH0": 0.2,
+                   "regime": 2}
+        mapped, written = [], []
+        row = {"H0_m": "0.2", "aspect_ratio_H0_over_L0": "5", "outcome": "collapsed"}
+        with mock.patch.multiple(
+                fm, unfinished=lambda run: None, stops=lambda runs: [],
+                finished_columns=lambda seeds: [(4, 500), (4, 1300)],
+                map_columns=lambda exe, cols, seeds: mapped.append(cols) or
+                {c: row for c in cols},
+                read_summary=lambda run: summary, opening_time=lambda run: 2.6,
+                stopped=lambda run, t: "at rest", wall_time=lambda run: 60.0,
+                accounted=lambda g, n, s, run, st: (60.0, 0.0, [], None),
+                at_rest_at_opening=lambda run, t: 1e-4,
+                write_summary=lambda s, *rest: written.append(s)), \
+                contextlib.redirect_stdout(io.StringIO()):
+            fm.main(["--depth-cm", "20", "--columns", "4:1000", "--reuse"])
+            # Without --columns: the defaults, and a finished column beyond them.
+            fm.finished_columns = lambda seeds: [(2.5, 100)]
+            fm.main(["--depth-cm", "20", "--reuse"])
+        self.assertEqual(mapped, [[(4, 500), (4, 1000), (4, 1300)],
+                                  [(2.5, 100)] + fm.DEEP_COLUMNS])
+        self.assertIn("--columns 4:500 4:1000 4:1300", written[0]["command"])
+        self.assertIn("--columns 2.5:100 4:500 4:1000 4:1300 8:1000 8:2000",
+                      written[1]["command"])
+        fm.model = fm.SUM
+
     def test_the_map_reports_every_column_finished_on_disk(self):
         with tempfile.TemporaryDirectory() as tmp, mock.patch.object(fm, "RESULTS", tmp):
             fm.model = fm.MEAN_POINT.in_experiments_box()
