@@ -51,8 +51,7 @@ heights with 3.3 times the crosses (4 cm gate 500, 1000 and 1300, 8 cm gate 1000
 own column, as the 8 cm gate's 2000 are). Its runs, map and report get the suffix _deep
 (crosses_flow_map_deep.py, crosses_flow_map_mean_deep.py and
 crosses_flow_map_mean_point_deep.py run the defaults, the mean and Grains3D's model so). A
-column that is one of
-crosses_dam_break's is poured as the dam break pours it, and the dam break's finished run
+column that is one of crosses_dam_break's is poured as the dam break pours it, and the dam break's finished run
 with the same model and the case's seed (3) is copied as the map's run of that seed (it
 must be of the current build, as every run of the report; its note gives its own wall
 time and threads, and says if the dam break's run has changed since the copy).
