@@ -259,6 +259,18 @@ def accounted(gate_cm, count, seed, run, stop_list):
     return wall_time(run) - stopped_s, stopped_s, intervals, None
 
 
+def dam_break_pour_notes(columns, seeds):
+    """The report's notes on the dam break's columns mapped without the case's seed: that
+    pour is the dam break's own run with this model (experiments_run), in its own section,
+    not in this map; crosses_runout counts it with this map's pours of the column."""
+    if SEED in seeds:
+        return []
+    return [f"Gate {g:g} cm, {n} crosses: the case's seed ({SEED}) is {model.dam_break}'s own "
+            f"pour of this column, left out of this map (--seeds {' '.join(map(str, seeds))}); "
+            "its outcome is in that case's section, and crosses_runout counts it with this "
+            "map's pours." for g, n in columns if experiments_run(g, n, SEED)]
+
+
 def run_one(exe, gate_cm, count, seed):
     """Pour, open and collapse one column and seed (one thread; map_columns analyses it),
     or copy crosses_dam_break's finished run of it (experiments_run)."""
@@ -493,7 +505,8 @@ def main(argv=None):
         "in the order they started, the columns of most crosses first"
         + (" (a run copied from crosses_dam_break counts nothing: see its note)." if copies
            else "."),
-    ] + copies + ([paused_note(paused / 60, model.name)] if paused > 0 else [])
+    ] + copies + dam_break_pour_notes(columns, seeds) + (
+        [paused_note(paused / 60, model.name)] if paused > 0 else [])
     summary = {
         "name": model.name,
         "title": "Flow-regime map of crosses: repeatable and intermittent columns"

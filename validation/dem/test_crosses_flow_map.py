@@ -174,6 +174,18 @@ class ExperimentsBox(unittest.TestCase):
         fm.model = fm.SUM
         self.assertIsNone(fm.experiments_run(4, 1300, db.SEED))  # another box
 
+    def test_a_map_without_the_cases_seed_names_the_dam_breaks_pour_of_its_columns(self):
+        fm.model = fm.MEAN.in_experiments_box()
+        notes = fm.dam_break_pour_notes([(4, 1300), (4, 1000)], [1, 2])
+        self.assertEqual(len(notes), 1)
+        self.assertIn("Gate 4 cm, 1300 crosses: the case's seed (3) is crosses_dam_break_mean's",
+                      notes[0])
+        self.assertIn("(--seeds 1 2)", notes[0])
+        self.assertIn("crosses_runout", notes[0])
+        self.assertEqual(fm.dam_break_pour_notes([(4, 1300)], [1, 2, 3]), [])
+        fm.depth_m = fm.DEPTH_M  # the narrow box holds none of the dam break's columns
+        self.assertEqual(fm.dam_break_pour_notes([(4, 1300), (4, 450)], [1, 2]), [])
+
     def test_a_finished_dam_break_run_is_copied_whole_and_an_unfinished_one_is_not(self):
         calls = []
         with tempfile.TemporaryDirectory() as tmp, mock.patch.object(fm, "RESULTS", tmp), \
