@@ -20,7 +20,9 @@ collapses as crosses_dam_break runs its gates (pour until at rest, gate removed 
 collapse until at rest, at most 3 s), on one thread, two runs at a time; a run stopped on
 the way goes on from its checkpoint with the same command. The map reports every column
 of its folder whose runs have finished, those of earlier calls with other --columns too
-(its command then lists them all). `sanguis analyze` of a column's runs classifies each
+(its command then lists them all). A call that would drop from the summary on disk a
+column whose runs are not on disk (a fresh checkout holds the summaries, not the runs)
+stops before running, unless --drop-missing. `sanguis analyze` of a column's runs classifies each
 (collapsed: H_inf below 95 % of H0; fractured: otherwise, the front moved more than 10 %
 of L0; stable: neither) and writes the column's ensemble.csv, and `sanguis flow-map` the
 map.
@@ -60,12 +62,13 @@ Writes validation/dem/results/crosses_flow_map.json, the map's CSV in the runs' 
 (results/runs/crosses_flow_map/map) and docs/validation/figures/crosses_flow_map.png
 (with another model, its name for crosses_flow_map).
 Usage: /usr/bin/python3 validation/dem/crosses_flow_map.py [--build build] [--quick]
-           [--columns 4:150 4:300 ...] [--seeds 1 2 3] [--reuse]
+           [--columns 4:150 4:300 ...] [--seeds 1 2 3] [--reuse] [--drop-missing]
            [--element-contacts sum|mean [--flat-contacts point]] [--depth-cm 6|20]
 """
 import argparse
 import csv
 import functools
+import json
 import os
 import re
 import shutil
@@ -316,6 +319,32 @@ def finished_columns(seeds):
     return found
 
 
+def columns_in_summary():
+    """The columns (gate, crosses) of this map's full summary on disk (results/NAME.json,
+    its per-run table), [] where there is none or it was written by --quick."""
+    path = os.path.join(RESULTS, model.name + ".json")
+    if not os.path.isfile(path):
+        return []
+    with open(path) as f:
+        summary = json.load(f)
+    if summary.get("quick"):
+        return []
+    found = set()
+    for table in summary.get("tables", []):
+        if table["header"][:2] == ["gate [cm]", "crosses"]:
+            for row in table["rows"]:
+                gate = float(row[0])
+                found.add((int(gate) if gate == int(gate) else gate, int(row[1])))
+    return sorted(found)
+
+
+def dropped_columns(columns):
+    """The columns of the summary on disk that this call would leave out of it: their runs
+    are not on disk (a fresh checkout holds the summaries, not the runs) and this call does
+    not run them."""
+    return [c for c in columns_in_summary() if c not in columns]
+
+
 def in_run_order(columns, seeds):
     """(gate, count, seed) of every run in the order run_all starts them: the columns of
     most crosses first (the longest runs: two at a time then ends with short ones)."""
@@ -383,6 +412,9 @@ def main(argv=None):
                     + ")")
     ap.add_argument("--seeds", type=int, nargs="+", help="packings (default 1 2 3)")
     ap.add_argument("--reuse", action="store_true", help="analyse the runs on disk")
+    ap.add_argument("--drop-missing", action="store_true",
+                    help="write the summary even where it drops columns of the one on disk "
+                    "whose runs are not on disk (by default the call stops before running)")
     ap.add_argument("--depth-cm", type=int, choices=(6, 20), default=6,
                     help="the box's depth: 6 (the memory case's column, the default) or 20 "
                     "(the experiments' box; the map's runs, folder and report get the "
@@ -411,6 +443,14 @@ def main(argv=None):
     if len(seeds) < 2:
         ap.error("--seeds: a column's outcome needs at least two packings")
     exe = os.path.join(ROOT, args.build, "app", "sanguis")
+    if not args.quick and not args.drop_missing:
+        dropped = dropped_columns(set(columns) | set(finished_columns(seeds)))
+        if dropped:
+            sys.exit(f"{os.path.relpath(os.path.join(RESULTS, model.name + '.json'), ROOT)} "
+                     "holds columns whose runs are not on disk and that this call does not "
+                     "run: " + " ".join(f"{g:g}:{n}" for g, n in dropped) + ". Add them to "
+                     "--columns to run them again, or pass --drop-missing to write a summary "
+                     "without them.")
     t0 = time.time()
     if not args.reuse:
         run_all(exe, columns, seeds)

@@ -2,6 +2,7 @@
 ValidationScripts.DemHelpers)."""
 import contextlib
 import io
+import json
 import os
 import runpy
 import sys
@@ -313,7 +314,7 @@ class Runs(unittest.TestCase):
                 read_summary=lambda run: summary, opening_time=lambda run: 2.6,
                 stopped=lambda run, t: "at rest", wall_time=lambda run: 60.0,
                 accounted=lambda g, n, s, run, st: (60.0, 0.0, [], None),
-                at_rest_at_opening=lambda run, t: 1e-4,
+                at_rest_at_opening=lambda run, t: 1e-4, dropped_columns=lambda cols: [],
                 write_summary=lambda s, *rest: written.append(s)), \
                 contextlib.redirect_stdout(io.StringIO()):
             fm.main(["--depth-cm", "20", "--columns", "4:1000", "--reuse"])
@@ -326,6 +327,41 @@ class Runs(unittest.TestCase):
         self.assertIn("--columns 2.5:100 4:500 4:1000 4:1300 8:1000 8:2000",
                       written[1]["command"])
         fm.model = fm.SUM
+
+    def test_a_call_that_would_drop_columns_whose_runs_are_gone_stops_before_running(self):
+        def summary(quick):
+            rows = [["4", "500", "1"], ["4", "1300", "1"], ["4", "1300", "2"]]
+            with open(os.path.join(tmp, fm.model.name + ".json"), "w") as f:
+                json.dump({"quick": quick, "tables": [{"header": ["gate [cm]", "crosses",
+                                                                  "seed"], "rows": rows}]}, f)
+
+        started = []
+        argv = ["--element-contacts", "mean", "--depth-cm", "20", "--seeds", "1", "2"]
+        with tempfile.TemporaryDirectory() as tmp, mock.patch.object(fm, "RESULTS", tmp), \
+                mock.patch.multiple(fm, finished_columns=lambda seeds: [],
+                                    unfinished=lambda run: "not run",
+                                    run_all=lambda exe, cols, seeds: started.append(cols)):
+            fm.model = fm.MEAN.in_experiments_box()
+            self.assertEqual(fm.columns_in_summary(), [])  # none on disk
+            summary(False)
+            self.assertEqual(fm.columns_in_summary(), [(4, 500), (4, 1300)])
+            self.assertEqual(fm.dropped_columns([(4, 1300), (8, 1000)]), [(4, 500)])
+            with self.assertRaises(SystemExit) as stop:
+                fm.main(argv + ["--columns", "8:1000"])
+            self.assertIn("crosses_flow_map_mean_deep.json holds columns whose runs are not "
+                          "on disk and that this call does not run: 4:500 4:1300",
+                          str(stop.exception.code))
+            self.assertEqual(started, [])  # stopped before running
+            for extra in (["--columns", "4:500", "4:1300", "8:1000"],  # runs them again
+                          ["--columns", "8:1000", "--drop-missing"]):
+                with self.assertRaises(SystemExit) as stop:  # the mocked runs never finish
+                    fm.main(argv + extra)
+                self.assertIn("not mapped", str(stop.exception.code))
+            self.assertEqual(len(started), 2)
+            summary(True)  # a quick summary holds no columns to keep
+            self.assertEqual(fm.columns_in_summary(), [])
+        fm.model = fm.SUM
+        fm.depth_m = fm.DEPTH_M
 
     def test_the_map_reports_every_column_finished_on_disk(self):
         with tempfile.TemporaryDirectory() as tmp, mock.patch.object(fm, "RESULTS", tmp):
