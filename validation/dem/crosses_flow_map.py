@@ -303,6 +303,17 @@ def unfinished(run):
     return None
 
 
+def column_key(gate_cm, count):
+    """A column as the map keys it: (gate [cm], crosses), a whole gate as an int."""
+    gate = float(gate_cm)
+    return (int(gate) if gate == int(gate) else gate, int(count))
+
+
+def summary_path():
+    """This map's summary, the file run_all.py reads (write_summary)."""
+    return os.path.join(RESULTS, model.name + ".json")
+
+
 def finished_columns(seeds):
     """The columns of this map's folder whose runs of every seed have finished: those of
     earlier calls with other --columns too. The map reports them all, so that a call that
@@ -312,8 +323,7 @@ def finished_columns(seeds):
     for name in sorted(os.listdir(runs)) if os.path.isdir(runs) else []:
         m = re.fullmatch(r"L(\d+(?:\.\d+)?)cm_(\d+)", name)
         if m:
-            gate = float(m.group(1))
-            key = (int(gate) if gate == int(gate) else gate, int(m.group(2)))
+            key = column_key(m.group(1), m.group(2))
             if all(unfinished(folder(*key, s)) is None for s in seeds):
                 found.append(key)
     return found
@@ -322,7 +332,7 @@ def finished_columns(seeds):
 def columns_in_summary():
     """The columns (gate, crosses) of this map's full summary on disk (results/NAME.json,
     its per-run table), [] where there is none or it was written by --quick."""
-    path = os.path.join(RESULTS, model.name + ".json")
+    path = summary_path()
     if not os.path.isfile(path):
         return []
     with open(path) as f:
@@ -332,9 +342,7 @@ def columns_in_summary():
     found = set()
     for table in summary.get("tables", []):
         if table["header"][:2] == ["gate [cm]", "crosses"]:
-            for row in table["rows"]:
-                gate = float(row[0])
-                found.add((int(gate) if gate == int(gate) else gate, int(row[1])))
+            found.update(column_key(row[0], row[1]) for row in table["rows"])
     return sorted(found)
 
 
@@ -432,10 +440,9 @@ def main(argv=None):
     columns = default_columns(deep, args.quick)
     if args.columns:
         try:
-            columns = [(float(g), int(n)) for g, n in (c.split(":") for c in args.columns)]
+            columns = [column_key(g, n) for g, n in (c.split(":") for c in args.columns)]
         except ValueError:
             ap.error("--columns: give GATE_CM:CROSSES, e.g. 4:300")
-        columns = [(int(g) if g == int(g) else g, n) for g, n in columns]
         if any(g <= 0 or n < 1 for g, n in columns):
             ap.error("--columns: the gate and the crosses must be positive")
     columns = list(dict.fromkeys(columns))  # one run folder per column and seed
@@ -446,7 +453,7 @@ def main(argv=None):
     if not args.quick and not args.drop_missing:
         dropped = dropped_columns(set(columns) | set(finished_columns(seeds)))
         if dropped:
-            sys.exit(f"{os.path.relpath(os.path.join(RESULTS, model.name + '.json'), ROOT)} "
+            sys.exit(f"{os.path.relpath(summary_path(), ROOT)} "
                      "holds columns whose runs are not on disk and that this call does not "
                      "run: " + " ".join(f"{g:g}:{n}" for g, n in dropped) + ". Add them to "
                      "--columns to run them again, or pass --drop-missing to write a summary "
