@@ -20,7 +20,9 @@ Writes validation/dem/results/hopper_repose.json and
 docs/validation/figures/hopper_repose.png. Run time on the 2-core machine: about 19 min
 per run on one core, two at a time (3000 beads, 3.7e6 steps of Tc/20); `--quick` runs
 mu_c = 0.05, 0.5 and 0.65 (about 40 min), the full sweep 7 values (about 80 min).
-`--reuse` analyses the runs already on disk and reruns only the missing ones.
+Each run stops once the heap is at rest (the case's [stop] table), at the latest at 3 s.
+`--reuse` analyses the runs already on disk, runs the missing ones, and continues from its
+checkpoint a run the case now takes further (one made when the case ended at 1.6 s).
 
 Usage: /usr/bin/python3 validation/dem/hopper_repose.py [--build build] [--quick] [--reuse]
                                                        [--values MU ...]
@@ -33,11 +35,13 @@ import os
 import subprocess
 import sys
 import time
+import tomllib
 
 import matplotlib
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import read_arrays, read_pvd, read_summary, wall_time  # noqa: E402
+from _outputs import (read_arrays, read_pvd, read_summary, reached_time,  # noqa: E402
+                      wall_time)
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -59,24 +63,56 @@ def run_dir(mu):
     return os.path.join(RUNS, f"mu_{mu:g}")
 
 
+def case_end():
+    """(end_time_s, the [stop] table's mean speed [m/s] and check_after_s) of the case."""
+    with open(CASE, "rb") as f:
+        case = tomllib.load(f)
+    stop = case["stop"]
+    return (float(case["simulation"]["end_time_s"]), float(stop["mean_velocity_below_m_s"]),
+            float(stop.get("check_after_s", 0.0)))
+
+
+def last_diagnostics(out):
+    """(time [s], mean bead speed [m/s]) of the last row of the run's diagnostics.csv."""
+    with open(os.path.join(out, "diagnostics.csv"), newline="") as f:
+        row = list(csv.DictReader(f))[-1]
+    return float(row["time_s"]), float(row["mean_velocity_m_s"])
+
+
+def run_state(out, end=None):
+    """What a run folder needs for the case as it stands: "finished" when it ran to the
+    case's end time, stopped at rest, or ended at an output where the case's settle check
+    would have stopped it (a run made before the case had its [stop] table: the same bits
+    as a run of the case now); "continue" when it has a checkpoint short of that (a
+    restart takes it on, the same bits as one run); "fresh" otherwise."""
+    end_s, below, after = end or case_end()
+    if not os.path.exists(os.path.join(out, "checkpoint.bin")):
+        return "fresh"
+    lines = [line for line in open(os.path.join(out, "run.log")) if line.startswith("done:")]
+    if not lines:
+        return "continue" if reached_time(out) > 0 else "fresh"
+    if lines[-1].rstrip().endswith("settled") or reached_time(out) >= end_s - 1e-9:
+        return "finished"
+    t, speed = last_diagnostics(out)
+    return "finished" if t >= after and speed < below else "continue"
+
+
 def finished(out):
-    return os.path.exists(os.path.join(out, "analysis", "summary.csv"))
+    return (run_state(out) == "finished"
+            and os.path.exists(os.path.join(out, "analysis", "summary.csv")))
 
 
-def run_one(exe, mu):
-    """One discharge at friction mu on one core, then its analysis."""
+def run_one(exe, mu, reuse):
+    """One discharge at friction mu on one core, then its analysis. With `reuse`, a run
+    on disk that the case now takes further is continued from its checkpoint."""
     out = run_dir(mu)
     start = time.time()
+    restart = ["--restart"] if reuse and run_state(out) == "continue" else []
     subprocess.run([exe, "run", CASE, "--output", out, "--quiet", "--threads", "1",
-                    "--set", f"{PARAMETER}={mu}"], check=True, stdout=subprocess.DEVNULL)
+                    "--set", f"{PARAMETER}={mu}"] + restart, check=True,
+                   stdout=subprocess.DEVNULL)
     subprocess.run([exe, "analyze", out], check=True, stdout=subprocess.DEVNULL)
     return mu, time.time() - start
-
-
-def final_mean_speed(out):
-    """Mean bead speed of the last diagnostics row [m/s]."""
-    with open(os.path.join(out, "diagnostics.csv"), newline="") as f:
-        return float(list(csv.DictReader(f))[-1]["mean_velocity_m_s"])
 
 
 def final_heap(out):
@@ -129,7 +165,7 @@ def main():
     print(f"hopper_repose: {len(todo)} run(s) to do of {len(frictions)}, two at a time "
           "(about 20 min each)", flush=True)
     with concurrent.futures.ThreadPoolExecutor(max_workers=2) as pool:
-        for done, (mu, seconds) in enumerate(pool.map(lambda m: run_one(exe, m), todo), 1):
+        for done, (mu, seconds) in enumerate(pool.map(lambda m: run_one(exe, m, args.reuse), todo), 1):
             elapsed = time.time() - t0
             eta = elapsed / done * (len(todo) - done)
             print(f"  mu_c = {mu:g} done in {seconds / 60:.1f} min ({done}/{len(todo)}, "
@@ -155,8 +191,9 @@ def main():
          "measured": sum(held.values()), "thesis": "—", "tolerance": "0",
          "pass": sum(held.values()) == 0},
     ]
+    ends = {mu: last_diagnostics(run_dir(mu)) for mu in frictions}
     rows = [[f"{mu:g}", f"{angle[mu]:.1f}", f"{1e3 * heap[mu][1]:.1f}", held[mu],
-             f"{final_mean_speed(run_dir(mu)):.1e}"] for mu in frictions]
+             f"{ends[mu][0]:.2f}", f"{ends[mu][1]:.1e}"] for mu in frictions]
 
     os.makedirs(os.path.dirname(FIGURE), exist_ok=True)
     fig, ax = plt.subplots(figsize=(6, 4.2))
@@ -190,7 +227,7 @@ def main():
         "checks": checks,
         "tables": [{"caption": "Repose angle per mu_c (one run each, the case's seed).",
                     "header": ["mu_c", "angle [deg]", "heap top [mm]", "beads in funnel",
-                               "mean speed at 1.6 s [m/s]"],
+                               "end [s]", "mean speed at the end [m/s]"],
                     "rows": rows}],
         "notes": ["Fig. 2.7 gives the thesis' curve and Yan et al.'s only as plots; the text "
                   "states the saturation near 36° at mu_c = 0.5 and a steeper rise than Yan et "

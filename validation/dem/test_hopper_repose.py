@@ -4,12 +4,64 @@ the sweep's angles and heap tops, not written in. Run by ctest
 /usr/bin/python3 -m unittest discover -s validation/dem -p 'test_*.py'"""
 import os
 import sys
+import tempfile
 import unittest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import hopper_repose  # noqa: E402
 
 FRICTIONS = [0.05, 0.1, 0.2, 0.3, 0.65]
+END = (3.0, 1e-4, 1.59)  # the case's end time, settle speed and check_after_s
+DONE = "done: t = {t} s, 100 steps in 1m0s (1e+06 particle-steps/s), ended 2026-12-07 10:00:00 UTC"
+
+
+def run_folder(parent, log_lines, last_row=None, checkpoint=True):
+    """A run folder with run.log, a diagnostics.csv ending at last_row (time, mean speed)
+    and, if asked, a checkpoint."""
+    out = tempfile.mkdtemp(dir=parent)
+    with open(os.path.join(out, "run.log"), "w") as f:
+        f.write("sanguis 0.1.0, started 2026-12-07 09:00:00 UTC\n" + "".join(
+            line + "\n" for line in log_lines))
+    if last_row:
+        with open(os.path.join(out, "diagnostics.csv"), "w") as f:
+            f.write("time_s,mean_velocity_m_s\n0,0\n" + f"{last_row[0]},{last_row[1]}\n")
+    if checkpoint:
+        open(os.path.join(out, "checkpoint.bin"), "w").close()
+    return out
+
+
+class RunState(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory()
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def state(self, *args, **kwargs):
+        return hopper_repose.run_state(run_folder(self.tmp.name, *args, **kwargs), END)
+
+    def test_a_run_cut_short_while_the_heap_still_moves_is_continued(self):
+        self.assertEqual(self.state([DONE.format(t=1.599999939)], (1.599999939, 2e-3)),
+                         "continue")
+
+    def test_a_run_at_rest_where_the_settle_check_would_stop_it_is_finished(self):
+        self.assertEqual(self.state([DONE.format(t=1.599999939)], (1.599999939, 6e-14)),
+                         "finished")
+
+    def test_a_run_at_rest_before_the_check_begins_is_continued(self):
+        self.assertEqual(self.state([DONE.format(t=1.2)], (1.2, 6e-14)), "continue")
+
+    def test_a_settled_or_ended_run_is_finished(self):
+        settled = ["settled at t = 1.9 s: mean velocity below 0.0001 m/s",
+                   DONE.format(t=1.9) + ", settled"]
+        self.assertEqual(self.state(settled, (1.9, 9e-5)), "finished")
+        self.assertEqual(self.state([DONE.format(t=3.0)], (3.0, 5e-3)), "finished")
+
+    def test_a_run_without_checkpoint_starts_afresh(self):
+        self.assertEqual(self.state([DONE.format(t=1.6)], (1.6, 2e-3), checkpoint=False),
+                         "fresh")
+        self.assertEqual(self.state([], None), "fresh")
+
 
 
 class HeapOnsetNote(unittest.TestCase):
