@@ -171,7 +171,7 @@ def main():
             print(f"  mu_c = {mu:g} done in {seconds / 60:.1f} min ({done}/{len(todo)}, "
                   f"ETA {eta / 60:.0f} min)", flush=True)
     elapsed = time.time() - t0
-    if not todo:  # all reused: the runs' own wall time, two at a time
+    if args.reuse:  # runs of earlier calls: the runs' own wall time, two at a time
         elapsed = sum(wall_time(run_dir(mu)) for mu in frictions) / 2.0
 
     angle = {mu: read_summary(run_dir(mu))["repose_angle_deg"] for mu in frictions}
