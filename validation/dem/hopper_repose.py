@@ -141,8 +141,19 @@ def heap_onset_note(frictions, angle, heap_top, flat_below_deg=1.0):
     return (f"Below mu_c = {first:g} no heap forms: the beads slide over each other and "
             f"spread over the floor {depth} bead diameters deep "
             f"(angle below {flat_below_deg:g}°); the angle jumps to {angle[first]:.1f}° at "
-            f"{first:g} and grows by {angle[last] - angle[first]:.1f}° more up to {last:g}, "
-            "the steep rise at low friction that the thesis reports against Yan et al.")
+            f"{first:g} (and is {angle[last]:.1f}° at {last:g}): the steep rise at low "
+            "friction that the thesis reports against Yan et al.")
+
+
+def jam_note(frictions, held):
+    """The runs whose discharge jammed: beads still above the outlet at rest."""
+    jammed = [mu for mu in frictions if held[mu] > 0]
+    if not jammed:
+        return None
+    return ("The discharge jammed at mu_c = " + ", ".join(
+        f"{mu:g} ({held[mu]} beads)" for mu in jammed) + ": an arch of beads over the "
+        "6-diameter outlet held them at rest above it. The top view's apex is then one of "
+        "them, so that run's angle does not measure the heap on the floor.")
 
 
 def main():
@@ -234,6 +245,15 @@ def main():
                   "al.'s between 0.05 and 0.2, which the checks use. The thesis does not give "
                   "the number of beads, the hopper's geometry or the drop height.",
                   heap_onset_note(frictions, angle, {mu: heap[mu][1] for mu in frictions}),
+                  *filter(None, [jam_note(frictions, held)]),
+                  "One pour per mu_c, and its angle depends on the pour: the sweep of "
+                  "2026-11-23, with the build of that day (before the storage sort, "
+                  "docs/performance.md, \"Storage along a space-filling curve\", which "
+                  "changes the round-off), gave 32.1° at mu_c = 0.5 and 34.5° at 0.65 with "
+                  "every bead out of the funnel; the same case gives the table's now. Those "
+                  "runs also ended at "
+                  "1.6 s with the 0.65 heap still moving (mean speed 3.8e-3 m/s); the case now "
+                  "stops once the heap is at rest.",
                   "The run at mu_c = 0.5 is the case file as shipped (seed 3). Every run used "
                   "one thread (results do not depend on the thread count). Run time: the "
                   "runs' wall time, two at a time on the 2 cores."],

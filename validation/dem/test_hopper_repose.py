@@ -30,6 +30,14 @@ def run_folder(parent, log_lines, last_row=None, checkpoint=True):
     return out
 
 
+class JamNote(unittest.TestCase):
+    def test_only_runs_with_beads_held_in_the_funnel_are_named(self):
+        note = hopper_repose.jam_note(FRICTIONS, {0.05: 0, 0.1: 0, 0.2: 0, 0.3: 3, 0.65: 59})
+        self.assertTrue(note.startswith("The discharge jammed at mu_c = 0.3 (3 beads), "
+                                        "0.65 (59 beads):"))
+        self.assertIsNone(hopper_repose.jam_note(FRICTIONS, {mu: 0 for mu in FRICTIONS}))
+
+
 class RunState(unittest.TestCase):
     def setUp(self):
         self.tmp = tempfile.TemporaryDirectory()
@@ -72,7 +80,7 @@ class HeapOnsetNote(unittest.TestCase):
         self.assertIn("Below mu_c = 0.2 no heap forms", note)
         self.assertIn("1.8-3.2 bead diameters deep", note)
         self.assertIn("jumps to 23.3° at 0.2", note)
-        self.assertIn("grows by 11.2° more up to 0.65", note)
+        self.assertIn("(and is 34.5° at 0.65)", note)
 
     def test_a_heap_at_the_lowest_friction_is_said_so(self):
         angle = {mu: 20.0 + 10 * mu for mu in FRICTIONS}
