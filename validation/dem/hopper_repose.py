@@ -176,7 +176,8 @@ def main():
     print(f"hopper_repose: {len(todo)} run(s) to do of {len(frictions)}, two at a time "
           "(about 20 min each)", flush=True)
     with concurrent.futures.ThreadPoolExecutor(max_workers=2) as pool:
-        for done, (mu, seconds) in enumerate(pool.map(lambda m: run_one(exe, m, args.reuse), todo), 1):
+        runs = pool.map(lambda m: run_one(exe, m, args.reuse), todo)
+        for done, (mu, seconds) in enumerate(runs, 1):
             elapsed = time.time() - t0
             eta = elapsed / done * (len(todo) - done)
             print(f"  mu_c = {mu:g} done in {seconds / 60:.1f} min ({done}/{len(todo)}, "
@@ -210,6 +211,10 @@ def main():
     fig, ax = plt.subplots(figsize=(6, 4.2))
     ax.plot(frictions, [angle[mu] for mu in frictions], "o-", color="tab:blue",
             label="sanguis, Table 2.1 (3000 beads)")
+    jammed = [mu for mu in frictions if held[mu] > 0]
+    if jammed:  # their angle is read with a held bead as the apex: not the heap's
+        ax.plot(jammed, [angle[mu] for mu in jammed], "x", color="tab:red", ms=10, mew=2,
+                label="discharge jammed (beads held in the funnel)")
     ax.errorbar([0.5], [THESIS_ANGLE], yerr=[[0.15 * THESIS_ANGLE], [0.15 * THESIS_ANGLE]],
                 fmt="ks", capsize=4, label="thesis: ≈ 36° at μc = 0.5 (±15 %)")
     ax.set_xlabel(r"bead-bead friction $\mu_c$")
@@ -251,9 +256,8 @@ def main():
                   "docs/performance.md, \"Storage along a space-filling curve\", which "
                   "changes the round-off), gave 32.1° at mu_c = 0.5 and 34.5° at 0.65 with "
                   "every bead out of the funnel; the same case gives the table's now. Those "
-                  "runs also ended at "
-                  "1.6 s with the 0.65 heap still moving (mean speed 3.8e-3 m/s); the case now "
-                  "stops once the heap is at rest.",
+                  "runs also ended at 1.6 s with the 0.65 heap still moving (mean speed "
+                  "3.8e-3 m/s); the case now stops once the heap is at rest.",
                   "The run at mu_c = 0.5 is the case file as shipped (seed 3). Every run used "
                   "one thread (results do not depend on the thread count). Run time: the "
                   "runs' wall time, two at a time on the 2 cores."],
