@@ -178,10 +178,11 @@ def finished_segments(run):
     stopped on the way (a killed call, an ended session) counts up to its last
     `checkpoint:` line, the part a restart keeps; what it ran past that is lost and not
     counted."""
-    return _segments(_log_lines(run))
+    return _segments(log_lines(run))
 
 
-def _log_lines(run):
+def log_lines(run):
+    """The lines of the run's run.log, [] where it has none."""
     path = os.path.join(run, "run.log")
     if not os.path.exists(path):
         return []
@@ -244,7 +245,7 @@ def segment_starts(run):
     the UTC date ("YYYY-MM-DD HH:MM:SS") where the line has one (since 2026-12-05), else
     None."""
     out = []
-    for line in _log_lines(run):
+    for line in log_lines(run):
         if ", started " in line or line.startswith("--- restart from checkpoint"):
             m = re.search(r"(\d{4}-\d{2}-\d{2} \d{2}:\d{2}:\d{2}) UTC", line)
             out.append(m.group(1) if m else None)
@@ -265,7 +266,7 @@ def uncounted_spans(run):
     segment stopped before run.log recorded checkpoints (logs written before 2026-12-03)
     leaves no line, yet the restart after it starts from a later checkpoint than the last
     one counted. wall_time leaves these spans out; a report should say so."""
-    lines = _log_lines(run)
+    lines = log_lines(run)
     spans = []
     for i, line in enumerate(lines):
         m = re.match(r"--- restart from checkpoint at t = (\S+) s", line)
@@ -457,7 +458,7 @@ def counted_intervals(run, after=-1.0):
     """(start, end) [UTC s since the epoch] of the segments wall_time(run, after) adds
     (a segment without a date, written before 2026-12-05, is left out)."""
     return [(stamp - seconds, stamp) for end, seconds, stamp in
-            _stamped_segments(_log_lines(run)) if end > after + 1e-9 and stamp is not None]
+            _stamped_segments(log_lines(run)) if end > after + 1e-9 and stamp is not None]
 
 
 def runs_utc(intervals):

@@ -40,8 +40,8 @@ import tomllib
 import matplotlib
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from _outputs import (read_arrays, read_pvd, read_summary, reached_time,  # noqa: E402
-                      wall_time)
+from _outputs import (log_lines, read_arrays, read_pvd,  # noqa: E402
+                      read_summary, reached_time, wall_time)
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -88,7 +88,7 @@ def run_state(out, end=None):
     end_s, below, after = end or case_end()
     if not os.path.exists(os.path.join(out, "checkpoint.bin")):
         return "fresh"
-    lines = [line for line in open(os.path.join(out, "run.log")) if line.startswith("done:")]
+    lines = [line for line in log_lines(out) if line.startswith("done:")]
     if not lines:
         return "continue" if reached_time(out) > 0 else "fresh"
     if lines[-1].rstrip().endswith("settled") or reached_time(out) >= end_s - 1e-9:
@@ -97,19 +97,18 @@ def run_state(out, end=None):
     return "finished" if t >= after and speed < below else "continue"
 
 
-def finished(out):
-    return (run_state(out) == "finished"
-            and os.path.exists(os.path.join(out, "analysis", "summary.csv")))
+def analysed(out):
+    return os.path.exists(os.path.join(out, "analysis", "summary.csv"))
 
 
-def run_one(exe, mu, reuse):
-    """One discharge at friction mu on one core, then its analysis. With `reuse`, a run
-    on disk that the case now takes further is continued from its checkpoint."""
+def run_one(exe, mu, restart):
+    """One discharge at friction mu on one core, then its analysis; `restart`: continue the
+    run on disk from its checkpoint."""
     out = run_dir(mu)
     start = time.time()
-    restart = ["--restart"] if reuse and run_state(out) == "continue" else []
     subprocess.run([exe, "run", CASE, "--output", out, "--quiet", "--threads", "1",
-                    "--set", f"{PARAMETER}={mu}"] + restart, check=True,
+                    "--set", f"{PARAMETER}={mu}"] + (["--restart"] if restart else []),
+                   check=True,
                    stdout=subprocess.DEVNULL)
     subprocess.run([exe, "analyze", out], check=True, stdout=subprocess.DEVNULL)
     return mu, time.time() - start
@@ -172,11 +171,14 @@ def main():
         ap.error(f"--values must include {', '.join(f'{m:g}' for m in missing)} (the checks use them)")
     t0 = time.time()
 
-    todo = [mu for mu in frictions if not (args.reuse and finished(run_dir(mu)))]
+    end = case_end()
+    state = {mu: run_state(run_dir(mu), end) if args.reuse else "fresh" for mu in frictions}
+    todo = [mu for mu in frictions
+            if not (state[mu] == "finished" and analysed(run_dir(mu)))]
     print(f"hopper_repose: {len(todo)} run(s) to do of {len(frictions)}, two at a time "
           "(about 20 min each)", flush=True)
     with concurrent.futures.ThreadPoolExecutor(max_workers=2) as pool:
-        runs = pool.map(lambda m: run_one(exe, m, args.reuse), todo)
+        runs = pool.map(lambda m: run_one(exe, m, state[m] == "continue"), todo)
         for done, (mu, seconds) in enumerate(runs, 1):
             elapsed = time.time() - t0
             eta = elapsed / done * (len(todo) - done)

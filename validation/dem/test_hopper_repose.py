@@ -1,5 +1,6 @@
-"""Tests of validation/dem/hopper_repose.py: the note on the onset of a heap is read from
-the sweep's angles and heap tops, not written in. Run by ctest
+"""Tests of validation/dem/hopper_repose.py: the notes on the onset of a heap and on a
+jammed discharge are read from the sweep, not written in; which runs on disk are
+finished, continued from their checkpoint or run afresh (run_state). Run by ctest
 (ValidationScripts.DemHelpers) or by hand:
 /usr/bin/python3 -m unittest discover -s validation/dem -p 'test_*.py'"""
 import os
@@ -69,7 +70,6 @@ class RunState(unittest.TestCase):
         self.assertEqual(self.state([DONE.format(t=1.6)], (1.6, 2e-3), checkpoint=False),
                          "fresh")
         self.assertEqual(self.state([], None), "fresh")
-
 
 
 class HeapOnsetNote(unittest.TestCase):
