@@ -1,6 +1,7 @@
 """Tests of validation/dem/hopper_repose.py: the notes on the onset of a heap and on a
-jammed discharge are read from the sweep, not written in; which runs on disk are
-finished, continued from their checkpoint or run afresh (run_state). Run by ctest
+jammed discharge are read from the sweep, not written in; the median over pours leaves
+the jammed ones out; where a pour's run lives; which runs on disk are finished, continued
+from their checkpoint or run afresh (run_state). Run by ctest
 (ValidationScripts.DemHelpers) or by hand:
 /usr/bin/python3 -m unittest discover -s validation/dem -p 'test_*.py'"""
 import os
@@ -32,11 +33,35 @@ def run_folder(parent, log_lines, last_row=None, checkpoint=True):
 
 
 class JamNote(unittest.TestCase):
-    def test_only_runs_with_beads_held_in_the_funnel_are_named(self):
-        note = hopper_repose.jam_note(FRICTIONS, {0.05: 0, 0.1: 0, 0.2: 0, 0.3: 3, 0.65: 59})
-        self.assertTrue(note.startswith("The discharge jammed at mu_c = 0.3 (3 beads), "
-                                        "0.65 (59 beads):"))
-        self.assertIsNone(hopper_repose.jam_note(FRICTIONS, {mu: 0 for mu in FRICTIONS}))
+    def test_only_pours_with_beads_held_in_the_funnel_are_named(self):
+        pours = [(mu, seed) for mu in FRICTIONS for seed in (1, 3)]
+        held = {p: 0 for p in pours}
+        held[(0.3, 1)], held[(0.65, 3)] = 3, 59
+        note = hopper_repose.jam_note(pours, held)
+        self.assertTrue(note.startswith("The discharge jammed at mu_c = 0.3 seed 1 (3 beads), "
+                                        "mu_c = 0.65 seed 3 (59 beads):"))
+        self.assertIsNone(hopper_repose.jam_note(pours, {p: 0 for p in pours}))
+
+
+class PourMedian(unittest.TestCase):
+    def test_the_median_of_an_odd_and_an_even_number_of_pours(self):
+        self.assertEqual(hopper_repose.pour_median([34.8, 27.6, 27.3], [0, 0, 0]), 27.6)
+        self.assertEqual(hopper_repose.pour_median([30.0, 26.0], [0, 0]), 28.0)
+
+    def test_jammed_pours_are_left_out(self):
+        self.assertEqual(hopper_repose.pour_median([10.9, 30.0, 26.0], [59, 0, 0]), 28.0)
+
+    def test_every_pour_jammed_gives_no_angle(self):
+        self.assertIsNone(hopper_repose.pour_median([10.9, 12.0], [59, 3]))
+
+
+class RunDir(unittest.TestCase):
+    def test_the_case_seed_keeps_the_folder_of_one_pour_per_friction(self):
+        seed = hopper_repose.case_seed()
+        self.assertEqual(os.path.basename(hopper_repose.run_dir(0.5, seed)), "mu_0.5")
+        self.assertEqual(os.path.basename(hopper_repose.run_dir(0.5)), "mu_0.5")
+        self.assertEqual(os.path.basename(hopper_repose.run_dir(0.05, seed + 1)),
+                         f"mu_0.05_seed_{seed + 1}")
 
 
 class RunState(unittest.TestCase):
