@@ -101,6 +101,42 @@ TEST(TopViewRaster, ReposeAngleOfAConeOfSpheres) {
   const ReposeMeasure m = measure_repose_angle(raster, 0.0);
   EXPECT_NEAR(m.angle_deg, 30.0, 1.0);
   EXPECT_GT(m.fitted_rings, 10u);
+  EXPECT_NEAR(m.cone_angle_deg, 30.0, 1.0);
+  EXPECT_GT(m.cone_pixels, 1000u);
+}
+
+// A heap of spheres h = h0 - sqrt((s1 x)^2 + (s2 y)^2) on a floor: slope s1 along x,
+// s2 along y. Optionally one loose sphere resting off the apex.
+TopViewRaster elliptic_heap(double s1, double s2, bool loose_sphere) {
+  const double r = 0.001, h0 = 0.02;
+  TopViewRaster raster(-0.08, 0.08, -0.08, 0.08, r / 2);
+  for (double x = -0.075; x <= 0.075; x += r) {
+    for (double y = -0.075; y <= 0.075; y += r) {
+      const double h = h0 - std::hypot(s1 * x, s2 * y);
+      if (h > 0) raster.add_sphere({x, y, h}, r);
+    }
+  }
+  if (loose_sphere) raster.add_sphere({0.004, 0.0, h0 - 0.004 * s1 + 2 * r}, r);
+  return raster;
+}
+
+double degrees(double slope) { return std::atan(slope) * 180.0 / std::numbers::pi; }
+
+TEST(TopViewRaster, ReposeAngleIgnoresALooseSphereNearTheApex) {
+  const ReposeMeasure m = measure_repose_angle(elliptic_heap(0.6, 0.6, true), 0.0);
+  EXPECT_NEAR(m.angle_deg, degrees(0.6), 1.0);
+  EXPECT_NEAR(m.cone_angle_deg, degrees(0.6), 1.0);
+}
+
+// On a heap that is not a cone the envelope reads the shallowest profile (the
+// highest at each radius), the cone fit a slope between the shallowest and the
+// steepest.
+TEST(TopViewRaster, ReposeReadingsOfAnEllipticHeap) {
+  const double s1 = 0.5, s2 = 0.9;
+  const ReposeMeasure m = measure_repose_angle(elliptic_heap(s1, s2, false), 0.0);
+  EXPECT_NEAR(m.angle_deg, degrees(s1), 1.0);
+  EXPECT_GT(m.cone_angle_deg, degrees(s1) + 3.0);
+  EXPECT_LT(m.cone_angle_deg, degrees(s2) - 3.0);
 }
 
 TEST(Quantile, InterpolatesOrderStatistics) {

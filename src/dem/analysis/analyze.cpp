@@ -256,6 +256,7 @@ std::vector<std::pair<std::string, double>> summary_values(const RunAnalysis& a)
       {"contact_point_coordination", whole.contact_point_coordination},
       {"fabric_anisotropy", a.fabric.anisotropy},
       {"repose_angle_deg", a.repose.angle_deg},
+      {"repose_cone_angle_deg", a.repose.cone_angle_deg},
       {"fabric_principal_angle_deg", a.fabric.principal_angle_deg},
       {"particles_touching_obstacles_fraction",
        whole.particles > 0 ? static_cast<double>(whole.particles_touching_obstacles) /

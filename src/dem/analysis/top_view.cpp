@@ -101,6 +101,45 @@ RunoutMeasure measure_runout(const TopViewRaster& raster) {
           runout_distance(raster, 0.01)};
 }
 
+namespace {
+
+// Least-squares straight line h = a + b r through (r, h) pairs, accumulated.
+struct LineFit {
+  double n = 0, sr = 0, sh = 0, srr = 0, srh = 0;
+  void add(double r, double h) {
+    n += 1;
+    sr += r;
+    sh += h;
+    srr += r * r;
+    srh += r * h;
+  }
+  double slope() const { return (n * srh - sr * sh) / (n * srr - sr * sr); }
+};
+
+constexpr double kDegrees = 180.0 / 3.14159265358979323846;
+
+// Angle below the horizontal of a fit of height against radius.
+double slope_angle_deg(const LineFit& height_on_radius) {
+  return std::atan(std::max(0.0, -height_on_radius.slope())) * kDegrees;
+}
+
+// Centroid (in pixel indices) of the pixels higher than `fraction` of the heap.
+std::pair<double, double> centroid_above(const TopViewRaster& raster, double floor,
+                                         double height, double fraction) {
+  double ax = 0.0, ay = 0.0, weight = 0.0;
+  for (std::size_t j = 0; j < raster.ny(); ++j) {
+    for (std::size_t i = 0; i < raster.nx(); ++i) {
+      if (raster.top(i, j) - floor < fraction * height) continue;
+      ax += static_cast<double>(i);
+      ay += static_cast<double>(j);
+      weight += 1.0;
+    }
+  }
+  return {ax / weight, ay / weight};
+}
+
+}  // namespace
+
 ReposeMeasure measure_repose_angle(const TopViewRaster& raster, double floor) {
   double highest = TopViewRaster::kEmpty;
   for (std::size_t j = 0; j < raster.ny(); ++j) {
@@ -109,46 +148,48 @@ ReposeMeasure measure_repose_angle(const TopViewRaster& raster, double floor) {
   ReposeMeasure m;
   if (highest <= floor) return m;
   const double height = highest - floor;
-  double ax = 0.0, ay = 0.0, weight = 0.0;
-  for (std::size_t j = 0; j < raster.ny(); ++j) {
-    for (std::size_t i = 0; i < raster.nx(); ++i) {
-      if (raster.top(i, j) - floor < 0.95 * height) continue;
-      ax += static_cast<double>(i);
-      ay += static_cast<double>(j);
-      weight += 1.0;
-    }
-  }
-  ax /= weight;
-  ay /= weight;
+  m.apex_height = height;
+  const auto in_band = [&](double h) { return h >= 0.2 * height && h <= 0.8 * height; };
+  const auto radius = [&](std::size_t i, std::size_t j, std::pair<double, double> c) {
+    return raster.pixel() *
+           std::hypot(static_cast<double>(i) - c.first, static_cast<double>(j) - c.second);
+  };
+
+  const auto apex = centroid_above(raster, floor, height, 0.95);
   const double ring = 2.0 * raster.pixel();
   std::vector<double> envelope;
   for (std::size_t j = 0; j < raster.ny(); ++j) {
     for (std::size_t i = 0; i < raster.nx(); ++i) {
       if (!raster.covered(i, j)) continue;
-      const double r =
-          raster.pixel() * std::hypot(static_cast<double>(i) - ax, static_cast<double>(j) - ay);
-      const auto k = static_cast<std::size_t>(r / ring);
+      const auto k = static_cast<std::size_t>(radius(i, j, apex) / ring);
       if (k >= envelope.size()) envelope.resize(k + 1, 0.0);
       envelope[k] = std::max(envelope[k], raster.top(i, j) - floor);
     }
   }
-  // Least-squares line h = a + b r over the rings in the 20-80% band.
-  double n = 0, sr = 0, sh = 0, srr = 0, srh = 0;
+  LineFit rings;
   for (std::size_t k = 0; k < envelope.size(); ++k) {
-    const double h = envelope[k];
-    if (h < 0.2 * height || h > 0.8 * height) continue;
-    const double r = (static_cast<double>(k) + 0.5) * ring;
-    n += 1;
-    sr += r;
-    sh += h;
-    srr += r * r;
-    srh += r * h;
+    if (in_band(envelope[k])) rings.add((static_cast<double>(k) + 0.5) * ring, envelope[k]);
   }
-  m.apex_height = height;
-  m.fitted_rings = static_cast<std::size_t>(n);
-  if (n < 2) return m;
-  const double slope = (n * srh - sr * sh) / (n * srr - sr * sr);
-  m.angle_deg = std::atan(std::max(0.0, -slope)) * 180.0 / 3.14159265358979323846;
+  m.fitted_rings = static_cast<std::size_t>(rings.n);
+  if (rings.n >= 2) m.angle_deg = slope_angle_deg(rings);
+
+  // Radius against height, not height against radius: the band selects on the
+  // height, and a least-squares fit whose dependent variable is truncated is biased
+  // towards a flat line (a heap whose slope varies with the azimuth read below its
+  // shallowest slope). With the height as the regressor, the fit gives the mean
+  // radius of the heap's contour at each height.
+  const auto cap = centroid_above(raster, floor, height, 0.8);
+  LineFit surface;
+  for (std::size_t j = 0; j < raster.ny(); ++j) {
+    for (std::size_t i = 0; i < raster.nx(); ++i) {
+      const double h = raster.top(i, j) - floor;
+      if (raster.covered(i, j) && in_band(h)) surface.add(h, radius(i, j, cap));
+    }
+  }
+  m.cone_pixels = static_cast<std::size_t>(surface.n);
+  if (surface.n >= 2 && surface.slope() < 0.0) {
+    m.cone_angle_deg = std::atan(-1.0 / surface.slope()) * kDegrees;
+  }
   return m;
 }
 

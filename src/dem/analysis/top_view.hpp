@@ -72,15 +72,25 @@ struct HeightMeasure {
 };
 HeightMeasure measure_height(const TopViewRaster& raster, double floor);
 
-// Angle of repose of a heap (degrees): the surface envelope (highest point in
-// rings of width 2 pixels around the apex) fitted by a straight line over the
-// part between 20% and 80% of the heap height (the rounded top and the
-// scattered foot excluded). The apex is the centroid of the pixels within 5% of
-// the highest. Suited to a conical heap on a floor (hopper, pouring).
+// Angle of repose of a heap (degrees), read two ways over the part between 20%
+// and 80% of the heap height (the rounded top and the scattered foot excluded):
+// - angle_deg: the surface envelope, the highest point in rings of width 2 pixels
+//   around the apex (the centroid of the pixels within 5% of the highest), fitted
+//   by a straight line;
+// - cone_angle_deg: a cone r = a - h / tan(angle) fitted by least squares through
+//   every covered pixel of the band, r from the centroid of the cap above the band
+//   (the pixels above 80%): the mean radius of the heap's contour at each height.
+//   It reads a mean slope over all azimuths, where the envelope reads the highest
+//   profile at each radius (the shallowest slope), so on a heap that is not a cone
+//   the two differ, and their gap says by how much.
+// Both give the slope of a cone of spheres (tests/dem/test_top_view.cpp). Suited
+// to a conical heap on a floor (hopper, pouring).
 struct ReposeMeasure {
   double angle_deg = 0.0;
+  double cone_angle_deg = 0.0;
   double apex_height = 0.0;  // from the floor [m]
   std::size_t fitted_rings = 0;
+  std::size_t cone_pixels = 0;  // pixels in the cone's fit
 };
 ReposeMeasure measure_repose_angle(const TopViewRaster& raster, double floor);
 
