@@ -124,8 +124,8 @@ double slope_angle_deg(const LineFit& height_on_radius) {
 }
 
 // Centroid (in pixel indices) of the pixels higher than `fraction` of the heap.
-std::pair<double, double> centroid_above(const TopViewRaster& raster, double floor,
-                                         double height, double fraction) {
+std::pair<double, double> centroid_above(const TopViewRaster& raster, double floor, double height,
+                                         double fraction) {
   double ax = 0.0, ay = 0.0, weight = 0.0;
   for (std::size_t j = 0; j < raster.ny(); ++j) {
     for (std::size_t i = 0; i < raster.nx(); ++i) {
