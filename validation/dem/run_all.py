@@ -8,7 +8,7 @@ the thesis' numbers with the tolerance and PASS/FAIL, the run time, and the hard
 date of the run. Exits 1 if any script fails. `make validate-dem` calls it; on the
 2-core development machine it takes about a day (run times of the last runs, in the
 report): the dam breaks of crosses (crosses_dam_break ~7 h, crosses_calibrated_gates
-~5 h, crosses_recalibrated ~3 h, crosses_column_width several hours), the hopper sweep (~75 min), the cross columns (memory
+~5 h, crosses_recalibrated ~3 h, crosses_column_width several hours), the hopper sweep (~3.5 h, three pours per mu_c), the cross columns (memory
 pair with its pour ~7 min, tangential map ~14 min, three more pours ~15 min, the gate
 lifted or removed on those pours ~11 min more), the
 friction calibration (~4 min), the run-out scaling (~3 min) and the settling runs
