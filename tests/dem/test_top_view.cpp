@@ -106,7 +106,8 @@ TEST(TopViewRaster, ReposeAngleOfAConeOfSpheres) {
 }
 
 // A heap of spheres h = h0 - sqrt((s1 x)^2 + (s2 y)^2) on a floor: slope s1 along x,
-// s2 along y. Optionally one loose sphere resting off the apex.
+// s2 along y. Optionally one loose sphere resting on the slope 3 mm off the apex, its
+// top the highest point of the heap (the apex the envelope takes).
 TopViewRaster elliptic_heap(double s1, double s2, bool loose_sphere) {
   const double r = 0.001, h0 = 0.02;
   TopViewRaster raster(-0.08, 0.08, -0.08, 0.08, r / 2);
@@ -116,7 +117,7 @@ TopViewRaster elliptic_heap(double s1, double s2, bool loose_sphere) {
       if (h > 0) raster.add_sphere({x, y, h}, r);
     }
   }
-  if (loose_sphere) raster.add_sphere({0.004, 0.0, h0 - 0.004 * s1 + 2 * r}, r);
+  if (loose_sphere) raster.add_sphere({0.003, 0.0, h0 - 0.003 * s1 + 2 * r}, r);
   return raster;
 }
 

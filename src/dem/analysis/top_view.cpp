@@ -103,17 +103,17 @@ RunoutMeasure measure_runout(const TopViewRaster& raster) {
 
 namespace {
 
-// Least-squares straight line h = a + b r through (r, h) pairs, accumulated.
+// Least-squares straight line y = a + b x through (x, y) pairs, accumulated.
 struct LineFit {
-  double n = 0, sr = 0, sh = 0, srr = 0, srh = 0;
-  void add(double r, double h) {
+  double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
+  void add(double x, double y) {
     n += 1;
-    sr += r;
-    sh += h;
-    srr += r * r;
-    srh += r * h;
+    sx += x;
+    sy += y;
+    sxx += x * x;
+    sxy += x * y;
   }
-  double slope() const { return (n * srh - sr * sh) / (n * srr - sr * sr); }
+  double slope() const { return (n * sxy - sx * sy) / (n * sxx - sx * sx); }
 };
 
 constexpr double kDegrees = 180.0 / 3.14159265358979323846;
