@@ -121,7 +121,9 @@ TopViewRaster elliptic_heap(double s1, double s2, bool loose_sphere) {
   return raster;
 }
 
-double degrees(double slope) { return std::atan(slope) * 180.0 / std::numbers::pi; }
+double degrees(double slope) {
+  return std::atan(slope) * 180.0 / std::numbers::pi;
+}
 
 TEST(TopViewRaster, ReposeAngleIgnoresALooseSphereNearTheApex) {
   const ReposeMeasure m = measure_repose_angle(elliptic_heap(0.6, 0.6, true), 0.0);
