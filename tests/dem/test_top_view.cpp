@@ -103,6 +103,7 @@ TEST(TopViewRaster, ReposeAngleOfAConeOfSpheres) {
   EXPECT_GT(m.fitted_rings, 10u);
   EXPECT_NEAR(m.cone_angle_deg, 30.0, 1.0);
   EXPECT_GT(m.cone_pixels, 1000u);
+  EXPECT_GT(m.cone_r_squared, 0.9);
 }
 
 // A heap of spheres h = h0 - sqrt((s1 x)^2 + (s2 y)^2) on a floor: slope s1 along x,
@@ -140,6 +141,25 @@ TEST(TopViewRaster, ReposeReadingsOfAnEllipticHeap) {
   EXPECT_NEAR(m.angle_deg, degrees(s1), 1.0);
   EXPECT_GT(m.cone_angle_deg, degrees(s1) + 3.0);
   EXPECT_LT(m.cone_angle_deg, degrees(s2) - 3.0);
+}
+
+// A layer of spheres spread flat, 0.2 mm higher in the middle than at the rim: no
+// heap, and neither reading makes one of it (the spheres' own caps swamp the dome,
+// so the cone fit's radius hardly depends on the height: fitted anyway, its slope
+// would tend to zero and its angle to 90°).
+TEST(TopViewRaster, ReposeReadingsOfAFlatLayer) {
+  const double r = 0.001;
+  TopViewRaster raster(-0.05, 0.05, -0.05, 0.05, r / 8);  // fine: caps of every height
+  for (double x = -0.04; x <= 0.04; x += 2 * r) {
+    for (double y = -0.04; y <= 0.04; y += 2 * r) {
+      const double rho = std::hypot(x, y);
+      if (rho < 0.04) raster.add_sphere({x, y, r + 2e-4 * (1.0 - rho / 0.04)}, r);
+    }
+  }
+  const ReposeMeasure m = measure_repose_angle(raster, 0.0);
+  EXPECT_LT(m.angle_deg, 2.0);
+  EXPECT_LT(m.cone_r_squared, 0.1);
+  EXPECT_EQ(m.cone_angle_deg, 0.0);
 }
 
 TEST(Quantile, InterpolatesOrderStatistics) {

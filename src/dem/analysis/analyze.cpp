@@ -257,6 +257,7 @@ std::vector<std::pair<std::string, double>> summary_values(const RunAnalysis& a)
       {"fabric_anisotropy", a.fabric.anisotropy},
       {"repose_angle_deg", a.repose.angle_deg},
       {"repose_cone_angle_deg", a.repose.cone_angle_deg},
+      {"repose_cone_r_squared", a.repose.cone_r_squared},
       {"fabric_principal_angle_deg", a.fabric.principal_angle_deg},
       {"particles_touching_obstacles_fraction",
        whole.particles > 0 ? static_cast<double>(whole.particles_touching_obstacles) /

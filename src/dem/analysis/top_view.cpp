@@ -105,18 +105,25 @@ namespace {
 
 // Least-squares straight line y = a + b x through (x, y) pairs, accumulated.
 struct LineFit {
-  double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
+  double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0;
   void add(double x, double y) {
     n += 1;
     sx += x;
     sy += y;
     sxx += x * x;
     sxy += x * y;
+    syy += y * y;
   }
   double slope() const { return (n * sxy - sx * sy) / (n * sxx - sx * sx); }
+  // Share of the variance of y that the line explains (the squared correlation).
+  double r_squared() const {
+    const double cov = n * sxy - sx * sy;
+    return cov * cov / ((n * sxx - sx * sx) * (n * syy - sy * sy));
+  }
 };
 
 constexpr double kDegrees = 180.0 / 3.14159265358979323846;
+constexpr double kConeMinRSquared = 0.5;
 
 // Angle below the horizontal of a fit of height against radius.
 double slope_angle_deg(const LineFit& height_on_radius) {
@@ -186,8 +193,13 @@ ReposeMeasure measure_repose_angle(const TopViewRaster& raster, double floor) {
       if (raster.covered(i, j) && in_band(h)) surface.add(h, radius(i, j, cap));
     }
   }
+  // A deposit spread flat has no relation between height and radius (the fit's
+  // slope then tends to zero and the angle to 90°): below half the radii's variance
+  // explained it is not a cone, and gets no angle (the hopper's heaps explain
+  // 0.74-0.83, its flat layers 0-0.22).
   m.cone_pixels = static_cast<std::size_t>(surface.n);
-  if (surface.n >= 2 && surface.slope() < 0.0) {
+  if (surface.n >= 2) m.cone_r_squared = surface.r_squared();
+  if (surface.n >= 2 && m.cone_r_squared >= kConeMinRSquared && surface.slope() < 0.0) {
     m.cone_angle_deg = std::atan(-1.0 / surface.slope()) * kDegrees;
   }
   return m;

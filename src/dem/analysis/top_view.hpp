@@ -82,7 +82,9 @@ HeightMeasure measure_height(const TopViewRaster& raster, double floor);
 //   (the pixels above 80%): the mean radius of the heap's contour at each height.
 //   It reads a mean slope over all azimuths, where the envelope reads the highest
 //   profile at each radius (the shallowest slope), so on a heap that is not a cone
-//   the two differ, and their gap says by how much.
+//   the two differ, and their gap says by how much. A deposit whose radii the cone
+//   explains less than half of (cone_r_squared < 0.5: a layer spread flat) gets
+//   cone_angle_deg = 0.
 // Both give the slope of a cone of spheres (tests/dem/test_top_view.cpp). Suited
 // to a conical heap on a floor (hopper, pouring).
 struct ReposeMeasure {
@@ -91,6 +93,7 @@ struct ReposeMeasure {
   double apex_height = 0.0;  // from the floor [m]
   std::size_t fitted_rings = 0;
   std::size_t cone_pixels = 0;  // pixels in the cone's fit
+  double cone_r_squared = 0.0;  // share of the radii's variance the cone explains
 };
 ReposeMeasure measure_repose_angle(const TopViewRaster& raster, double floor);
 
