@@ -283,7 +283,8 @@ def main():
             label="sanguis, Table 2.1 (3000 beads)"
             + (f": median of {len(seeds)} pours" if len(seeds) > 1 else ""))
     ax.plot(kept, [cone_mu[mu] for mu in kept], "s--", color="tab:green", ms=4,
-            label="cone fitted through the surface (shown, not graded)")
+            label="cone fitted through the surface"
+            + (": median" if len(seeds) > 1 else "") + " (shown, not graded)")
     if len(seeds) > 1:
         free = [p for p in pours if held[p] == 0]
         ax.plot([mu for mu, _ in free], [angle[p] for p in free], ".", color="tab:blue",
@@ -298,7 +299,7 @@ def main():
     ax.set_ylabel("repose angle [deg]")
     ax.set_ylim(0, 45)
     ax.set_title("Hopper discharge, Table 2.1 (thesis Fig. 2.7)")
-    ax.legend(fontsize=8, loc="lower right")
+    ax.legend(fontsize=8, loc="upper left")  # the jammed pours sit low on the right
     fig.tight_layout()
     fig.savefig(FIGURE, dpi=130)
 
