@@ -248,6 +248,7 @@ def main():
 
     def shown(value, fmt):
         return "— (every pour jammed)" if value is None else format(value, fmt) + "°"
+
     growth = None if None in (low, mid) else mid - low
     saturation = None if None in (mid, high) else high - mid
     checks = [
@@ -270,9 +271,11 @@ def main():
              f"{1e3 * heap[(mu, seed)][1]:.1f}",
              held[(mu, seed)], f"{ends[(mu, seed)][0]:.2f}", f"{ends[(mu, seed)][1]:.1e}"]
             for mu, seed in pours]
+
     def listed(values, mu):
         return ", ".join(f"{values[(mu, s)]:.1f}" + ("*" if held[(mu, s)] else "")
                          for s in seeds)
+
     medians = [[f"{mu:g}", shown(angle_mu[mu], ".1f"), listed(angle, mu),
                 shown(cone_mu[mu], ".1f"), listed(cone, mu)] for mu in frictions]
 
@@ -349,8 +352,9 @@ def main():
                   "reads a slope averaged over the azimuths where the envelope reads the "
                   "highest profile, the shallowest (on an elliptic heap of slopes 26.6° and "
                   "42.0°, the envelope reads 26.6° and the cone fit a slope between). Both "
-                  "read a cone of spheres to within 1° (tests/dem/test_top_view.cpp). The checks were fixed on the envelope "
-                  "before the cone fit existed and stay on it.",
+                  "read a cone of spheres to within 1° (tests/dem/test_top_view.cpp). The "
+                  "checks were fixed on the envelope before the cone fit existed and stay on "
+                  "it.",
                   "The pour of seed 3 at mu_c = 0.5 is the case file as shipped. Every run "
                   "used one thread (results do not depend on the thread count). Run time: "
                   "the runs' wall time, two at a time on the 2 cores."],
