@@ -196,7 +196,7 @@ ReposeMeasure measure_repose_angle(const TopViewRaster& raster, double floor) {
   // A deposit spread flat has no relation between height and radius (the fit's
   // slope then tends to zero and the angle to 90°): below half the radii's variance
   // explained it is not a cone, and gets no angle (the hopper's heaps explain
-  // 0.74-0.83, its flat layers 0-0.22).
+  // 0.72-0.83, its flat layers 0-0.22).
   m.cone_pixels = static_cast<std::size_t>(surface.n);
   if (surface.n >= 2) m.cone_r_squared = surface.r_squared();
   if (surface.n >= 2 && m.cone_r_squared >= kConeMinRSquared && surface.slope() < 0.0) {
