@@ -40,8 +40,10 @@ Usage: /usr/bin/python3 validation/dem/hopper_repose.py [--build build] [--quick
 import argparse
 import concurrent.futures
 import csv
+import functools
 import json
 import os
+import statistics
 import subprocess
 import sys
 import time
@@ -76,6 +78,7 @@ def run_dir(mu, seed=None):
     return os.path.join(RUNS, name)
 
 
+@functools.cache  # run_dir asks for the case's seed for every file of every pour
 def read_case():
     with open(CASE, "rb") as f:
         return tomllib.load(f)
@@ -139,11 +142,8 @@ def analyse(exe, out):
 def pour_median(values, held):
     """Median of the pours' values, the pours that jammed (beads held in the funnel: the
     top view's apex is then a held bead) left out; None when every pour jammed."""
-    kept = sorted(v for v, h in zip(values, held) if h == 0)
-    if not kept:
-        return None
-    mid = len(kept) // 2
-    return kept[mid] if len(kept) % 2 else 0.5 * (kept[mid - 1] + kept[mid])
+    kept = [v for v, h in zip(values, held) if h == 0]
+    return statistics.median(kept) if kept else None
 
 
 def final_heap(out):
