@@ -55,6 +55,14 @@ class PourMedian(unittest.TestCase):
         self.assertIsNone(hopper_repose.pour_median([10.9, 12.0], [59, 3]))
 
 
+class GradingProtocol(unittest.TestCase):
+    def test_the_pours_seen_before_the_reading_was_chosen_do_not_grade(self):
+        # the cone fit was chosen after it had been seen on seeds 1-3: grading them would
+        # be choosing the reading that passes
+        self.assertEqual(hopper_repose.GRADED, "repose_cone_angle_deg")
+        self.assertFalse(set(hopper_repose.SEEDS) & set(hopper_repose.SEEN_SEEDS))
+
+
 class RunDir(unittest.TestCase):
     def test_the_case_seed_keeps_the_folder_of_one_pour_per_friction(self):
         seed = hopper_repose.case_seed()
