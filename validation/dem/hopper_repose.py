@@ -183,6 +183,14 @@ def heap_onset_note(frictions, angle, heap_top, flat_below_deg=1.0):
     depths = sorted({f"{heap_top[mu] / BEAD_DIAMETER:.1f}" for mu in flat}, key=float)
     depth = depths[0] if len(depths) == 1 else f"{depths[0]}-{depths[-1]}"
     last = frictions[-1]
+    skipped = [mu for mu in FRICTIONS if flat[-1] < mu < first]  # not run (--quick)
+    if skipped:  # the onset lies somewhere in between: no jump can be read
+        return (f"At mu_c = {', '.join(f'{mu:g}' for mu in flat)} no heap forms: the beads "
+                f"slide over each other and spread over the floor {depth} bead diameters "
+                f"deep (angle below {flat_below_deg:g}°); the next friction run, {first:g}, "
+                f"forms a heap of {angle[first]:.1f}° (and {angle[last]:.1f}° at {last:g}). "
+                f"The onset lies between {flat[-1]:g} and {first:g}, which this sweep did not "
+                f"resolve ({', '.join(f'{mu:g}' for mu in skipped)} not run).")
     return (f"Below mu_c = {first:g} no heap forms: the beads slide over each other and "
             f"spread over the floor {depth} bead diameters deep "
             f"(angle below {flat_below_deg:g}°); the angle jumps to {angle[first]:.1f}° at "

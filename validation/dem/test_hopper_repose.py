@@ -115,6 +115,16 @@ class HeapOnsetNote(unittest.TestCase):
         self.assertIn("jumps to 23.3° at 0.2", note)
         self.assertIn("(and is 34.5° at 0.65)", note)
 
+    def test_a_sweep_with_frictions_left_out_does_not_read_a_jump(self):
+        quick = [0.05, 0.5, 0.65]
+        angle = {0.05: 0.0, 0.5: 31.7, 0.65: 33.6}
+        top = {0.05: 3.6e-3, 0.5: 17e-3, 0.65: 17.5e-3}
+        note = hopper_repose.heap_onset_note(quick, angle, top)
+        self.assertTrue(note.startswith("At mu_c = 0.05 no heap forms"), note)
+        self.assertIn("between 0.05 and 0.5, which this sweep did not resolve "
+                      "(0.1, 0.2, 0.3, 0.4 not run)", note)
+        self.assertNotIn("jumps", note)
+
     def test_a_heap_at_the_lowest_friction_is_said_so(self):
         angle = {mu: 20.0 + 10 * mu for mu in FRICTIONS}
         top = {mu: 1e-2 for mu in FRICTIONS}
