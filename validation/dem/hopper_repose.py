@@ -317,11 +317,12 @@ def main():
     os.makedirs(os.path.dirname(FIGURE), exist_ok=True)
     fig, ax = plt.subplots(figsize=(6, 4.2))
     kept = [mu for mu in frictions if angle_mu[mu] is not None]
-    ax.plot(kept, [angle_mu[mu] for mu in kept], "o-", color="tab:blue",
+    line = "-" if frictions == FRICTIONS else ""  # no line across the frictions not run
+    ax.plot(kept, [angle_mu[mu] for mu in kept], "o" + line, color="tab:blue",
             label=f"sanguis, Table 2.1 (3000 beads), cone fit, seeds "
             f"{', '.join(map(str, seeds))}" + (": median" if len(seeds) > 1 else ""))
     kept_envelope = [mu for mu in frictions if envelope_mu[mu] is not None]
-    ax.plot(kept_envelope, [envelope_mu[mu] for mu in kept_envelope], "s--",
+    ax.plot(kept_envelope, [envelope_mu[mu] for mu in kept_envelope], "s--" if line else "s",
             color="tab:green", ms=4, label="surface envelope (shown, not graded)")
     if len(seeds) > 1:
         free = [p for p in pours if held[p] == 0]
