@@ -264,6 +264,7 @@ def main():
         return {mu: pour_median([values[(mu, s)] for s in over_seeds],
                                 [held[(mu, s)] for s in over_seeds])
                 for mu in over_frictions}
+
     angle_mu = median(angle)
     envelope_mu = median(envelope)
     heap_top_mu = median({p: heap[p][1] for p in pours})
@@ -301,6 +302,7 @@ def main():
 
     def median_rows(over_seeds, over_frictions):
         """Per mu_c: the medians of both readings and the pours (* jammed)."""
+
         def listed(values, mu):
             return ", ".join(f"{values[(mu, s)]:.1f}" + ("*" if held[(mu, s)] else "")
                              for s in over_seeds)
@@ -308,6 +310,7 @@ def main():
         top_mu = median(envelope, over_seeds, over_frictions)
         return [[f"{mu:g}", shown(cone_mu[mu], ".1f"), listed(angle, mu),
                  shown(top_mu[mu], ".1f"), listed(envelope, mu)] for mu in over_frictions]
+
     median_header = ["mu_c", "median cone fit", "pours, cone fit [deg]", "median envelope",
                      "pours, envelope [deg]"]
     seen_frictions = [mu for mu in FRICTIONS
@@ -404,7 +407,7 @@ def main():
                   "seeds 1-3 had been seen by then, so they no longer grade: they are shown in "
                   "the last table and the figure. The tolerances are those fixed before the "
                   "first sweep.",
-                  "The case file as shipped has seed 3. Every run "
+                  "The case file as shipped pours with seed 3, one of the shown pours. Every run "
                   "used one thread (results do not depend on the thread count). Run time: "
                   "the runs' wall time, two at a time on the 2 cores."],
         "run_time_s": round(elapsed, 1),
