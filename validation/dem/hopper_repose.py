@@ -276,6 +276,7 @@ def main():
     def shown(value, fmt):
         return "— (every pour jammed)" if value is None else format(value, fmt) + "°"
 
+    held_graded = sum(held[p] for p in pours)
     growth = None if None in (low, mid) else mid - low
     saturation = None if None in (mid, high) else high - mid
     checks = [
@@ -292,22 +293,20 @@ def main():
          "thesis": "saturates (Fig. 2.7)", "tolerance": "within ±3°",
          "pass": graded(saturation, lambda d: abs(d) <= 3.0)},
         {"quantity": "sanity: beads left in the funnel (graded pours)",
-         "measured": sum(held[p] for p in pours), "thesis": "—", "tolerance": "0",
-         "pass": sum(held[p] for p in pours) == 0},
+         "measured": held_graded, "thesis": "—", "tolerance": "0",
+         "pass": held_graded == 0},
     ]
     rows = [[f"{mu:g}", seed, f"{angle[(mu, seed)]:.1f}", f"{envelope[(mu, seed)]:.1f}",
              f"{1e3 * heap[(mu, seed)][1]:.1f}",
              held[(mu, seed)], f"{ends[(mu, seed)][0]:.2f}", f"{ends[(mu, seed)][1]:.1e}"]
             for mu, seed in pours]
 
-    def median_rows(over_seeds, over_frictions):
+    def median_rows(over_seeds, over_frictions, cone_mu, top_mu):
         """Per mu_c: the medians of both readings and the pours (* jammed)."""
 
         def listed(values, mu):
             return ", ".join(f"{values[(mu, s)]:.1f}" + ("*" if held[(mu, s)] else "")
                              for s in over_seeds)
-        cone_mu = median(angle, over_seeds, over_frictions)
-        top_mu = median(envelope, over_seeds, over_frictions)
         return [[f"{mu:g}", shown(cone_mu[mu], ".1f"), listed(angle, mu),
                  shown(top_mu[mu], ".1f"), listed(envelope, mu)] for mu in over_frictions]
 
@@ -315,7 +314,8 @@ def main():
                      "pours, envelope [deg]"]
     seen_frictions = [mu for mu in FRICTIONS
                       if all((mu, s) in seen for s in SEEN_SEEDS)]
-    seen_mu = median(angle, SEEN_SEEDS, seen_frictions) if seen_frictions else {}
+    seen_mu = median(angle, SEEN_SEEDS, seen_frictions)
+    seen_envelope_mu = median(envelope, SEEN_SEEDS, seen_frictions)
 
     os.makedirs(os.path.dirname(FIGURE), exist_ok=True)
     fig, ax = plt.subplots(figsize=(6, 4.2))
@@ -360,12 +360,13 @@ def main():
         tables.insert(0, {"caption": "Median angle per mu_c over the graded pours (seeds "
                                      f"{', '.join(map(str, seeds))}; * jammed, left out of "
                                      "the median).",
-                          "header": median_header, "rows": median_rows(seeds, frictions)})
+                          "header": median_header, "rows": median_rows(seeds, frictions, angle_mu, envelope_mu)})
     if seen_frictions:
         tables.append({"caption": "Shown, not graded: the pours of seeds 1, 2 and 3, run while "
                                   "the envelope was graded (* jammed).",
                        "header": median_header,
-                       "rows": median_rows(SEEN_SEEDS, seen_frictions)})
+                       "rows": median_rows(SEEN_SEEDS, seen_frictions, seen_mu,
+                                           seen_envelope_mu)})
     summary = {
         "name": "hopper_repose",
         "title": "Hopper discharge: repose angle against mu_c",
