@@ -105,11 +105,21 @@ VelocityProfile parabolic_profile(const FlowCase& c, int face) {
 }
 
 /// [flow.adapt]: levels relative to the grid's (the case's cells), the
-/// wavelet threshold on the velocity, refinement regions.
+/// wavelet thresholds of the fields the criterion reads, refinement regions.
 void read_adaptivity(const ConfigTable& flow, const ConfigTable& t, FlowCase& c) {
   FlowAdaptivity& a = c.adapt;
   a.enabled = true;
-  a.velocity_threshold = t.get_positive("velocity_threshold_m_s");
+  const auto threshold = [&t](const char* key) {
+    return t.has(key) ? t.get_positive(key) : 0.0;  // 0: that field is not estimated
+  };
+  a.velocity_threshold = threshold("velocity_threshold_m_s");
+  a.vorticity_threshold = threshold("vorticity_threshold_1_s");
+  a.pressure_threshold = threshold("pressure_threshold_Pa");
+  if (a.velocity_threshold == 0.0 && a.vorticity_threshold == 0.0 && a.pressure_threshold == 0.0) {
+    t.fail("velocity_threshold_m_s",
+           "[flow.adapt] needs the threshold of at least one field: velocity_threshold_m_s, "
+           "vorticity_threshold_1_s or pressure_threshold_Pa");
+  }
   const int base = c.forest.level;
   const std::int64_t refine = t.get_int("refine_levels", 1);
   if (refine < 0 || refine > 8) t.fail("refine_levels", "must be in 0..8");
@@ -415,11 +425,20 @@ std::string describe(const FlowCase& c) {
   if (const auto hint = block_size_hint(c); !hint.empty()) s << hint << "\n";
   if (c.adapt.enabled) {
     const int base = c.forest.level;
-    s << "adaptive grid: wavelet criterion (eq. 4.11) on the velocity, threshold "
-      << c.adapt.velocity_threshold << " m/s, every " << c.adapt.every_steps
-      << " step(s); cells from " << (1 << (base - c.adapt.min_level)) << "x coarser to "
-      << (1 << (c.adapt.max_level - base)) << "x finer than the grid (p4est levels "
-      << c.adapt.min_level << ".." << c.adapt.max_level << ")\n";
+    s << "adaptive grid: wavelet criterion (eq. 4.11) on";
+    const char* sep = " ";
+    const auto field = [&](double zeta, const char* name, const char* unit) {
+      if (zeta == 0.0) return;
+      s << sep << name << " (threshold " << zeta << " " << unit << ")";
+      sep = ", ";
+    };
+    field(c.adapt.velocity_threshold, "the velocity", "m/s");
+    field(c.adapt.vorticity_threshold, "the vorticity magnitude", "1/s");
+    field(c.adapt.pressure_threshold, "the pressure", "Pa");
+    s << ", every " << c.adapt.every_steps << " step(s); cells from "
+      << (1 << (base - c.adapt.min_level)) << "x coarser to " << (1 << (c.adapt.max_level - base))
+      << "x finer than the grid (p4est levels " << c.adapt.min_level << ".." << c.adapt.max_level
+      << ")\n";
     for (const auto& r : c.adapt.regions) {
       s << "refinement region (" << r.min.x << ", " << r.min.y << ", " << r.min.z << ") - ("
         << r.max.x << ", " << r.max.y << ", " << r.max.z << ") m: at least " << r.refine_levels;

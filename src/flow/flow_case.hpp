@@ -23,11 +23,14 @@ struct RefinementRegion {
   std::optional<int> max_refine_levels;  ///< levels above the grid's (a cap)
 };
 
-/// [flow.adapt]: the grid follows the flow (wavelet criterion, eq. 4.11).
+/// [flow.adapt]: the grid follows the flow (wavelet criterion, eq. 4.11) on
+/// the fields given a threshold zeta (0: not estimated; at least one > 0).
 struct FlowAdaptivity {
   bool enabled = false;
-  double velocity_threshold = 0.0;  ///< zeta for each velocity component (m/s)
-  int min_level = 0;                ///< p4est levels of the blocks (absolute)
+  double velocity_threshold = 0.0;   ///< zeta for each velocity component (m/s)
+  double vorticity_threshold = 0.0;  ///< zeta for the vorticity magnitude (1/s)
+  double pressure_threshold = 0.0;   ///< zeta for the pressure (Pa)
+  int min_level = 0;                 ///< p4est levels of the blocks (absolute)
   int max_level = 0;
   int every_steps = 1;  ///< regrid every this many steps
   std::vector<RefinementRegion> regions;

@@ -85,13 +85,33 @@ double leaf_cells(const Forest& forest) {
   return static_cast<double>(forest.global_blocks()) * b * b * b;
 }
 
-/// [flow.adapt]: the wavelet criterion (eq. 4.11) on the three velocity
-/// components within the case's levels, at least the regions' floors and at
+/// [flow.adapt]: the wavelet criterion (eq. 4.11) on the fields with a
+/// threshold (the three velocity components, the vorticity magnitude, the
+/// pressure) within the case's levels, at least the regions' floors and at
 /// most their caps (a block overlapping a region takes both).
 std::vector<AdaptFlag> adapt_flags(const FlowAdaptivity& a, const Forest& forest,
                                    NavierStokes& ns) {
-  const double zeta = a.velocity_threshold;
-  WaveletCriterion criterion{{zeta, zeta, zeta}, a.min_level, a.max_level};
+  // The estimate fills the fields' ghosts: the derived fields are copies, so
+  // the solver's own pressure is left as the step made it.
+  std::vector<BlockField*> fields;
+  WaveletCriterion criterion{{}, a.min_level, a.max_level};
+  if (a.velocity_threshold > 0.0) {
+    for (BlockField& component : ns.velocity()) {
+      fields.push_back(&component);
+      criterion.thresholds.push_back(a.velocity_threshold);
+    }
+  }
+  BlockField vorticity, pressure;
+  if (a.vorticity_threshold > 0.0) {
+    vorticity = ns.vorticity_magnitude();
+    fields.push_back(&vorticity);
+    criterion.thresholds.push_back(a.vorticity_threshold);
+  }
+  if (a.pressure_threshold > 0.0) {
+    pressure = ns.pressure();
+    fields.push_back(&pressure);
+    criterion.thresholds.push_back(a.pressure_threshold);
+  }
   const int base = forest.spec().level;
   const auto blocks = static_cast<std::size_t>(forest.local_blocks());
   criterion.block_min_level.assign(blocks, a.min_level);
@@ -116,8 +136,7 @@ std::vector<AdaptFlag> adapt_flags(const FlowAdaptivity& a, const Forest& forest
       }
     }
   }
-  BlockField* velocity[] = {&ns.velocity()[0], &ns.velocity()[1], &ns.velocity()[2]};
-  return wavelet_flags(forest, velocity, criterion);
+  return wavelet_flags(forest, fields, criterion);
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 // follow a front within the level limits, and the forced-finest tag.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -174,6 +175,57 @@ TEST(FlowAdaptCriterion, FlagsFollowAFrontWithinTheLevelLimits) {
   const WaveletCriterion below{{1e-3}, 0, 1};
   for (const AdaptFlag flag : wavelet_flags(forest, fields, below, &tag)) {
     EXPECT_EQ(flag, AdaptFlag::Coarsen);
+  }
+}
+
+// Each field is held to its own threshold, in its own units: a front in u
+// (order 1) near x = 0.53 and one in p, 1000 times larger, near x = 0.2. A
+// block is refined where either field asks, coarsened only where both allow.
+TEST(FlowAdaptCriterion, EachFieldIsHeldToItsOwnThreshold) {
+  const Forest forest(spec_at(2));
+  BlockField u(forest.local_blocks(), 8), p(forest.local_blocks(), 8);
+  fill_cells(forest, u, front);
+  fill_cells(forest, p, [](const Vec3& x) { return 1e3 * std::tanh((x.x - 0.2) / 0.02); });
+  BlockField* fields[] = {&u, &p};
+  // (blocks flagged Refine, blocks) among those centred in x_lo < x < x_hi.
+  const auto refined_in = [&](const WaveletCriterion& criterion, double x_lo, double x_hi) {
+    const auto flags = wavelet_flags(forest, fields, criterion);
+    std::array<int, 2> count{};
+    for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+      const double x = block_centre(forest.block(blk)).x;
+      if (x > x_lo && x < x_hi) {
+        count[0] += flags[static_cast<std::size_t>(blk)] == AdaptFlag::Refine ? 1 : 0;
+        ++count[1];
+      }
+    }
+    return count;
+  };
+  const auto refined = [&](const WaveletCriterion& criterion, double x_lo, double x_hi) {
+    const auto [flagged, blocks] = refined_in(criterion, x_lo, x_hi);
+    return blocks > 0 && flagged == blocks;
+  };
+  const auto any_refined = [&](const WaveletCriterion& criterion, double x_lo, double x_hi) {
+    return refined_in(criterion, x_lo, x_hi)[0] > 0;
+  };
+  // Blocks of 1/4: the p front lies in x in [0, 0.25], the u front in [0.5, 0.75].
+  const WaveletCriterion both{{1e-3, 1.0}, 1, 3};  // zeta 1e-3 on u, 1 on p
+  EXPECT_TRUE(refined(both, 0.0, 0.25));
+  EXPECT_TRUE(refined(both, 0.5, 0.75));
+  // p's threshold 1e6 (beyond any estimate of p): only the u front refines.
+  const WaveletCriterion u_only{{1e-3, 1e6}, 1, 3};
+  EXPECT_FALSE(any_refined(u_only, 0.0, 0.25));
+  EXPECT_TRUE(refined(u_only, 0.5, 0.75));
+  // u's threshold 1e6: only the p front refines.
+  const WaveletCriterion p_only{{1e6, 1.0}, 1, 3};
+  EXPECT_TRUE(refined(p_only, 0.0, 0.25));
+  EXPECT_FALSE(any_refined(p_only, 0.5, 0.75));
+  // Far from both fronts both estimates vanish: those blocks coarsen.
+  const auto flags = wavelet_flags(forest, fields, both);
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    const double x = block_centre(forest.block(blk)).x;
+    if (x > 0.75) {
+      EXPECT_EQ(flags[static_cast<std::size_t>(blk)], AdaptFlag::Coarsen);
+    }
   }
 }
 
