@@ -109,21 +109,9 @@ void restrict_block(const BlockField& old, const std::array<int, 8>& children, B
       }
 }
 
-/// Calls body(i, j, k) for the faces of component d of one block: slots
-/// 0..b along d (slot b, in the ghost layer, is the block's upper face), 0..b-1 across.
-template <typename Body>
-void for_each_face(int b, int d, Body&& body) {
-  std::array<int, 3> end{b, b, b};
-  end[static_cast<std::size_t>(d)] = b + 1;
-  for (int k = 0; k < end[2]; ++k)
-    for (int j = 0; j < end[1]; ++j)
-      for (int i = 0; i < end[0]; ++i) body(std::array<int, 3>{i, j, k});
-}
-
 void copy_faces(const BlockField& from, int from_blk, int d, BlockField& to, int to_blk) {
-  for_each_face(to.cells(), d, [&](const std::array<int, 3>& f) {
-    to(to_blk, f[0], f[1], f[2]) = from(from_blk, f[0], f[1], f[2]);
-  });
+  for_each_face(to.cells(), d,
+                [&](int i, int j, int k) { to(to_blk, i, j, k) = from(from_blk, i, j, k); });
 }
 
 /// Parent faces of component d: the mean of the 4 child faces on each (the
@@ -133,7 +121,8 @@ void restrict_faces(const BlockField& old, const std::array<int, 8>& children, i
   const int b = parent.cells();
   const auto dd = static_cast<std::size_t>(d);
   const auto e1 = static_cast<std::size_t>((d + 1) % 3), e2 = static_cast<std::size_t>((d + 2) % 3);
-  for_each_face(b, d, [&](const std::array<int, 3>& face) {
+  for_each_face(b, d, [&](int i, int j, int k) {
+    const std::array<int, 3> face{i, j, k};
     double sum = 0.0;
     for (int t2 = 0; t2 < 2; ++t2)
       for (int t1 = 0; t1 < 2; ++t1) {
@@ -160,7 +149,8 @@ void prolong_faces(const BlockField& parent, int parent_blk, const std::array<in
                    int d, BlockField& child, int child_blk) {
   const int b = child.cells();
   const auto dd = static_cast<std::size_t>(d);
-  for_each_face(b, d, [&](const std::array<int, 3>& face) {
+  for_each_face(b, d, [&](int i, int j, int k) {
+    const std::array<int, 3> face{i, j, k};
     std::array<int, 3> cell{};
     for (std::size_t x = 0; x < 3; ++x) cell[x] = (child_bits[x] * b + face[x]) >> 1;
     const int along = child_bits[dd] * b + face[dd];  // fine face number along d, 0..2b

@@ -44,6 +44,38 @@ struct BlockLayout {
   }
 };
 
+// Iteration over one block, so that a kernel is written once for one cell
+// (or one row of cells) and runs on every block of any size.
+
+/// Calls body(i, j, k) for the cells 0..b-1 of a block, i fastest.
+template <typename Body>
+inline void for_each_cell(int b, Body&& body) {
+  for (int k = 0; k < b; ++k)
+    for (int j = 0; j < b; ++j)
+      for (int i = 0; i < b; ++i) body(i, j, k);
+}
+
+/// Calls body(i, j, k) for the faces of component d of a face field: slots
+/// 0..b along d (slot b, in the ghost layer, is the block's upper face), the
+/// cells 0..b-1 across.
+template <typename Body>
+inline void for_each_face(int b, int d, Body&& body) {
+  const int ni = d == 0 ? b + 1 : b, nj = d == 1 ? b + 1 : b, nk = d == 2 ? b + 1 : b;
+  for (int k = 0; k < nk; ++k)
+    for (int j = 0; j < nj; ++j)
+      for (int i = 0; i < ni; ++i) body(i, j, k);
+}
+
+/// Calls body(row, j, k) for every row of a block's cells along x, row being
+/// the offset of cell (0, j, k): the pointer-and-offset form of
+/// for_each_cell for the passes that stream several arrays (contiguous in i,
+/// so the compiler vectorises them; the same operations per cell).
+template <typename Body>
+inline void for_each_row(const BlockLayout& L, Body&& body) {
+  for (int k = 0; k < L.cells; ++k)
+    for (int j = 0; j < L.cells; ++j) body(L.index(0, j, k), j, k);
+}
+
 /// Calls body(c, g) for every cell c of the block's layer beside face (d, side)
 /// (side 0: the lower face) and the ghost g just beyond that face.
 template <typename Body>

@@ -184,32 +184,6 @@ bool on_boundary(const Block& block, int d, int side) {
   return block.neighbours[D(neighbour_slot(o[0], o[1], o[2]))].link == Link::Boundary;
 }
 
-/// Calls body(i, j, k) over the faces 0..b along d and the cells 0..b-1 across.
-template <typename Body>
-inline void for_each_face(int b, int d, Body&& body) {
-  const int ni = d == 0 ? b + 1 : b, nj = d == 1 ? b + 1 : b, nk = d == 2 ? b + 1 : b;
-  for (int k = 0; k < nk; ++k)
-    for (int j = 0; j < nj; ++j)
-      for (int i = 0; i < ni; ++i) body(i, j, k);
-}
-
-template <typename Body>
-inline void for_each_cell(int b, Body&& body) {
-  for (int k = 0; k < b; ++k)
-    for (int j = 0; j < b; ++j)
-      for (int i = 0; i < b; ++i) body(i, j, k);
-}
-
-/// Calls body(row, j, k) for every row of a block's cells along x, row being
-/// the offset of cell (0, j, k): the pointer-and-offset form of
-/// for_each_cell for the passes that stream several arrays (contiguous in i,
-/// so the compiler vectorises them; the same operations per cell).
-template <typename Body>
-inline void for_each_row(const BlockLayout& L, Body&& body) {
-  for (int k = 0; k < L.cells; ++k)
-    for (int j = 0; j < L.cells; ++j) body(L.index(0, j, k), j, k);
-}
-
 /// Calls body(c, f) for every cell c of the block's layer beside face (d, side)
 /// and the index f of that face in a face field (c on the lower face, c + s_d
 /// on the upper one).
