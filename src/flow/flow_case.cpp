@@ -109,16 +109,14 @@ VelocityProfile parabolic_profile(const FlowCase& c, int face) {
 void read_adaptivity(const ConfigTable& flow, const ConfigTable& t, FlowCase& c) {
   FlowAdaptivity& a = c.adapt;
   a.enabled = true;
-  const auto threshold = [&t](const char* key) {
-    return t.has(key) ? t.get_positive(key) : 0.0;  // 0: that field is not estimated
-  };
-  a.velocity_threshold = threshold("velocity_threshold_m_s");
-  a.vorticity_threshold = threshold("vorticity_threshold_1_s");
-  a.pressure_threshold = threshold("pressure_threshold_Pa");
+  // 0: that field is not estimated.
+  a.velocity_threshold = t.get_positive("velocity_threshold_m_s", 0.0);
+  a.vorticity_threshold = t.get_positive("vorticity_threshold_1_s", 0.0);
+  a.pressure_threshold = t.get_positive("pressure_threshold_Pa", 0.0);
   if (a.velocity_threshold == 0.0 && a.vorticity_threshold == 0.0 && a.pressure_threshold == 0.0) {
     t.fail("velocity_threshold_m_s",
-           "[flow.adapt] needs the threshold of at least one field: velocity_threshold_m_s, "
-           "vorticity_threshold_1_s or pressure_threshold_Pa");
+           "missing: the wavelet criterion needs the threshold of at least one field "
+           "(velocity_threshold_m_s, vorticity_threshold_1_s or pressure_threshold_Pa)");
   }
   const int base = c.forest.level;
   const std::int64_t refine = t.get_int("refine_levels", 1);

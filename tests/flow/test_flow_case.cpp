@@ -381,8 +381,8 @@ TEST(FlowCaseErrors, AdaptivityKeysAreChecked) {
   EXPECT_EQ(fields.adapt.vorticity_threshold, 2.0);
   EXPECT_EQ(fields.adapt.pressure_threshold, 0.5);
   expect_input_error(replaced(kAdaptiveChannel, "velocity_threshold_m_s = 7e-4", ""),
-                     "flow.adapt.velocity_threshold_m_s': [flow.adapt] needs the threshold of at "
-                     "least one field");
+                     "flow.adapt.velocity_threshold_m_s': missing: the wavelet criterion needs "
+                     "the threshold of at least one field");
   expect_input_error(
       replaced(kAdaptiveChannel, "velocity_threshold_m_s = 7e-4", "pressure_threshold_Pa = 0.0"),
       "pressure_threshold_Pa");
