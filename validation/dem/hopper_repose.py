@@ -198,10 +198,15 @@ def heap_onset_note(frictions, angle, heap_top, flat_below_deg=1.0):
             "friction that the thesis reports against Yan et al.")
 
 
+def jammed_pours(pours, held):
+    """The pours, (friction, seed), with beads still held above the outlet."""
+    return [p for p in pours if held[p] > 0]
+
+
 def jam_note(pours, held):
     """The pours, (friction, seed), whose discharge jammed: beads still above the outlet
     at rest."""
-    jammed = [p for p in pours if held[p] > 0]
+    jammed = jammed_pours(pours, held)
     if not jammed:
         return None
     return ("The discharge jammed at " + ", ".join(
@@ -335,7 +340,7 @@ def main():
     if seen_kept:
         ax.plot(seen_kept, [seen_mu[mu] for mu in seen_kept], ":", color="0.45",
                 marker="^", ms=4, label="cone fit, seeds 1-3 (seen before grading; shown)")
-    jammed = [p for p in pours if held[p] > 0]
+    jammed = jammed_pours(pours, held)
     if jammed:  # their angle is read with a held bead as the apex: not the heap's
         ax.plot([mu for mu, _ in jammed], [angle[p] for p in jammed], "x", color="tab:red",
                 ms=10, mew=2, label="discharge jammed (beads held in the funnel)")
@@ -360,7 +365,8 @@ def main():
         tables.insert(0, {"caption": "Median angle per mu_c over the graded pours (seeds "
                                      f"{', '.join(map(str, seeds))}; * jammed, left out of "
                                      "the median).",
-                          "header": median_header, "rows": median_rows(seeds, frictions, angle_mu, envelope_mu)})
+                          "header": median_header,
+                          "rows": median_rows(seeds, frictions, angle_mu, envelope_mu)})
     if seen_frictions:
         tables.append({"caption": "Shown, not graded: the pours of seeds 1, 2 and 3, run while "
                                   "the envelope was graded (* jammed).",
