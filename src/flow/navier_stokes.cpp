@@ -1507,18 +1507,95 @@ StepReport NavierStokes::step(double dt) {
   return report;
 }
 
-void NavierStokes::average_shared_faces(FaceField& uf) {
+void NavierStokes::reconcile_shared_faces(FaceField& uf, std::span<const int> gained) {
   // Fresh layers: send_faces relies on zeros outside the face layers.
-  std::array<BlockField, 6> layers;
-  for (auto& layer : layers) layer = BlockField(forest_.local_blocks(), forest_.block_cells());
-  send_faces(forest_, layers, LevelJump::Same,
+  const int n = forest_.local_blocks();
+  const int b = forest_.block_cells();
+  std::array<BlockField, 6> values, their_gain;
+  for (auto& layer : values) layer = BlockField(n, b);
+  for (auto& layer : their_gain) layer = BlockField(n, b);
+  send_faces(forest_, values, LevelJump::Same,
              [&](int blk, int d, std::ptrdiff_t f) { return uf[D(d)].block(blk)[f]; });
+  send_faces(forest_, their_gain, LevelJump::Same,
+             [&](int blk, int, std::ptrdiff_t) { return static_cast<double>(gained[D(blk)]); });
+  // The neighbour's gain at each received face, shaped as uf (the receiving
+  // half hands out the face, not the layer's cell).
+  FaceField gain_across;
+  for (auto& component : gain_across) component = BlockField(n, b, uf[0].layout().ghost);
   forest_.for_each_block([&](int blk) {
-    for_received_faces(forest_, layers, blk, LevelJump::Same,
+    for_received_faces(
+        forest_, their_gain, blk, LevelJump::Same,
+        [&](int d, std::ptrdiff_t f, double theirs) { gain_across[D(d)].block(blk)[f] = theirs; });
+    const auto mine_gained = static_cast<double>(gained[D(blk)]);
+    for_received_faces(forest_, values, blk, LevelJump::Same,
                        [&](int d, std::ptrdiff_t f, double theirs) {
                          double& mine = uf[D(d)].block(blk)[f];
-                         mine = 0.5 * (mine + theirs);
+                         const double theirs_gained = gain_across[D(d)].block(blk)[f];
+                         if (theirs_gained < mine_gained) {
+                           mine = theirs;
+                         } else if (theirs_gained == mine_gained) {
+                           mine = 0.5 * (mine + theirs);
+                         }
                        });
+  });
+}
+
+void NavierStokes::balance_refined_children(FaceField& uf, std::span<const int> gained) const {
+  const int b = forest_.block_cells();
+  const BlockLayout L = uf[0].layout();
+  const std::array<std::ptrdiff_t, 3> s{L.stride(0), L.stride(1), L.stride(2)};
+  // Child n = x + 2y + 4z of a group; its cell's offset from the group's first.
+  std::array<std::ptrdiff_t, 8> offset{};
+  for (int child = 0; child < 8; ++child) {
+    offset[D(child)] = (child & 1) * s[0] + ((child >> 1) & 1) * s[1] + ((child >> 2) & 1) * s[2];
+  }
+  // (-1)^{popcount(mode & child)}: the eigenvectors of the cube's graph
+  // Laplacian (8 children, 12 inner faces), eigenvalue 2 popcount(mode).
+  const auto walsh = [](int mode, int child) {
+    return (std::popcount(static_cast<unsigned>(mode & child)) & 1) != 0 ? -1.0 : 1.0;
+  };
+  forest_.for_each_block([&](int blk) {
+    if (gained[D(blk)] <= 0) return;  // restriction keeps every cell divergence-free
+    std::array<double*, 3> u{uf[0].block(blk), uf[1].block(blk), uf[2].block(blk)};
+    std::array<const double*, 3> open{open_[0].block(blk), open_[1].block(blk),
+                                      open_[2].block(blk)};
+    for (int k = 0; k < b; k += 2)
+      for (int j = 0; j < b; j += 2)
+        for (int i = 0; i < b; i += 2) {
+          const std::ptrdiff_t first = L.index(i, j, k);
+          bool closed = false;
+          std::array<double, 8> divergence{};
+          double mean = 0.0;
+          for (int child = 0; child < 8; ++child) {
+            const std::ptrdiff_t c = first + offset[D(child)];
+            for (int d = 0; d < 3; ++d) {
+              divergence[D(child)] += u[D(d)][c + s[D(d)]] - u[D(d)][c];
+              if (((child >> d) & 1) == 0) closed = closed || open[D(d)][c + s[D(d)]] == 0.0;
+            }
+            mean += divergence[D(child)] / 8.0;
+          }
+          if (closed) continue;
+          // Solve (graph Laplacian) phi = -(divergence - its mean) mode by
+          // mode; an inner face between children a (low) and a + 2^d then
+          // changes by phi_a - phi_(a + 2^d), each child's divergence by
+          // its row of the Laplacian. The mean (the parent's own divergence,
+          // round-off after a projection) no inner face can change.
+          std::array<double, 8> phi{};
+          for (int mode = 1; mode < 8; ++mode) {
+            double amplitude = 0.0;
+            for (int child = 0; child < 8; ++child) {
+              amplitude -= walsh(mode, child) * (divergence[D(child)] - mean);
+            }
+            amplitude /= 8.0 * 2.0 * std::popcount(static_cast<unsigned>(mode));
+            for (int child = 0; child < 8; ++child) phi[D(child)] += walsh(mode, child) * amplitude;
+          }
+          for (int child = 0; child < 8; ++child)
+            for (int d = 0; d < 3; ++d) {
+              if (((child >> d) & 1) != 0) continue;
+              u[D(d)][first + offset[D(child)] + s[D(d)]] +=
+                  phi[D(child)] - phi[D(child + (1 << d))];
+            }
+        }
   });
 }
 
@@ -1537,9 +1614,18 @@ RegridReport NavierStokes::regrid(Forest& forest, std::span<const AdaptFlag> fla
   }
   RegridReport report;
   report.blocks_before = forest.global_blocks();
+  // Each block's level rides along as a cell field (a constant is prolonged
+  // and restricted exactly), so that afterwards every block, on whatever
+  // rank, knows how many levels it gained (reconcile_shared_faces).
+  BlockField level_before(forest.local_blocks(), forest.block_cells());
+  forest.for_each_block([&](int blk) {
+    const auto level = static_cast<double>(forest.block(blk).level);
+    for_each_cell(forest.block_cells(),
+                  [&](int i, int j, int k) { level_before(blk, i, j, k) = level; });
+  });
   // The scratch fields are rebuilt from the state at every step.
-  std::vector<BlockField*> cells{&u_[0], &u_[1], &u_[2], &g_[0],       &g_[1],
-                                 &g_[2], &p_,    &mu_,   &predictor_p_};
+  std::vector<BlockField*> cells{&u_[0], &u_[1], &u_[2], &g_[0],        &g_[1],
+                                 &g_[2], &p_,    &mu_,   &predictor_p_, &level_before};
   for (auto& f : viscous_increment_) cells.push_back(&f);
   cells.insert(cells.end(), scalars.begin(), scalars.end());
   FaceField* faces[] = {&uf_, &accel_};
@@ -1575,11 +1661,18 @@ RegridReport NavierStokes::regrid(Forest& forest, std::span<const AdaptFlag> fla
   }
   // The carried uf keeps every old face's flux, but a block refined beside
   // finer ones gave its children the coarse face's value where the finer
-  // neighbour has its own: the copies are averaged (same total flux), the
-  // coarse faces take the fine faces' mean, and one projection removes the
-  // divergence this leaves (O(h^2), in those children only).
-  average_shared_faces(uf_);
+  // neighbour has its own: the neighbour's values are taken and a local
+  // projection in each group of 8 children makes them divergence-free
+  // again. The projection below then has nothing left to do, except where
+  // the grid changed what it prescribes: solid faces sampled on new cells,
+  // inflow faces (their fine means).
   set_boundary_faces(uf_);
+  std::vector<int> gained(static_cast<std::size_t>(forest.local_blocks()));
+  forest.for_each_block([&](int blk) {
+    gained[D(blk)] = forest.block(blk).level - static_cast<int>(level_before(blk, 0, 0, 0));
+  });
+  reconcile_shared_faces(uf_, gained);
+  balance_refined_children(uf_, gained);
   // The potential in a scratch field, as set_velocity's (a new field would be fresh pages).
   BlockField& potential = scratch_[1];
   potential.fill(0.0);

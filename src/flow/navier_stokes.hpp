@@ -304,9 +304,20 @@ class NavierStokes {
   [[nodiscard]] std::int64_t blocks_near_solids_below(int level) const;
   /// Scratch, masks and interface layers sized to the current block list.
   void allocate_work_fields();
-  /// Both copies of a face shared by two blocks of one level take their mean
-  /// (they differ after a regrid where a block was refined beside finer ones).
-  void average_shared_faces(FaceField& uf);
+  /// After a regrid, both copies of a face shared by two blocks of one level
+  /// agree again. They differ where a block was refined beside finer ones:
+  /// its children took the coarse face's value, the neighbour has the fine
+  /// values. The copy of the block that gained fewer levels in the regrid
+  /// (`gained`, per local block) holds the finer data and wins; equal gains
+  /// came from the same data and take the mean (round-off apart, the same).
+  void reconcile_shared_faces(FaceField& uf, std::span<const int> gained);
+  /// Then, in every refined block, each group of the 8 children of one old
+  /// cell gets back a zero divergence from a local projection on its 12
+  /// inner faces (the fluxes through the group's outer faces summing to the
+  /// parent's, only their split changed): uf exactly divergence-free again
+  /// without a global solve. Groups with a closed inner face (solids) are
+  /// left to the projection that follows.
+  void balance_refined_children(FaceField& uf, std::span<const int> gained) const;
 
   const Forest& forest_;
   std::array<FlowBoundary, 6> boundaries_;
