@@ -5,7 +5,7 @@ usage: flow_slice.py RUN [--frame N | --time T] [--normal x|y|z] [--at M]
                          [--field NAME] [--blocks] [--output FILE.png]
 
 RUN is a run folder of `sanguis run` with a [flow] section (its flow.pvd and
-flow/*.vtu frames) or one .vtu frame. The slice is the plane normal to
+flow/*.vtu or flow/*.vtm frames) or one .vtu or .vtm frame. The slice is the plane normal to
 --normal through --at (metres; default: the middle of the domain). Each cell
 the plane cuts (lower corner <= at < upper corner, so exactly one layer of
 every block) is drawn at its own size, so adaptive grids show their levels;
@@ -37,10 +37,10 @@ class SliceError(Exception):
 
 
 def frames_of(run):
-    """[(time, [vtu paths])] of a run folder (flow.pvd), or of one .vtu file."""
+    """[(time, [frame paths])] of a run folder (flow.pvd), or of one .vtu or .vtm file."""
     if os.path.isfile(run):
-        if not run.endswith(".vtu"):
-            raise SliceError(f"{run}: not a .vtu frame nor a run folder")
+        if not run.endswith((".vtu", ".vtm")):
+            raise SliceError(f"{run}: not a .vtu or .vtm frame nor a run folder")
         return [(None, [run])]
     if not os.path.isdir(run):
         raise SliceError(f"{run}: no such run folder")
@@ -60,43 +60,97 @@ def frames_of(run):
     return sorted(by_time.items())
 
 
-def read_frame(paths):
-    """Cell lower corners, upper corners and cell arrays of one frame (all its pieces)."""
+def read_text(path):
+    try:
+        with open(path) as f:
+            return f.read()
+    except OSError as e:
+        raise SliceError(f"{path}: unreadable ({e.strerror})") from e
+
+
+def read_arrays(path, text):
+    """The binary DataArrays of one of our VTK XML files, by name."""
     import numpy as np
 
     kinds = {"Float64": "<f8", "Int64": "<i8", "UInt8": "u1"}
     pattern = re.compile(
         r'<DataArray type="(\w+)" Name="(\w+)" NumberOfComponents="(\d)" format="binary">\s*(\S*)\s*</DataArray>')
-    lows, highs, arrays = [], [], {}
+    piece = {}
+    for m in pattern.finditer(text):
+        kind, name, comps, data = m.group(1), m.group(2), int(m.group(3)), m.group(4)
+        if kind not in kinds:
+            raise SliceError(f"{path}: array {name} of unsupported type {kind}")
+        try:
+            raw = base64.b64decode(data, validate=True)[8:]  # an 8-byte length header, then the values
+            values = np.frombuffer(raw, dtype=kinds[kind])
+            piece[name] = values.reshape(-1, comps) if comps > 1 else values
+        except ValueError as e:  # binascii.Error is a ValueError
+            raise SliceError(f"{path}: array {name} is corrupt ({e})") from e
+    return piece
+
+
+def hexahedra_cells(path):
+    """Cell corners and arrays of a .vtu frame (hexahedra)."""
+    piece = read_arrays(path, read_text(path))
+    if "Points" not in piece or "connectivity" not in piece:
+        raise SliceError(f"{path}: not a flow frame of sanguis (no Points or connectivity)")
+    try:
+        corners = piece["Points"][piece["connectivity"].reshape(-1, 8)]
+    except (ValueError, IndexError) as e:
+        raise SliceError(f"{path}: cells do not match the points ({e})") from e
+    arrays = {n: v for n, v in piece.items() if n not in ("Points", "connectivity", "offsets", "types")}
+    return corners.min(axis=1), corners.max(axis=1), arrays
+
+
+def image_block_cells(path):
+    """Cell corners and arrays of one .vti block (cubes, x fastest, then y, then z)."""
+    import numpy as np
+
+    text = read_text(path)
+    m = re.search(r'<ImageData WholeExtent="0 (\d+) 0 (\d+) 0 (\d+)" Origin="(\S+) (\S+) (\S+)" '
+                  r'Spacing="(\S+) \S+ \S+"', text)
+    if not m:
+        raise SliceError(f"{path}: not a block of a sanguis flow frame (no ImageData extent)")
+    n = [int(m.group(i)) for i in (1, 2, 3)]
+    origin = np.array([float(m.group(i)) for i in (4, 5, 6)])
+    h = float(m.group(7))
+    k, j, i = np.meshgrid(np.arange(n[2]), np.arange(n[1]), np.arange(n[0]), indexing="ij")
+    lows = origin + h * np.stack([i.ravel(), j.ravel(), k.ravel()], axis=1)
+    arrays = read_arrays(path, text)
+    for name, values in arrays.items():
+        if len(values) != len(lows):
+            raise SliceError(f"{path}: array {name} has {len(values)} values for {len(lows)} cells")
+    return lows, lows + h, arrays
+
+
+def block_files(path):
+    """The .vti files a .vtm frame lists, relative to its folder."""
+    try:
+        root = ET.parse(path).getroot()
+    except (ET.ParseError, OSError) as e:
+        raise SliceError(f"{path}: unreadable ({e})") from e
+    files = [os.path.join(os.path.dirname(path), d.get("file", "")) for d in root.iter("DataSet")]
+    if not files:
+        raise SliceError(f"{path}: lists no block")
+    return files
+
+
+def read_frame(paths):
+    """Cell lower corners, upper corners and cell arrays of one frame (all its pieces:
+    the .vtu of every rank, or every block a .vtm lists)."""
+    import numpy as np
+
+    pieces = []
     for path in paths:
-        try:
-            with open(path) as f:
-                text = f.read()
-        except OSError as e:
-            raise SliceError(f"{path}: unreadable ({e.strerror})") from e
-        piece = {}
-        for m in pattern.finditer(text):
-            kind, name, comps, data = m.group(1), m.group(2), int(m.group(3)), m.group(4)
-            if kind not in kinds:
-                raise SliceError(f"{path}: array {name} of unsupported type {kind}")
-            try:
-                raw = base64.b64decode(data, validate=True)[8:]  # an 8-byte length header, then the values
-                values = np.frombuffer(raw, dtype=kinds[kind])
-                piece[name] = values.reshape(-1, comps) if comps > 1 else values
-            except ValueError as e:  # binascii.Error is a ValueError
-                raise SliceError(f"{path}: array {name} is corrupt ({e})") from e
-        if "Points" not in piece or "connectivity" not in piece:
-            raise SliceError(f"{path}: not a flow frame of sanguis (no Points or connectivity)")
-        try:
-            corners = piece["Points"][piece["connectivity"].reshape(-1, 8)]
-        except (ValueError, IndexError) as e:
-            raise SliceError(f"{path}: cells do not match the points ({e})") from e
-        lows.append(corners.min(axis=1))
-        highs.append(corners.max(axis=1))
+        if path.endswith(".vtm"):
+            pieces.extend(image_block_cells(block) for block in block_files(path))
+        else:
+            pieces.append(hexahedra_cells(path))
+    arrays = {}
+    for _, _, piece in pieces:
         for name, values in piece.items():
-            if name not in ("Points", "connectivity", "offsets", "types"):
-                arrays.setdefault(name, []).append(values)
-    return (np.concatenate(lows), np.concatenate(highs),
+            arrays.setdefault(name, []).append(values)
+    return (np.concatenate([p[0] for p in pieces]), np.concatenate([p[1] for p in pieces]),
             {name: np.concatenate(parts) for name, parts in arrays.items()})
 
 
@@ -139,7 +193,7 @@ def atomic_write(path, write):
 
 def main(argv):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("run", help="flow run folder (flow.pvd) or one .vtu frame")
+    parser.add_argument("run", help="flow run folder (flow.pvd) or one .vtu or .vtm frame")
     when = parser.add_mutually_exclusive_group()
     when.add_argument("--frame", type=int, help="frame index (default: the last; negative counts back)")
     when.add_argument("--time", type=float, help="the frame nearest to this time (s)")
@@ -155,7 +209,7 @@ def main(argv):
     frames = frames_of(a.run)
     if a.time is not None:
         if frames[0][0] is None:
-            raise SliceError("--time needs a run folder (one .vtu frame has no time)")
+            raise SliceError("--time needs a run folder (one frame file has no time)")
         index = min(range(len(frames)), key=lambda k: abs(frames[k][0] - a.time))
     else:
         index = len(frames) - 1 if a.frame is None else a.frame

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs the Debian packages sanguis needs. Idempotent: when every package is
 # already present it does nothing (no apt-get update, no network).
-#   scripts/install-deps.sh            build + test + validation plots
+#   scripts/install-deps.sh            build + test + validation plots (python3-vtk9: the
+#                                      tests read the flow frames through VTK's readers)
 #   scripts/install-deps.sh --bench    also the peer codes used by bench/ (LAMMPS, Gerris)
 #   scripts/install-deps.sh --clang    also Clang and its OpenMP runtime (CXX=clang++ builds)
 set -euo pipefail
@@ -10,7 +11,7 @@ packages=(
   g++ cmake ninja-build make pkg-config
   libeigen3-dev libtomlplusplus-dev libcli11-dev libgtest-dev
   libp4est-dev libopenmpi-dev openmpi-bin
-  python3 python3-numpy python3-matplotlib
+  python3 python3-numpy python3-matplotlib python3-vtk9
 )
 case "${1:-}" in
   --bench) packages+=(lammps gerris) ;;

@@ -325,6 +325,7 @@ FlowCase load_flow_case(const ConfigTable& cfg, const std::filesystem::path& sou
   if (output) {
     c.output_interval = output->get_positive("interval_s", c.end_time / 100.0);
     c.vtk = output->get_bool("vtk", true);
+    c.vtk_blocks = output->get_choice("vtk_format", {"vtu", "vtm"}, "vtu") == "vtm";
     c.checkpoint_interval = output->get_non_negative("checkpoint_interval_s", 0.0);
   }
   cfg.check_no_unknown_keys();

@@ -61,6 +61,7 @@ struct FlowCase {
   std::vector<ViscosityRegion> viscosity_regions;
   double output_interval = 0.0;      ///< (s)
   bool vtk = true;                   ///< write ParaView files
+  bool vtk_blocks = false;           ///< as blocks of ImageData (.vtm + .vti), not one .vtu
   double checkpoint_interval = 0.0;  ///< (s), 0: only at the end
   FlowAdaptivity adapt;              ///< off unless [flow.adapt] is given
 };

@@ -1,6 +1,8 @@
 #include "flow/flow_output.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <set>
@@ -59,6 +61,91 @@ io::HexMesh flow_mesh(NavierStokes& ns) {
                     std::move(viscosity)};
   mesh.int_cell_data = {std::move(level), std::move(rank), std::move(block_id)};
   return mesh;
+}
+
+void write_flow_block_frame(NavierStokes& ns, const std::filesystem::path& dir,
+                            const std::string& stem) {
+  const Forest& forest = ns.forest();
+  const int b = forest.block_cells();
+  const BlockField vorticity = ns.vorticity_magnitude();  // collective: before any early exit
+  const std::filesystem::path folder = dir / stem;
+  std::filesystem::create_directories(folder);
+  const std::string leaf = std::filesystem::path(stem).filename().string();
+  const Vec3 origin = forest.spec().origin;
+  // Level, lower corner (cells of its level from the origin) and local index per block.
+  std::vector<std::int64_t> records;
+  records.reserve(static_cast<std::size_t>(forest.local_blocks()) * 5);
+  const auto cells = static_cast<std::size_t>(b) * static_cast<std::size_t>(b * b);
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    const Block& block = forest.block(blk);
+    const double h = block.length / b;
+    io::ImageBlock image;
+    image.origin = block.lower;
+    image.spacing = h;
+    image.cells = {b, b, b};
+    io::DataArray velocity{"velocity", 3, {}}, pressure{"pressure", 1, {}},
+        vort{"vorticity_magnitude", 1, {}}, viscosity{"viscosity", 1, {}};
+    velocity.values.reserve(3 * cells);
+    pressure.values.reserve(cells);
+    vort.values.reserve(cells);
+    viscosity.values.reserve(cells);
+    for_each_cell(b, [&](int i, int j, int k) {
+      for (const BlockField& u : ns.velocity()) velocity.values.push_back(u(blk, i, j, k));
+      pressure.values.push_back(ns.pressure()(blk, i, j, k));
+      vort.values.push_back(vorticity(blk, i, j, k));
+      viscosity.values.push_back(std::as_const(ns).viscosity()(blk, i, j, k));
+    });
+    image.cell_data = {std::move(velocity), std::move(pressure), std::move(vort),
+                       std::move(viscosity)};
+    image.int_cell_data = {{"level", 1, std::vector<std::int64_t>(cells, block.level)},
+                           {"rank", 1, std::vector<std::int64_t>(cells, forest.rank())},
+                           {"block", 1, std::vector<std::int64_t>(cells, blk)}};
+    io::write_image_block_vti(
+        folder / ("r" + std::to_string(forest.rank()) + "_b" + std::to_string(blk) + ".vti"),
+        image);
+    records.push_back(block.level);
+    for (int d = 0; d < 3; ++d) records.push_back(std::llround((block.lower[d] - origin[d]) / h));
+    records.push_back(blk);
+  }
+  // Rank 0 lists every rank's blocks.
+  const int count = static_cast<int>(records.size());
+  std::vector<int> counts(static_cast<std::size_t>(forest.ranks())),
+      offsets(static_cast<std::size_t>(forest.ranks()));
+  MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, forest.comm());
+  int total = 0;
+  for (std::size_t r = 0; r < counts.size(); ++r) {
+    offsets[r] = total;
+    total += counts[r];
+  }
+  std::vector<std::int64_t> all(static_cast<std::size_t>(forest.rank() == 0 ? total : 0));
+  MPI_Gatherv(records.data(), count, MPI_INT64_T, all.data(), counts.data(), offsets.data(),
+              MPI_INT64_T, 0, forest.comm());
+  if (forest.rank() != 0) return;
+  // One group per level, coarsest first; within a level, by rank and block.
+  const int coarsest = forest.min_level();
+  std::vector<io::MultiblockGroup> levels(
+      static_cast<std::size_t>(forest.max_level() - coarsest + 1));
+  for (std::size_t l = 0; l < levels.size(); ++l) {
+    const int level = coarsest + static_cast<int>(l);
+    char name[96];
+    std::snprintf(name, sizeof name, "level %d (h = %.6g m)", level,
+                  forest.spec().tree_length / std::ldexp(1.0, level) / b);
+    levels[l].name = name;
+  }
+  for (int r = 0; r < forest.ranks(); ++r) {
+    const auto first = static_cast<std::size_t>(offsets[static_cast<std::size_t>(r)]);
+    const auto end = first + static_cast<std::size_t>(counts[static_cast<std::size_t>(r)]);
+    for (std::size_t n = first; n + 5 <= end; n += 5) {
+      const std::string block = "r" + std::to_string(r) + "_b" + std::to_string(all[n + 4]);
+      char name[128];
+      std::snprintf(name, sizeof name, "%s (cells from %lld %lld %lld)", block.c_str(),
+                    static_cast<long long>(all[n + 1]), static_cast<long long>(all[n + 2]),
+                    static_cast<long long>(all[n + 3]));
+      levels[static_cast<std::size_t>(all[n] - coarsest)].members.emplace_back(
+          name, leaf + "/" + block + ".vti");
+    }
+  }
+  io::write_multiblock_vtm(dir / (stem + ".vtm"), levels);
 }
 
 namespace {

@@ -3,6 +3,7 @@
 // (ParaView), and the full state for a restart.
 
 #include <filesystem>
+#include <string>
 
 #include "core/io/vtk.hpp"
 #include "flow/navier_stokes.hpp"
@@ -13,6 +14,14 @@ namespace sanguis::flow {
 /// block), with cell data velocity, pressure, vorticity_magnitude, viscosity
 /// and the integers level, rank, block.
 io::HexMesh flow_mesh(NavierStokes& ns);
+
+/// Writes a frame as a block-structured data set: every local block as an
+/// ImageData file `dir/stem/rR_bN.vti` (rank R, local block N; the cell
+/// arrays of flow_mesh), and on rank 0 the multiblock index `dir/stem.vtm`
+/// listing every rank's blocks, grouped by level (coarsest first).
+/// Collective over the ranks.
+void write_flow_block_frame(NavierStokes& ns, const std::filesystem::path& dir,
+                            const std::string& stem);
 
 /// Writes the solver state of this rank (fields with their ghost layers,
 /// time) atomically; `steps` and `frames` are the run's counters.

@@ -217,7 +217,16 @@ FlowRunSummary run_flow_case(const FlowCase& c, const FlowRunOptions& options,
 
   StepReport last;
   const auto record = [&]() {
-    if (c.vtk) {
+    if (c.vtk && c.vtk_blocks) {
+      char stem[64];
+      std::snprintf(stem, sizeof stem, "flow/flow_%08lld", static_cast<long long>(frames));
+      write_flow_block_frame(ns, dir, stem);
+      if (root) {
+        pvd.add(ns.time(), std::string(stem) + ".vtm");
+        pvd.write();
+      }
+      ++frames;
+    } else if (c.vtk) {
       io::write_hex_mesh_vtu(dir / frame_file(frames, forest), flow_mesh(ns));
       if (root) {
         for (int r = 0; r < forest.ranks(); ++r) {

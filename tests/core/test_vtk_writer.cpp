@@ -535,6 +535,80 @@ TEST_F(VtkWriterTest, PolyMeshValidationThrows) {
   EXPECT_FALSE(fs::exists(path));
 }
 
+// --- write_image_block_vti, write_multiblock_vtm ------------------------------------------
+
+ImageBlock make_block() {
+  ImageBlock block;
+  block.origin = {0.5, -1.0, 0.1 + 0.2};
+  block.spacing = 1.0 / 3.0;
+  block.cells = {2, 1, 3};
+  block.cell_data.push_back({"pressure", 1, {1, 2, 3, 4, 5, 1e-300}});
+  block.int_cell_data.push_back({"level", 1, {4, 4, 4, 4, 4, 4}});
+  return block;
+}
+
+TEST_F(VtkWriterTest, ImageBlockIsImageDataWithExactGeometryAndCellData) {
+  const fs::path path = directory_ / "block.vti";
+  const ImageBlock block = make_block();
+  write_image_block_vti(path, block);
+  const auto root = parse_xml_file(path);
+  EXPECT_EQ(root->attributes.at("type"), "ImageData");
+  EXPECT_EQ(root->attributes.at("header_type"), "UInt64");
+  const XmlElement& image = root->child("ImageData");
+  // Extents count points (cells + 1 per direction); origin and spacing round-trip.
+  EXPECT_EQ(image.attributes.at("WholeExtent"), "0 2 0 1 0 3");
+  EXPECT_EQ(image.attributes.at("Origin"), "0.5 -1 0.30000000000000004");
+  EXPECT_EQ(image.attributes.at("Spacing"),
+            "0.33333333333333331 0.33333333333333331 0.33333333333333331");
+  const XmlElement& piece = image.child("Piece");
+  EXPECT_EQ(piece.attributes.at("Extent"), "0 2 0 1 0 3");
+  const XmlElement& cells = piece.child("CellData");
+  EXPECT_EQ(cells.child_array_names(), (std::vector<std::string>{"pressure", "level"}));
+  EXPECT_EQ(decode_words(cells.data_array("pressure")), bits_of(block.cell_data[0].values));
+  EXPECT_EQ(as_int64(decode_words(cells.data_array("level"))), block.int_cell_data[0].values);
+}
+
+TEST_F(VtkWriterTest, ImageBlockValidationThrowsAndWritesNothing) {
+  const fs::path path = directory_ / "bad.vti";
+  ImageBlock block = make_block();
+  block.cell_data[0].values.pop_back();  // 5 values for 6 cells
+  try {
+    write_image_block_vti(path, block);
+    FAIL() << "expected std::invalid_argument";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find("'pressure'"), std::string::npos) << error.what();
+  }
+  block = make_block();
+  block.cells[1] = 0;
+  EXPECT_THROW(write_image_block_vti(path, block), std::invalid_argument);
+  block = make_block();
+  block.spacing = 0.0;
+  EXPECT_THROW(write_image_block_vti(path, block), std::invalid_argument);
+  EXPECT_FALSE(fs::exists(path));
+}
+
+TEST_F(VtkWriterTest, MultiblockIndexListsGroupsAndTheirFiles) {
+  const fs::path path = directory_ / "frame.vtm";
+  write_multiblock_vtm(path, {{"level 2", {{"b0", "frame/b0.vti"}, {"b1", "frame/b1.vti"}}},
+                              {"level 3 <fine>", {{"b2", "frame/b2.vti"}}},
+                              {"level 4", {}}});
+  const auto root = parse_xml_file(path);
+  EXPECT_EQ(root->attributes.at("type"), "vtkMultiBlockDataSet");
+  const XmlElement& set = root->child("vtkMultiBlockDataSet");
+  ASSERT_EQ(set.children.size(), 3u);
+  EXPECT_EQ(set.children[0]->attributes.at("index"), "0");
+  EXPECT_EQ(set.children[1]->attributes.at("name"), "level 3 &lt;fine&gt;");
+  ASSERT_EQ(set.children[0]->children.size(), 2u);
+  EXPECT_EQ(set.children[0]->children[1]->name, "DataSet");
+  EXPECT_EQ(set.children[0]->children[1]->attributes.at("index"), "1");
+  EXPECT_EQ(set.children[0]->children[1]->attributes.at("file"), "frame/b1.vti");
+  EXPECT_EQ(set.children[1]->children[0]->attributes.at("name"), "b2");
+  EXPECT_TRUE(set.children[2]->children.empty());
+  EXPECT_THROW(write_multiblock_vtm(directory_ / "bad.vtm", {{"level 0", {{"b0", ""}}}}),
+               std::invalid_argument);
+  EXPECT_FALSE(fs::exists(directory_ / "bad.vtm"));
+}
+
 // --- PvdIndex --------------------------------------------------------------------------
 
 TEST_F(VtkWriterTest, PvdIndexWritesCollectionWithExactTimes) {

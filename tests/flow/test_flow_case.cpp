@@ -296,6 +296,9 @@ TEST(FlowCaseErrors, UnknownKeysNonCubicCellsAndOneSidedPeriodicityAreErrors) {
   expect_input_error(replaced(kChannel, "type = \"wall\" }", "type = \"wal\" }"), "y_min.type");
   expect_input_error(replaced(kChannel, "interval_s = 0.01", "interval_s = 0.01\nsnapshots = 3"),
                      "snapshots");
+  expect_input_error(
+      replaced(kChannel, "interval_s = 0.01", "interval_s = 0.01\nvtk_format = \"vti\""),
+      "vtk_format");
 }
 
 /// Runs `c` again into `whole`'s folder with "split" for a name, stopped at
@@ -336,6 +339,32 @@ TEST(FlowRun, WritesFramesDiagnosticsAndRestartsBitForBit) {
 
   const FlowRunOptions split = expect_restart_bit_for_bit(c, whole, 0.02, console);
   EXPECT_EQ(read_bytes(whole.output_dir / "flow.pvd"), read_bytes(split.output_dir / "flow.pvd"));
+  std::filesystem::remove_all(base);
+}
+
+TEST(FlowRun, WritesBlockFramesAndRestartsBitForBit) {
+  const auto base = std::filesystem::temp_directory_path() / "sanguis_flow_block_frames_test";
+  std::filesystem::remove_all(base);
+  const FlowCase c =
+      parse(replaced(kChannel, "interval_s = 0.01", "interval_s = 0.01\nvtk_format = \"vtm\""));
+  std::ostringstream console;
+  FlowRunOptions whole;
+  whole.output_dir = base / "whole";
+  whole.quiet = true;
+  run_flow_case(c, whole, console);
+  // One .vtm per frame listing one .vti per block (tests/flow/check_flow_block_frames.py
+  // reads them through VTK); the .pvd indexes the .vtm files.
+  const auto last = whole.output_dir / "flow" / "flow_00000004.vtm";
+  ASSERT_TRUE(std::filesystem::exists(last));
+  EXPECT_TRUE(std::filesystem::exists(whole.output_dir / "flow" / "flow_00000004" / "r0_b0.vti"));
+  EXPECT_FALSE(std::filesystem::exists(whole.output_dir / "flow" / "flow_00000004.vtu"));
+  EXPECT_NE(read_bytes(whole.output_dir / "flow.pvd").find("flow/flow_00000004.vtm"),
+            std::string::npos);
+  const FlowRunOptions split = expect_restart_bit_for_bit(c, whole, 0.02, console);
+  EXPECT_EQ(read_bytes(whole.output_dir / "flow.pvd"), read_bytes(split.output_dir / "flow.pvd"));
+  EXPECT_EQ(read_bytes(last), read_bytes(split.output_dir / "flow" / "flow_00000004.vtm"));
+  EXPECT_EQ(read_bytes(whole.output_dir / "flow" / "flow_00000004" / "r0_b0.vti"),
+            read_bytes(split.output_dir / "flow" / "flow_00000004" / "r0_b0.vti"));
   std::filesystem::remove_all(base);
 }
 

@@ -418,6 +418,63 @@ void write_hex_mesh_vtu(const std::filesystem::path& path, const HexMesh& mesh) 
   });
 }
 
+void write_image_block_vti(const std::filesystem::path& path, const ImageBlock& block) {
+  for (const int n : block.cells) {
+    if (n < 1) throw std::invalid_argument(path.string() + ": an image block needs cells >= 1");
+  }
+  if (!(block.spacing > 0.0)) {
+    throw std::invalid_argument(path.string() + ": an image block needs a spacing > 0");
+  }
+  const std::size_t cell_count = static_cast<std::size_t>(block.cells[0]) *
+                                 static_cast<std::size_t>(block.cells[1]) *
+                                 static_cast<std::size_t>(block.cells[2]);
+  std::set<std::string> names_seen;
+  check_attribute_arrays(path, "cell data", cell_count, block.cell_data, names_seen);
+  check_attribute_arrays(path, "cell data", cell_count, block.int_cell_data, names_seen);
+  // Extents count points: cells n give 0..n.
+  const std::string extent = "0 " + std::to_string(block.cells[0]) + " 0 " +
+                             std::to_string(block.cells[1]) + " 0 " +
+                             std::to_string(block.cells[2]);
+  const std::string spacing = format_exact(block.spacing);
+  write_file_atomically(path, [&](std::ostream& out) {
+    out << "<?xml version=\"1.0\"?>\n"
+        << "<VTKFile type=\"ImageData\" version=\"1.0\" byte_order=\"LittleEndian\" "
+           "header_type=\"UInt64\">\n"
+        << "  <ImageData WholeExtent=\"" << extent << "\" Origin=\"" << format_exact(block.origin.x)
+        << " " << format_exact(block.origin.y) << " " << format_exact(block.origin.z)
+        << "\" Spacing=\"" << spacing << " " << spacing << " " << spacing << "\">\n"
+        << "    <Piece Extent=\"" << extent << "\">\n";
+    write_attribute_section(out, "      ", "CellData", block.cell_data, block.int_cell_data);
+    out << "    </Piece>\n";
+    write_file_footer(out, "ImageData");
+  });
+}
+
+void write_multiblock_vtm(const std::filesystem::path& path,
+                          const std::vector<MultiblockGroup>& groups) {
+  for (const MultiblockGroup& group : groups) {
+    for (const auto& member : group.members) {
+      if (member.second.empty()) {
+        throw std::invalid_argument(path.string() + ": member " + member.first + " of " +
+                                    group.name + " has no file");
+      }
+    }
+  }
+  write_file_atomically(path, [&](std::ostream& out) {
+    write_file_header(out, "vtkMultiBlockDataSet");
+    for (std::size_t g = 0; g < groups.size(); ++g) {
+      out << "    <Block index=\"" << g << "\" name=\"" << xml_escape(groups[g].name) << "\">\n";
+      for (std::size_t m = 0; m < groups[g].members.size(); ++m) {
+        const auto& [name, file] = groups[g].members[m];
+        out << "      <DataSet index=\"" << m << "\" name=\"" << xml_escape(name) << "\" file=\""
+            << xml_escape(file) << "\"/>\n";
+      }
+      out << "    </Block>\n";
+    }
+    write_file_footer(out, "vtkMultiBlockDataSet");
+  });
+}
+
 void write_polymesh_vtp(const std::filesystem::path& path, const PolyMesh& mesh) {
   const std::size_t point_count = mesh.points.size();
   check_cells(path, "line", mesh.lines, 2, point_count);

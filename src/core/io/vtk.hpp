@@ -21,6 +21,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/vec3.hpp"
@@ -91,6 +92,34 @@ struct HexMesh {
 
 // Writes an UnstructuredGrid (.vtu) of VTK_HEXAHEDRON cells.
 void write_hex_mesh_vtu(const std::filesystem::path& path, const HexMesh& mesh);
+
+// One block of a block-structured grid: a box of cells x cells x cells
+// cubes of edge `spacing` from `origin` (its lower corner), as VTK
+// ImageData. Cell data has one tuple per cell, x fastest, then y, then z.
+struct ImageBlock {
+  Vec3 origin;
+  double spacing = 1.0;
+  std::array<int, 3> cells{};
+  std::vector<DataArray> cell_data;
+  std::vector<IntDataArray> int_cell_data;
+};
+
+// Writes an ImageData (.vti) of one block.
+void write_image_block_vti(const std::filesystem::path& path, const ImageBlock& block);
+
+// A group of data sets in a multiblock index: its name and, per member, a
+// name and the file (relative to the index's folder).
+struct MultiblockGroup {
+  std::string name;
+  std::vector<std::pair<std::string, std::string>> members;  // name, file
+};
+
+// Writes a vtkMultiBlockDataSet index (.vtm): one block per group, each
+// holding its members' files. ParaView opens it as one data set (its
+// Multiblock Inspector lists the groups). Throws std::invalid_argument for
+// an empty file name.
+void write_multiblock_vtm(const std::filesystem::path& path,
+                          const std::vector<MultiblockGroup>& groups);
 
 // A ParaView time-series index (.pvd "Collection"): opening it in ParaView
 // loads every frame listed as one data set with a time slider.
