@@ -28,7 +28,9 @@ missed the cell count (1.5x). The threshold trades one for the other, so the
 graded check, fixed on 2026-12-07 before these runs, is the sweep
 zeta = 1e-2, 2e-2, 4e-2 u0 (the last two appended to the same reference with
 the driver's --uniform no): the target is met if one threshold of the sweep
-meets all four tolerances at once; every threshold's row is reported.
+meets all four tolerances at once; every threshold's row is reported. The
+sweep missed by 2.5 % (4.87x at 4e-2 u0, every accuracy tolerance met); the
+next doubling, 8e-2 u0, was added afterwards and is reported only.
 
 Writes validation/flow/results/taylor_green_adaptive.json (the driver's CSVs
 and the reference snapshots under results/runs/taylor_green/) and
@@ -57,6 +59,9 @@ FIGURE = ROOT / "docs" / "validation" / "figures" / "flow_taylor_green_adaptive.
 REFERENCE = "uniform 128^3"
 CHECKED = "adaptive zeta 0.01"
 SWEEP = (0.01, 0.02, 0.04)  # u0; fixed 2026-12-07 before the 0.02 and 0.04 runs
+# Added after the sweep missed by 2.5 % (4.87x at 0.04): the next doubling, reported
+# only, so that the figure shows where the trade-off crosses the tolerances.
+AFTER_SWEEP = (0.08,)
 CELL_TOLERANCE = 1e-2  # u0
 ENERGY_TOLERANCE = 5e-3  # relative
 
@@ -72,7 +77,7 @@ def main():
         exe = Path(args.build) / "validation" / "validate_taylor_green_adaptive"
         subprocess.run([str(exe), str(RUNS), "--threads", str(args.threads),
                         "--zeta", str(SWEEP[0])], check=True)
-        for zeta in SWEEP[1:]:  # against the snapshots of the reference just run
+        for zeta in SWEEP[1:] + AFTER_SWEEP:  # against the snapshots of the reference just run
             subprocess.run([str(exe), str(RUNS), "--threads", str(args.threads),
                             "--zeta", str(zeta), "--uniform", "no"], check=True)
     runs = {r["run"]: {k: (v if k == "run" else float(v)) for k, v in r.items()}
@@ -111,12 +116,13 @@ def main():
 
     swept = [f"adaptive zeta {z:g}" for z in SWEEP if f"adaptive zeta {z:g}" in runs]
     meeting = [name for name in swept if all(c[3] for c in sweep_checks(name))]
+    after = [f"adaptive zeta {z:g}" for z in AFTER_SWEEP if f"adaptive zeta {z:g}" in runs]
     checks = [(f"thresholds of the sweep zeta = {', '.join(f'{z:g}' for z in SWEEP)} u0 meeting "
                "all four tolerances at once", len(meeting),
                ">= 1 (" + (", ".join(meeting) if meeting else "none") + ")",
                len(meeting) >= 1 and len(swept) == len(SWEEP))]
     # Each threshold's rows, with their verdicts, shown but not graded one by one.
-    for name in swept:
+    for name in swept + after:
         checks += [(n, v, t + ", reported", None, p) for n, v, t, p in sweep_checks(name)]
         checks.append((f"{name}: cells (largest grid of the run)",
                        fine["cells_mean"] / runs[name]["cells_max"], "reported", None))
@@ -142,11 +148,11 @@ def main():
     from matplotlib.colors import LogNorm
     fig, axes = plt.subplots(1, 4, figsize=(17, 4.0))
     styles = {"uniform 32^3": ":", "uniform 64^3": "--", REFERENCE: "-"}
-    styles.update({name: marker for name, marker in zip(swept, "o^s")})
+    styles.update({name: marker for name, marker in zip(swept + after, "o^sd")})
     for name, style in styles.items():
         h = history[name]
         label = name.replace("^3", "$^3$").replace("adaptive zeta ", "adaptive, zeta = ")
-        label += " u0" if name in swept else ""
+        label += (" u0" if name in swept else "") + (" u0 (after the sweep)" if name in after else "")
         axes[0].plot(h[:, 0], h[:, 1], style, ms=3, label=label)
         # Dissipation rate -dE/dt, centred differences between records.
         t_mid = 0.5 * (h[1:, 0] + h[:-1, 0])
@@ -158,7 +164,7 @@ def main():
     axes[1].set_xlabel("t (s)")
     axes[1].set_ylabel("dissipation rate -dE/dt (m$^2$/s$^3$)")
     axes[1].set_title("dissipation")
-    for name, marker in zip(swept, "o^s"):
+    for name, marker in zip(swept + after, "o^sd"):
         h = history[name]
         axes[2].plot(h[:, 0], h[:, 2], marker + "-", ms=3,
                      label=name.replace("adaptive zeta ", "zeta = ") + " u0")
@@ -170,7 +176,8 @@ def main():
     axes[2].set_xlabel("t (s)")
     axes[2].set_ylabel("cells")
     axes[2].set_title("grid: " + ", ".join(
-        f"{fine['cells_mean'] / runs[n]['cells_mean']:.1f}x" for n in swept) + " fewer cells")
+        f"{fine['cells_mean'] / runs[n]['cells_mean']:.2g}x" for n in swept + after) + " fewer cells",
+        fontsize=9)
     axes[2].legend(fontsize=8)
     # The layer at z = 0 at t = 1.5 s of the coarsest run that meets the tolerances
     # (else the first threshold's): |difference| per cell, cell outlines.
@@ -201,6 +208,8 @@ def main():
         "checks": [{"name": c[0], "value": c[1], "tolerance": c[2], "pass": c[3],
                     **({"met": c[4]} if len(c) > 4 else {})} for c in checks],
         "sweep_meeting_every_tolerance": meeting,
+        "after_the_sweep_meeting_every_tolerance": [
+            n for n in after if all(c[3] for c in sweep_checks(n))],
         "pass": ok,
         "script_seconds": round(time.time() - started, 1),
         "date": time.strftime("%Y-%m-%d %H:%M"),
