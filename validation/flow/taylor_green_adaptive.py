@@ -196,7 +196,7 @@ def main():
     fig.colorbar(shown, ax=axes[3], label="|u - reference mean| (u0)")
     axes[3].set_xlabel("x (m)")
     axes[3].set_ylabel("y (m)")
-    axes[3].set_title(f"{shown_run.replace('adaptive zeta ', 'zeta = ')} u0, z = 0, t = 1.5 s "
+    axes[3].set_title(f"{shown_run.replace('adaptive zeta ', 'zeta = ')} u0, z = 0, t = 1.5 s\n"
                       "(white: level changes)", fontsize=9)
     fig.tight_layout()
     FIGURE.parent.mkdir(parents=True, exist_ok=True)
