@@ -115,12 +115,13 @@ def image_block_cells(path):
     origin = np.array([float(m.group(i)) for i in (4, 5, 6)])
     h = float(m.group(7))
     k, j, i = np.meshgrid(np.arange(n[2]), np.arange(n[1]), np.arange(n[0]), indexing="ij")
-    lows = origin + h * np.stack([i.ravel(), j.ravel(), k.ravel()], axis=1)
+    index = np.stack([i.ravel(), j.ravel(), k.ravel()], axis=1)
     arrays = read_arrays(path, text)
     for name, values in arrays.items():
-        if len(values) != len(lows):
-            raise SliceError(f"{path}: array {name} has {len(values)} values for {len(lows)} cells")
-    return lows, lows + h, arrays
+        if len(values) != len(index):
+            raise SliceError(f"{path}: array {name} has {len(values)} values for {len(index)} cells")
+    # Corners as the .vtu's points are computed (lower + index h), to the same bits.
+    return origin + h * index, origin + h * (index + 1), arrays
 
 
 def block_files(path):

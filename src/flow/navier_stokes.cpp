@@ -1661,17 +1661,26 @@ RegridReport NavierStokes::regrid(Forest& forest, std::span<const AdaptFlag> fla
   }
   // The carried uf keeps every old face's flux, but a block refined beside
   // finer ones gave its children the coarse face's value where the finer
-  // neighbour has its own: the neighbour's values are taken and a local
-  // projection in each group of 8 children makes them divergence-free
-  // again. The projection below then has nothing left to do, except where
-  // the grid changed what it prescribes: solid faces sampled on new cells,
-  // inflow faces (their fine means).
+  // neighbour has its own: between blocks of one level the neighbour's
+  // values are taken; where the new children are the coarse side of a level
+  // jump (the 2:1 balance refined them with their finer neighbour), their
+  // copies become the mean of the fine faces across. Each old cell's total
+  // flux is kept, only its split changes, and a local projection in each
+  // group of 8 children gives every child its parent's divergence again.
+  // The projection below then has nothing left to do, except where the grid
+  // changed what it prescribes (solid faces sampled on new cells, inflow
+  // faces: their fine means) and in blocks that gained two levels (groups of
+  // 64 children, left to it).
   set_boundary_faces(uf_);
+  // (A restricted face and the coarse copy it meets differ by round-off, the
+  // mean of 4 taken two ways: reconcile_shared_faces evens those too.)
   std::vector<int> gained(static_cast<std::size_t>(forest.local_blocks()));
   forest.for_each_block([&](int blk) {
-    gained[D(blk)] = forest.block(blk).level - static_cast<int>(level_before(blk, 0, 0, 0));
+    gained[D(blk)] =
+        forest.block(blk).level - static_cast<int>(std::lround(level_before(blk, 0, 0, 0)));
   });
   reconcile_shared_faces(uf_, gained);
+  if (composite_) synchronise_coarse_faces(uf_);
   balance_refined_children(uf_, gained);
   // The potential in a scratch field, as set_velocity's (a new field would be fresh pages).
   BlockField& potential = scratch_[1];

@@ -312,11 +312,13 @@ class NavierStokes {
   /// came from the same data and take the mean (round-off apart, the same).
   void reconcile_shared_faces(FaceField& uf, std::span<const int> gained);
   /// Then, in every refined block, each group of the 8 children of one old
-  /// cell gets back a zero divergence from a local projection on its 12
-  /// inner faces (the fluxes through the group's outer faces summing to the
-  /// parent's, only their split changed): uf exactly divergence-free again
-  /// without a global solve. Groups with a closed inner face (solids) are
-  /// left to the projection that follows.
+  /// cell gets back its parent's divergence in every child (the residual the
+  /// last projection left) from a local projection on its 12 inner faces:
+  /// the fluxes through the group's outer faces still sum to the parent's,
+  /// only their split changed. uf is then as divergence-free as before the
+  /// regrid, without a global solve. Groups with a closed inner face
+  /// (solids) and blocks that gained two levels are left to the projection
+  /// that follows.
   void balance_refined_children(FaceField& uf, std::span<const int> gained) const;
 
   const Forest& forest_;

@@ -109,7 +109,10 @@ def check_run(run_dir, failures):
     counts = {"files": 0, "points": 0, "cells": 0, "kinds": set()}
     indexes = sorted(run_dir.glob("*.pvd"))
     for pvd in indexes:
-        for entry in ElementTree.parse(pvd).getroot().iter("DataSet"):
+        entries = list(ElementTree.parse(pvd).getroot().iter("DataSet"))
+        if not entries:
+            failures.append(f"{pvd}: lists no file")
+        for entry in entries:
             check_file(run_dir / entry.get("file"), failures, counts)
     print(f"{run_dir.name}: {', '.join(p.name for p in indexes)}: {counts['files']} files read "
           f"by VTK, {counts['points']} points and {counts['cells']} cells in all, contact kinds "
