@@ -69,6 +69,11 @@ void write_flow_block_frame(NavierStokes& ns, const std::filesystem::path& dir,
   const int b = forest.block_cells();
   const BlockField vorticity = ns.vorticity_magnitude();  // collective: before any early exit
   const std::filesystem::path folder = dir / stem;
+  // A frame written again (a restart from an earlier checkpoint, a run into an
+  // old output folder) replaces the whole folder: blocks of the earlier grid
+  // that the new index would not list do not linger.
+  if (forest.rank() == 0) std::filesystem::remove_all(folder);
+  MPI_Barrier(forest.comm());
   std::filesystem::create_directories(folder);
   const std::string leaf = std::filesystem::path(stem).filename().string();
   const Vec3 origin = forest.spec().origin;

@@ -360,6 +360,14 @@ TEST(FlowRun, WritesBlockFramesAndRestartsBitForBit) {
   EXPECT_FALSE(std::filesystem::exists(whole.output_dir / "flow" / "flow_00000004.vtu"));
   EXPECT_NE(read_bytes(whole.output_dir / "flow.pvd").find("flow/flow_00000004.vtm"),
             std::string::npos);
+  // A block file of another grid left in a frame's folder is gone once the
+  // frame is written again (here by the same run into the same folder).
+  const auto stale = whole.output_dir / "flow" / "flow_00000003" / "r0_b999.vti";
+  std::ofstream(stale) << "stale";
+  const std::string index = read_bytes(last);
+  run_flow_case(c, whole, console);
+  EXPECT_FALSE(std::filesystem::exists(stale));
+  EXPECT_EQ(read_bytes(last), index);
   const FlowRunOptions split = expect_restart_bit_for_bit(c, whole, 0.02, console);
   EXPECT_EQ(read_bytes(whole.output_dir / "flow.pvd"), read_bytes(split.output_dir / "flow.pvd"));
   EXPECT_EQ(read_bytes(last), read_bytes(split.output_dir / "flow" / "flow_00000004.vtm"));
