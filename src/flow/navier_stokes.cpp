@@ -1669,9 +1669,9 @@ RegridReport NavierStokes::regrid(Forest& forest, std::span<const AdaptFlag> fla
   // group of 8 children gives every child its parent's divergence again.
   // The projection below then has nothing left to do, except where the grid
   // changed what it prescribes (solid faces sampled on new cells, inflow
-  // faces: their fine means) and around blocks that gained two levels
-  // (groups of 64 children; beside a coarser block that kept its level the
-  // coarse copy held the finer data): left to it.
+  // faces: their fine means). Blocks gain two levels only in the settling
+  // passes near solids, from the finest level, where no face is finer than
+  // theirs (docs/theory/flow.md, "Adapting during a run").
   set_boundary_faces(uf_);
   // (A restricted face and the coarse copy it meets differ by round-off, the
   // mean of 4 taken two ways: reconcile_shared_faces evens those too.)

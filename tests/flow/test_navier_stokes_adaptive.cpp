@@ -403,6 +403,35 @@ TEST(FlowAdaptiveNavierStokes, SolidWallsOnAForestWithTwoLevels) {
   EXPECT_LT(ns.max_divergence(), 1e-7);
 }
 
+TEST(FlowAdaptiveNavierStokes, BlocksNearSolidsGainingTwoLevelsKeepTheFaceVelocityDivergenceFree) {
+  // The settling passes of a regrid raise the blocks near the slabs two
+  // levels (0 -> 2) and the 2:1 balance the middle ones one: blocks that
+  // were all at the finest level, so no neighbour holds finer faces and the
+  // carried uf needs no solve (the slabs lie on the coarse cells' faces, so
+  // no face closes anew).
+  Forest forest(slab_box(0));
+  NavierStokesOptions options;
+  options.pressure.tolerance = 1e-13;
+  options.pressure.max_cycles = 100;
+  NavierStokes ns(forest, all_periodic(), Fluid{1.0, 0.01}, options);
+  ns.set_solid(channel_slabs);
+  ns.set_velocity([](const Vec3& x) { return Vec3{rough(x, 1), rough(x, 2), rough(x, 3)}; });
+  ns.step(0.2 * ns.stable_dt());
+  const double before = ns.max_divergence();
+  const RegridReport r =
+      ns.regrid(forest, std::vector<AdaptFlag>(3, AdaptFlag::Keep), {}, /*max_level=*/2);
+  const double after = ns.max_divergence();
+  std::printf(
+      "near-slab blocks raised two levels: %lld -> %lld blocks, max |div uf| %.2e -> %.2e "
+      "(%d V-cycles)\n",
+      static_cast<long long>(r.blocks_before), static_cast<long long>(r.blocks_after), before,
+      after, r.projection_cycles);
+  EXPECT_EQ(blocks_near_slabs_below(forest, 2), 0);
+  EXPECT_EQ(forest.min_level(), 1);  // the middle tree, raised by the balance
+  EXPECT_EQ(r.projection_cycles, 0);
+  EXPECT_LT(after, before + 1e-12);
+}
+
 TEST(FlowAdaptiveNavierStokes, SolidsBesideCoarserBlocksAreRefused) {
   // A forest already refined away from the slabs: their blocks are coarse.
   Forest forest(slab_box(0));
