@@ -15,6 +15,87 @@
 
 namespace sanguis::flow {
 
+namespace {
+
+/// The cell arrays of a frame, block after block: velocity, pressure,
+/// vorticity_magnitude, viscosity and the integers level, rank, block.
+struct FrameCellData {
+  io::DataArray velocity{"velocity", 3, {}}, pressure{"pressure", 1, {}},
+      vorticity{"vorticity_magnitude", 1, {}}, viscosity{"viscosity", 1, {}};
+  io::IntDataArray level{"level", 1, {}}, rank{"rank", 1, {}}, block{"block", 1, {}};
+
+  /// Appends the cells of local block blk, i fastest.
+  void append(const NavierStokes& ns, const BlockField& vorticity_magnitude, int blk) {
+    const Forest& forest = ns.forest();
+    for_each_cell(forest.block_cells(), [&](int i, int j, int k) {
+      for (const BlockField& u : ns.velocity()) velocity.values.push_back(u(blk, i, j, k));
+      pressure.values.push_back(ns.pressure()(blk, i, j, k));
+      vorticity.values.push_back(vorticity_magnitude(blk, i, j, k));
+      viscosity.values.push_back(ns.viscosity()(blk, i, j, k));
+      level.values.push_back(forest.block(blk).level);
+      rank.values.push_back(forest.rank());
+      block.values.push_back(blk);
+    });
+  }
+
+  /// Moves the arrays into a mesh's (or image's) cell data.
+  template <typename Mesh>
+  void move_into(Mesh& mesh) {
+    mesh.cell_data = {std::move(velocity), std::move(pressure), std::move(vorticity),
+                      std::move(viscosity)};
+    mesh.int_cell_data = {std::move(level), std::move(rank), std::move(block)};
+  }
+};
+
+/// Level and coordinates of every local block, 4 numbers each.
+std::vector<std::int64_t> leaf_records(const Forest& forest) {
+  std::vector<std::int64_t> records;
+  records.reserve(static_cast<std::size_t>(forest.local_blocks()) * 4);
+  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
+    const Block& block = forest.block(blk);
+    records.push_back(block.level);
+    records.insert(records.end(), block.coord.begin(), block.coord.end());
+  }
+  return records;
+}
+
+/// Every rank's records, rank after rank, with where each rank's start: on
+/// every rank (`everyone`) or on rank 0 only (the others get none).
+struct GatheredRecords {
+  std::vector<std::int64_t> all;
+  std::vector<int> counts, offsets;
+};
+
+GatheredRecords gather_records(const Forest& forest, const std::vector<std::int64_t>& mine,
+                               bool everyone) {
+  GatheredRecords g;
+  const int count = static_cast<int>(mine.size());
+  g.counts.resize(static_cast<std::size_t>(forest.ranks()));
+  g.offsets.resize(g.counts.size());
+  if (everyone) {
+    MPI_Allgather(&count, 1, MPI_INT, g.counts.data(), 1, MPI_INT, forest.comm());
+  } else {
+    MPI_Gather(&count, 1, MPI_INT, g.counts.data(), 1, MPI_INT, 0, forest.comm());
+  }
+  int total = 0;
+  for (std::size_t r = 0; r < g.counts.size(); ++r) {
+    g.offsets[r] = total;
+    total += g.counts[r];
+  }
+  if (everyone) {
+    g.all.resize(static_cast<std::size_t>(total));
+    MPI_Allgatherv(mine.data(), count, MPI_INT64_T, g.all.data(), g.counts.data(), g.offsets.data(),
+                   MPI_INT64_T, forest.comm());
+  } else {
+    g.all.resize(static_cast<std::size_t>(forest.rank() == 0 ? total : 0));
+    MPI_Gatherv(mine.data(), count, MPI_INT64_T, g.all.data(), g.counts.data(), g.offsets.data(),
+                MPI_INT64_T, 0, forest.comm());
+  }
+  return g;
+}
+
+}  // namespace
+
 io::HexMesh flow_mesh(NavierStokes& ns) {
   const Forest& forest = ns.forest();
   const int b = forest.block_cells();
@@ -25,10 +106,8 @@ io::HexMesh flow_mesh(NavierStokes& ns) {
   const std::size_t cells = blocks * static_cast<std::size_t>(b * b * b);
   mesh.points.reserve(blocks * static_cast<std::size_t>(np * np * np));
   mesh.cells.reserve(cells);
-  io::DataArray velocity{"velocity", 3, {}}, pressure{"pressure", 1, {}},
-      vort{"vorticity_magnitude", 1, {}}, viscosity{"viscosity", 1, {}};
-  io::IntDataArray level{"level", 1, {}}, rank{"rank", 1, {}}, block_id{"block", 1, {}};
-  velocity.values.reserve(3 * cells);
+  FrameCellData data;
+  data.velocity.values.reserve(3 * cells);
   for (int blk = 0; blk < forest.local_blocks(); ++blk) {
     const Block& block = forest.block(blk);
     const double h = block.length / b;
@@ -41,25 +120,14 @@ io::HexMesh flow_mesh(NavierStokes& ns) {
     auto point = [&](int i, int j, int k) {
       return first + (static_cast<std::int64_t>(k) * np + j) * np + i;
     };
-    for (int k = 0; k < b; ++k)
-      for (int j = 0; j < b; ++j)
-        for (int i = 0; i < b; ++i) {
-          mesh.cells.push_back({point(i, j, k), point(i + 1, j, k), point(i + 1, j + 1, k),
-                                point(i, j + 1, k), point(i, j, k + 1), point(i + 1, j, k + 1),
-                                point(i + 1, j + 1, k + 1), point(i, j + 1, k + 1)});
-          for (int c = 0; c < 3; ++c)
-            velocity.values.push_back(ns.velocity()[static_cast<std::size_t>(c)](blk, i, j, k));
-          pressure.values.push_back(ns.pressure()(blk, i, j, k));
-          vort.values.push_back(vorticity(blk, i, j, k));
-          viscosity.values.push_back(std::as_const(ns).viscosity()(blk, i, j, k));
-          level.values.push_back(block.level);
-          rank.values.push_back(forest.rank());
-          block_id.values.push_back(blk);
-        }
+    for_each_cell(b, [&](int i, int j, int k) {
+      mesh.cells.push_back({point(i, j, k), point(i + 1, j, k), point(i + 1, j + 1, k),
+                            point(i, j + 1, k), point(i, j, k + 1), point(i + 1, j, k + 1),
+                            point(i + 1, j + 1, k + 1), point(i, j + 1, k + 1)});
+    });
+    data.append(ns, vorticity, blk);
   }
-  mesh.cell_data = {std::move(velocity), std::move(pressure), std::move(vort),
-                    std::move(viscosity)};
-  mesh.int_cell_data = {std::move(level), std::move(rank), std::move(block_id)};
+  data.move_into(mesh);
   return mesh;
 }
 
@@ -75,56 +143,22 @@ void write_flow_block_frame(NavierStokes& ns, const std::filesystem::path& dir,
   if (forest.rank() == 0) std::filesystem::remove_all(folder);
   MPI_Barrier(forest.comm());
   std::filesystem::create_directories(folder);
-  const std::string leaf = std::filesystem::path(stem).filename().string();
-  const Vec3 origin = forest.spec().origin;
-  // Level, lower corner (cells of its level from the origin) and local index per block.
-  std::vector<std::int64_t> records;
-  records.reserve(static_cast<std::size_t>(forest.local_blocks()) * 5);
-  const auto cells = static_cast<std::size_t>(b) * static_cast<std::size_t>(b * b);
+  const auto block_name = [](int rank, std::int64_t blk) {
+    return "r" + std::to_string(rank) + "_b" + std::to_string(blk);
+  };
   for (int blk = 0; blk < forest.local_blocks(); ++blk) {
     const Block& block = forest.block(blk);
-    const double h = block.length / b;
     io::ImageBlock image;
     image.origin = block.lower;
-    image.spacing = h;
+    image.spacing = block.length / b;
     image.cells = {b, b, b};
-    io::DataArray velocity{"velocity", 3, {}}, pressure{"pressure", 1, {}},
-        vort{"vorticity_magnitude", 1, {}}, viscosity{"viscosity", 1, {}};
-    velocity.values.reserve(3 * cells);
-    pressure.values.reserve(cells);
-    vort.values.reserve(cells);
-    viscosity.values.reserve(cells);
-    for_each_cell(b, [&](int i, int j, int k) {
-      for (const BlockField& u : ns.velocity()) velocity.values.push_back(u(blk, i, j, k));
-      pressure.values.push_back(ns.pressure()(blk, i, j, k));
-      vort.values.push_back(vorticity(blk, i, j, k));
-      viscosity.values.push_back(std::as_const(ns).viscosity()(blk, i, j, k));
-    });
-    image.cell_data = {std::move(velocity), std::move(pressure), std::move(vort),
-                       std::move(viscosity)};
-    image.int_cell_data = {{"level", 1, std::vector<std::int64_t>(cells, block.level)},
-                           {"rank", 1, std::vector<std::int64_t>(cells, forest.rank())},
-                           {"block", 1, std::vector<std::int64_t>(cells, blk)}};
-    io::write_image_block_vti(
-        folder / ("r" + std::to_string(forest.rank()) + "_b" + std::to_string(blk) + ".vti"),
-        image);
-    records.push_back(block.level);
-    for (int d = 0; d < 3; ++d) records.push_back(std::llround((block.lower[d] - origin[d]) / h));
-    records.push_back(blk);
+    FrameCellData data;
+    data.append(ns, vorticity, blk);
+    data.move_into(image);
+    io::write_image_block_vti(folder / (block_name(forest.rank(), blk) + ".vti"), image);
   }
-  // Rank 0 lists every rank's blocks.
-  const int count = static_cast<int>(records.size());
-  std::vector<int> counts(static_cast<std::size_t>(forest.ranks())),
-      offsets(static_cast<std::size_t>(forest.ranks()));
-  MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, forest.comm());
-  int total = 0;
-  for (std::size_t r = 0; r < counts.size(); ++r) {
-    offsets[r] = total;
-    total += counts[r];
-  }
-  std::vector<std::int64_t> all(static_cast<std::size_t>(forest.rank() == 0 ? total : 0));
-  MPI_Gatherv(records.data(), count, MPI_INT64_T, all.data(), counts.data(), offsets.data(),
-              MPI_INT64_T, 0, forest.comm());
+  // Rank 0 lists every rank's blocks (their records in local block order).
+  const GatheredRecords leaves = gather_records(forest, leaf_records(forest), false);
   if (forest.rank() != 0) return;
   // One group per level, coarsest first; within a level, by rank and block.
   const int coarsest = forest.min_level();
@@ -137,16 +171,18 @@ void write_flow_block_frame(NavierStokes& ns, const std::filesystem::path& dir,
                   forest.spec().tree_length / std::ldexp(1.0, level) / b);
     levels[l].name = name;
   }
+  const std::string leaf = std::filesystem::path(stem).filename().string();
   for (int r = 0; r < forest.ranks(); ++r) {
-    const auto first = static_cast<std::size_t>(offsets[static_cast<std::size_t>(r)]);
-    const auto end = first + static_cast<std::size_t>(counts[static_cast<std::size_t>(r)]);
-    for (std::size_t n = first; n + 5 <= end; n += 5) {
-      const std::string block = "r" + std::to_string(r) + "_b" + std::to_string(all[n + 4]);
+    const auto first = static_cast<std::size_t>(leaves.offsets[static_cast<std::size_t>(r)]);
+    const auto end = first + static_cast<std::size_t>(leaves.counts[static_cast<std::size_t>(r)]);
+    for (std::size_t n = first; n + 4 <= end; n += 4) {
+      const std::string block = block_name(r, static_cast<std::int64_t>((n - first) / 4));
+      const std::int64_t* record = &leaves.all[n];
       char name[128];
       std::snprintf(name, sizeof name, "%s (cells from %lld %lld %lld)", block.c_str(),
-                    static_cast<long long>(all[n + 1]), static_cast<long long>(all[n + 2]),
-                    static_cast<long long>(all[n + 3]));
-      levels[static_cast<std::size_t>(all[n] - coarsest)].members.emplace_back(
+                    static_cast<long long>(record[1] * b), static_cast<long long>(record[2] * b),
+                    static_cast<long long>(record[3] * b));
+      levels[static_cast<std::size_t>(record[0] - coarsest)].members.emplace_back(
           name, leaf + "/" + block + ".vti");
     }
   }
@@ -198,36 +234,13 @@ bool same_case_grid(const Header& h, const Forest& forest) {
   return same;
 }
 
-/// Level and coordinates of every local block, 4 numbers each.
-std::vector<std::int64_t> leaf_records(const Forest& forest) {
-  std::vector<std::int64_t> records;
-  records.reserve(static_cast<std::size_t>(forest.local_blocks()) * 4);
-  for (int blk = 0; blk < forest.local_blocks(); ++blk) {
-    const Block& block = forest.block(blk);
-    records.push_back(block.level);
-    records.insert(records.end(), block.coord.begin(), block.coord.end());
-  }
-  return records;
-}
-
 using LeafKey = std::array<std::int64_t, 4>;  // level, x, y, z
 
 /// Refines and coarsens `forest` until its blocks are the leaves of all
 /// ranks' checkpoints (`mine` on this rank); false if it does not get there.
 bool rebuild_grid(Forest& forest, NavierStokes& ns, const std::vector<std::int64_t>& mine) {
   // Every rank needs the whole leaf set to decide its own blocks' flags.
-  const int count = static_cast<int>(mine.size());
-  std::vector<int> counts(static_cast<std::size_t>(forest.ranks())),
-      offsets(static_cast<std::size_t>(forest.ranks()));
-  MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, forest.comm());
-  int total = 0;
-  for (std::size_t r = 0; r < counts.size(); ++r) {
-    offsets[r] = total;
-    total += counts[r];
-  }
-  std::vector<std::int64_t> all(static_cast<std::size_t>(total));
-  MPI_Allgatherv(mine.data(), count, MPI_INT64_T, all.data(), counts.data(), offsets.data(),
-                 MPI_INT64_T, forest.comm());
+  const std::vector<std::int64_t> all = gather_records(forest, mine, true).all;
   std::set<LeafKey> target;
   int finest = 0;
   for (std::size_t i = 0; i + 3 < all.size(); i += 4) {

@@ -63,15 +63,16 @@ Diagnostics diagnostics(const NavierStokes& ns) {
   return {forest.sum(energy), forest.max(vmax)};
 }
 
-std::string frame_file(std::int64_t frame, const Forest& forest) {
-  char name[96];
-  if (forest.ranks() == 1) {
-    std::snprintf(name, sizeof name, "flow/flow_%08lld.vtu", static_cast<long long>(frame));
-  } else {
-    std::snprintf(name, sizeof name, "flow/flow_%08lld_r%d.vtu", static_cast<long long>(frame),
-                  forest.rank());
-  }
+/// "flow/flow_NNNNNNNN": a frame's name without its rank or extension.
+std::string frame_stem(std::int64_t frame) {
+  char name[64];
+  std::snprintf(name, sizeof name, "flow/flow_%08lld", static_cast<long long>(frame));
   return name;
+}
+
+/// The .vtu of rank `rank` (of `ranks`) for a frame, relative to the output folder.
+std::string frame_file(std::int64_t frame, int rank, int ranks) {
+  return frame_stem(frame) + (ranks == 1 ? "" : "_r" + std::to_string(rank)) + ".vtu";
 }
 
 fs::path checkpoint_path(const fs::path& dir, const Forest& forest) {
@@ -218,27 +219,18 @@ FlowRunSummary run_flow_case(const FlowCase& c, const FlowRunOptions& options,
   StepReport last;
   const auto record = [&]() {
     if (c.vtk && c.vtk_blocks) {
-      char stem[64];
-      std::snprintf(stem, sizeof stem, "flow/flow_%08lld", static_cast<long long>(frames));
-      write_flow_block_frame(ns, dir, stem);
+      write_flow_block_frame(ns, dir, frame_stem(frames));
       if (root) {
-        pvd.add(ns.time(), std::string(stem) + ".vtm");
+        pvd.add(ns.time(), frame_stem(frames) + ".vtm");
         pvd.write();
       }
       ++frames;
     } else if (c.vtk) {
-      io::write_hex_mesh_vtu(dir / frame_file(frames, forest), flow_mesh(ns));
+      io::write_hex_mesh_vtu(dir / frame_file(frames, forest.rank(), forest.ranks()),
+                             flow_mesh(ns));
       if (root) {
         for (int r = 0; r < forest.ranks(); ++r) {
-          char name[96];
-          if (forest.ranks() == 1) {
-            std::snprintf(name, sizeof name, "flow/flow_%08lld.vtu",
-                          static_cast<long long>(frames));
-          } else {
-            std::snprintf(name, sizeof name, "flow/flow_%08lld_r%d.vtu",
-                          static_cast<long long>(frames), r);
-          }
-          pvd.add(ns.time(), name, r);
+          pvd.add(ns.time(), frame_file(frames, r, forest.ranks()), r);
         }
         pvd.write();
       }

@@ -236,9 +236,9 @@ void send_faces(const Forest& forest, std::array<BlockField, 6>& layers, LevelJu
   forest.exchange(fields, 1, true);
 }
 
-/// The receiving half, for one block: use(d, f, v) for every face f of it on
-/// a block face whose neighbour has relation `from` (Same: the neighbour's
-/// copy; Finer: the mean of the 4 fine faces across).
+/// The receiving half, for one block: use(d, side, f, v) for every face f of
+/// it on a block face (d, side) whose neighbour has relation `from` (Same:
+/// the neighbour's copy; Finer: the mean of the 4 fine faces across).
 template <typename Use>
 void for_received_faces(const Forest& forest, const std::array<BlockField, 6>& layers, int blk,
                         LevelJump from, Use&& use) {
@@ -252,7 +252,7 @@ void for_received_faces(const Forest& forest, const std::array<BlockField, 6>& l
       const double* sent = layers[D(face_index(d, 1 - side))].block(blk);
       const std::ptrdiff_t beyond = side == 0 ? -L.stride(d) : L.stride(d);
       for_face_layer(L, d, side, [&](std::ptrdiff_t c, std::ptrdiff_t f) {
-        use(d, f, factor * sent[c + beyond]);
+        use(d, side, f, factor * sent[c + beyond]);
       });
     }
 }
@@ -770,7 +770,7 @@ void NavierStokes::synchronise_coarse_faces(FaceField& uf) {
   forest_.for_each_block([&](int blk) {
     for_received_faces(
         forest_, interface_, blk, LevelJump::Finer,
-        [&](int d, std::ptrdiff_t f, double mean) { uf[D(d)].block(blk)[f] = mean; });
+        [&](int d, int, std::ptrdiff_t f, double mean) { uf[D(d)].block(blk)[f] = mean; });
   });
 }
 
@@ -882,9 +882,10 @@ void NavierStokes::update_from_face_fluxes(BlockFluxes&& block_fluxes, UpperFlux
                        [&](std::ptrdiff_t, std::ptrdiff_t f) { fl[f] = upper_flux(blk, d, f); });
       }
     }
-    for_received_faces(
-        forest_, interface_, blk, LevelJump::Finer,
-        [&](int d, std::ptrdiff_t face, double mean) { face_flux_[D(d)].block(blk)[face] = mean; });
+    for_received_faces(forest_, interface_, blk, LevelJump::Finer,
+                       [&](int d, int, std::ptrdiff_t face, double mean) {
+                         face_flux_[D(d)].block(blk)[face] = mean;
+                       });
     update(blk, std::array<const double*, 3>{face_flux_[0].block(blk), face_flux_[1].block(blk),
                                              face_flux_[2].block(blk)});
   });
@@ -1518,19 +1519,18 @@ void NavierStokes::reconcile_shared_faces(FaceField& uf, std::span<const int> ga
              [&](int blk, int d, std::ptrdiff_t f) { return uf[D(d)].block(blk)[f]; });
   send_faces(forest_, their_gain, LevelJump::Same,
              [&](int blk, int, std::ptrdiff_t) { return static_cast<double>(gained[D(blk)]); });
-  // The neighbour's gain at each received face, shaped as uf (the receiving
-  // half hands out the face, not the layer's cell).
-  FaceField gain_across;
-  for (auto& component : gain_across) component = BlockField(n, b, uf[0].layout().ghost);
   forest_.for_each_block([&](int blk) {
-    for_received_faces(
-        forest_, their_gain, blk, LevelJump::Same,
-        [&](int d, std::ptrdiff_t f, double theirs) { gain_across[D(d)].block(blk)[f] = theirs; });
+    // A block's gain is one number: the neighbour's, per block face.
+    std::array<double, 6> gain_beside{};
+    for_received_faces(forest_, their_gain, blk, LevelJump::Same,
+                       [&](int d, int side, std::ptrdiff_t, double theirs) {
+                         gain_beside[D(face_index(d, side))] = theirs;
+                       });
     const auto mine_gained = static_cast<double>(gained[D(blk)]);
     for_received_faces(forest_, values, blk, LevelJump::Same,
-                       [&](int d, std::ptrdiff_t f, double theirs) {
+                       [&](int d, int side, std::ptrdiff_t f, double theirs) {
                          double& mine = uf[D(d)].block(blk)[f];
-                         const double theirs_gained = gain_across[D(d)].block(blk)[f];
+                         const double theirs_gained = gain_beside[D(face_index(d, side))];
                          if (theirs_gained < mine_gained) {
                            mine = theirs;
                          } else if (theirs_gained == mine_gained) {

@@ -10,8 +10,6 @@ of kinds 0 and 1, branches, obstacles) and 40 crosses poured into a box
 (bodies as surfaces, contacts of kinds 2 and 3). Exits 1 naming the file and
 the difference if a check fails.
 """
-import base64
-import re
 import subprocess
 import sys
 import tempfile
@@ -28,10 +26,10 @@ except ImportError:
              "(scripts/install-deps.sh does)")
 
 ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "scripts"))
+from flow_slice import read_arrays  # noqa: E402  (our own decoding of the payloads)
+
 READERS = {".vtu": vtk.vtkXMLUnstructuredGridReader, ".vtp": vtk.vtkXMLPolyDataReader}
-KINDS = {"Float64": "<f8", "Int64": "<i8", "UInt8": "u1"}
-ARRAY = re.compile(r'<DataArray type="(\w+)" Name="([^"]+)" NumberOfComponents="(\d+)" '
-                   r'format="binary">\s*(\S*)\s*</DataArray>')
 
 
 class ErrorCatcher:
@@ -44,17 +42,6 @@ class ErrorCatcher:
 
     def __call__(self, caller, event):
         self.messages.append(f"{event} from {caller.GetClassName()}")
-
-
-def payloads(text):
-    """Our own decoding of every binary DataArray: name -> (values, components)."""
-    arrays = {}
-    for kind, name, components, data in ARRAY.findall(text):
-        raw = base64.b64decode(data)
-        count = int.from_bytes(raw[:8], "little")  # the UInt64 byte-count header
-        values = np.frombuffer(raw[8:8 + count], dtype=KINDS[kind])
-        arrays[name] = (values, int(components))
-    return arrays
 
 
 def vtk_arrays(dataset):
@@ -89,20 +76,20 @@ def check_file(path, failures, counts):
         failures.append(f"{path}: VTK read {dataset.GetNumberOfPoints()} points and "
                         f"{dataset.GetNumberOfCells()} cells, the file declares {declared_points} "
                         f"and {declared_cells}")
-    ours = payloads(text)
+    ours = read_arrays(path, text)
     theirs = vtk_arrays(dataset)
-    for name, (values, components) in ours.items():
+    for name, values in ours.items():
         if name in ("connectivity", "offsets", "types") or (name == "Points" and not len(values)):
             continue
         if name not in theirs:
             failures.append(f"{path}: array {name} is missing in what VTK read")
-        elif not np.array_equal(theirs[name].ravel(), values):
+        elif not np.array_equal(theirs[name].ravel(), values.ravel()):
             failures.append(f"{path}: array {name} differs from its payload")
     counts["files"] += 1
     counts["points"] += declared_points
     counts["cells"] += declared_cells
     if "kind" in ours:
-        counts["kinds"].update(int(k) for k in ours["kind"][0])
+        counts["kinds"].update(int(k) for k in ours["kind"])
 
 
 def check_run(run_dir, failures):

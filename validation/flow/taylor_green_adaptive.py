@@ -115,15 +115,16 @@ def main():
         ]
 
     swept = [f"adaptive zeta {z:g}" for z in SWEEP if f"adaptive zeta {z:g}" in runs]
-    meeting = [name for name in swept if all(c[3] for c in sweep_checks(name))]
     after = [f"adaptive zeta {z:g}" for z in AFTER_SWEEP if f"adaptive zeta {z:g}" in runs]
+    rows = {name: sweep_checks(name) for name in swept + after}
+    meeting = [name for name in swept if all(c[3] for c in rows[name])]
     checks = [(f"thresholds of the sweep zeta = {', '.join(f'{z:g}' for z in SWEEP)} u0 meeting "
                "all four tolerances at once", len(meeting),
                ">= 1 (" + (", ".join(meeting) if meeting else "none") + ")",
                len(meeting) >= 1 and len(swept) == len(SWEEP))]
     # Each threshold's rows, with their verdicts, shown but not graded one by one.
     for name in swept + after:
-        checks += [(n, v, t + ", reported", None, p) for n, v, t, p in sweep_checks(name)]
+        checks += [(n, v, t + ", reported", None, p) for n, v, t, p in rows[name]]
         checks.append((f"{name}: cells (largest grid of the run)",
                        fine["cells_mean"] / runs[name]["cells_max"], "reported", None))
     for name in ("uniform 64^3", "uniform 32^3"):
@@ -181,7 +182,7 @@ def main():
     axes[2].legend(fontsize=8)
     # The layer at z = 0 at t = 1.5 s of the coarsest run that meets the accuracy
     # tolerances (else the first threshold's): |difference| per cell, cell outlines.
-    accurate = [n for n in swept if all(c[3] for c in sweep_checks(n)[1:])]
+    accurate = [n for n in swept if all(c[3] for c in rows[n][1:])]
     shown_run = accurate[-1] if accurate else CHECKED
     n = 128
     image = np.zeros((n, n))
@@ -210,7 +211,7 @@ def main():
                     **({"met": c[4]} if len(c) > 4 else {})} for c in checks],
         "sweep_meeting_every_tolerance": meeting,
         "after_the_sweep_meeting_every_tolerance": [
-            n for n in after if all(c[3] for c in sweep_checks(n))],
+            n for n in after if all(c[3] for c in rows[n])],
         "pass": ok,
         "script_seconds": round(time.time() - started, 1),
         "date": time.strftime("%Y-%m-%d %H:%M"),
