@@ -1,7 +1,7 @@
 #pragma once
 // What the adaptive validation drivers (vortex_adaptive_main.cpp,
 // taylor_green_adaptive_main.cpp) share: a box periodic in every direction
-// made of trees 1/4 m long with blocks of 8^3 cells, the solver's settings
+// made of trees 1/4 m long with blocks of 8^3 cells (by default), the solver's settings
 // for them (multigrid tolerances 1e-8, so that the grids and not the solves
 // make the differences), and the regrid by the wavelet criterion (thesis
 // eq. 4.11) on the three velocity components.
@@ -14,14 +14,16 @@
 
 namespace sanguis::flow::validation {
 
-/// trees[0] x trees[1] x trees[2] trees of 1/4 m, blocks of 8^3 cells at `level`.
-inline ForestSpec periodic_box(const std::array<int, 3>& trees, int level, int threads) {
+/// trees[0] x trees[1] x trees[2] trees of `tree_length` (1/4 m by default),
+/// blocks of block_cells^3 cells (8^3 by default) at `level`.
+inline ForestSpec periodic_box(const std::array<int, 3>& trees, int level, int threads,
+                               int block_cells = 8, double tree_length = 0.25) {
   ForestSpec spec;
   spec.trees = trees;
-  spec.tree_length = 0.25;
+  spec.tree_length = tree_length;
   spec.periodic = {true, true, true};
   spec.level = level;
-  spec.block_cells = 8;
+  spec.block_cells = block_cells;
   spec.threads = threads;
   return spec;
 }

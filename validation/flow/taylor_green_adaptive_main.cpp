@@ -5,6 +5,7 @@
 // criterion (thesis eq. 4.11) on the velocity.
 //
 //   validate_taylor_green_adaptive OUTDIR [--threads T] [--zeta Z] [--uniform yes|no]
+//                                  [--block-cells B]
 //
 // The initial field, wave number k = 2 pi, u0 = 1 m/s,
 //
@@ -22,6 +23,11 @@
 // component-major, x fastest) and every other run is compared, cell by cell, with the reference's
 // mean over each of its cells. With --uniform no, the uniform runs are skipped and the reference is
 // read back from those files.
+//
+// --block-cells 4 (default 8) builds every grid from 4^3-cell blocks, 8^3 trees
+// of 1/8 m instead of 4^3 trees of 1/4 m: the same cells, refined and coarsened
+// in units of 4^3 cells instead of 8^3 (the criterion decides per block). The
+// adaptive run's name then ends in " (4^3 blocks)".
 //
 // Writes OUTDIR/taylor_green_adaptive.csv (one row per run: cells, cell
 // differences against the reference, wall time), OUTDIR/taylor_green_history.csv
@@ -53,7 +59,7 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kWave = 2.0 * kPi;
 constexpr double kSpeed = 1.0;                        // u0 (m/s)
 constexpr double kViscosity = 1.0 / (100.0 * kWave);  // Re = u0 / (k nu) = 100
-constexpr int kFinestLevel = 2;                       // 4^3 trees of 8^3 cells: 128^3
+constexpr int kFinestLevel = 2;                       // 32^3 cells at level 0: 128^3
 constexpr int kFinestCells = 128;
 constexpr double kStep = 0.8 / kFinestCells / kSpeed;  // CFL 0.8 of the finest grid
 constexpr int kSteps = 240;                            // t = 1.5 s
@@ -211,8 +217,11 @@ struct RunResult {
 /// adaptive. The reference run (uniform at the finest level) fills
 /// `references`; the others are compared with them.
 RunResult run(const std::string& name, int min_level, int max_level, double zeta, int threads,
-              std::vector<Snapshot>& references, const std::filesystem::path& out_dir) {
-  Forest forest(validation::periodic_box({4, 4, 4}, min_level, threads));
+              int block_cells, std::vector<Snapshot>& references,
+              const std::filesystem::path& out_dir) {
+  const int trees = kFinestCells / 4 / block_cells;  // 32^3 cells at level 0
+  Forest forest(validation::periodic_box({trees, trees, trees}, min_level, threads, block_cells,
+                                         1.0 / trees));
   if (forest.ranks() > 1) {
     throw std::runtime_error("one process only: the reference snapshot holds the local blocks");
   }
@@ -278,7 +287,7 @@ RunResult run(const std::string& name, int min_level, int max_level, double zeta
 int main(int argc, char** argv) {
   if (argc < 2) {
     std::cerr << "usage: validate_taylor_green_adaptive OUTDIR [--threads T] [--zeta Z] "
-                 "[--uniform yes|no]\n";
+                 "[--uniform yes|no] [--block-cells B]\n";
     return 2;
   }
   MpiSession::ensure();
@@ -286,6 +295,7 @@ int main(int argc, char** argv) {
   int threads = 1;
   double zeta = 1e-2;
   bool uniform = true;
+  int block_cells = 8;
   for (int a = 2; a + 1 < argc; a += 2) {
     const std::string key = argv[a];
     if (key == "--threads") {
@@ -294,6 +304,8 @@ int main(int argc, char** argv) {
       zeta = std::atof(argv[a + 1]);
     } else if (key == "--uniform") {  // yes (default) or no: read the reference back
       uniform = std::string(argv[a + 1]) != "no";
+    } else if (key == "--block-cells") {
+      block_cells = std::atoi(argv[a + 1]);
     } else {
       std::cerr << "unknown option " << key << "\n";
       return 2;
@@ -301,6 +313,10 @@ int main(int argc, char** argv) {
   }
   if (!(zeta > 0.0)) {
     std::cerr << "--zeta: a positive threshold in m/s\n";
+    return 2;
+  }
+  if (block_cells != 4 && block_cells != 8) {
+    std::cerr << "--block-cells: 4 or 8 (cells per block edge)\n";
     return 2;
   }
   std::filesystem::create_directories(out_dir);
@@ -325,13 +341,14 @@ int main(int argc, char** argv) {
     }
   }
   char name[64];
-  std::snprintf(name, sizeof name, "adaptive zeta %g", zeta);
+  std::snprintf(name, sizeof name, "adaptive zeta %g%s", zeta,
+                block_cells == 8 ? "" : " (4^3 blocks)");
   runs.push_back({name, 0, kFinestLevel, zeta});
   std::vector<RunResult> results;
   for (const Spec& spec : runs) {
     try {
-      results.push_back(
-          run(spec.name, spec.min_level, spec.max_level, spec.zeta, threads, references, out_dir));
+      results.push_back(run(spec.name, spec.min_level, spec.max_level, spec.zeta, threads,
+                            block_cells, references, out_dir));
     } catch (const std::exception& e) {
       std::cerr << spec.name << ": " << e.what() << "\n";
       return 1;
