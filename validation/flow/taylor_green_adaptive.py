@@ -172,7 +172,7 @@ def main():
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     from matplotlib.colors import LogNorm
-    fig, axes = plt.subplots(1, 4, figsize=(17, 4.0))
+    fig, axes = plt.subplots(1, 4, figsize=(17, 5.2))
     styles = {"uniform 32^3": ":", "uniform 64^3": "--", REFERENCE: "-"}
     markers = dict(zip(swept + after, "o^sd"))
     markers.update(zip(blocks4, "v<>"))
@@ -195,7 +195,7 @@ def main():
     axes[0].set_xlabel("t (s)")
     axes[0].set_ylabel("kinetic energy per unit mass (m$^2$/s$^2$)")
     axes[0].set_title("Taylor-Green, Re = 100")
-    axes[0].legend(fontsize=8)
+    axes[0].legend(fontsize=7)
     axes[1].set_xlabel("t (s)")
     axes[1].set_ylabel("dissipation rate -dE/dt (m$^2$/s$^3$)")
     axes[1].set_title("dissipation")
@@ -213,7 +213,8 @@ def main():
     axes[2].set_title("grid: " + ", ".join(
         f"{fine['cells_mean'] / runs[n]['cells_mean']:.3g}x" for n in swept + after + blocks4)
         + " fewer cells", fontsize=9)
-    axes[2].legend(fontsize=8)
+    # Below the panel: above it the legend would hide the curves.
+    axes[2].legend(fontsize=7, ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.16))
     # The layer at z = 0 at t = 1.5 s of the coarsest run that meets the accuracy
     # tolerances (else the first threshold's): |difference| per cell, cell outlines.
     accurate = [n for n in swept if all(c[3] for c in rows[n][1:])]
