@@ -27,7 +27,7 @@
 // --block-cells 4 (default 8) builds every grid from 4^3-cell blocks, 8^3 trees
 // of 1/8 m instead of 4^3 trees of 1/4 m: the same cells, refined and coarsened
 // in units of 4^3 cells instead of 8^3 (the criterion decides per block). The
-// adaptive run's name then ends in " (4^3 blocks)".
+// adaptive run's name then ends in " (4^3 blocks)"; it needs --uniform no.
 //
 // Writes OUTDIR/taylor_green_adaptive.csv (one row per run: cells, cell
 // differences against the reference, wall time), OUTDIR/taylor_green_history.csv
@@ -317,6 +317,11 @@ int main(int argc, char** argv) {
   }
   if (block_cells != 4 && block_cells != 8) {
     std::cerr << "--block-cells: 4 or 8 (cells per block edge)\n";
+    return 2;
+  }
+  if (block_cells != 8 && uniform) {  // the uniform runs would take the reference's names
+    std::cerr << "--block-cells 4: adaptive runs only, against the reference on disk "
+                 "(give --uniform no)\n";
     return 2;
   }
   std::filesystem::create_directories(out_dir);
