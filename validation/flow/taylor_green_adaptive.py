@@ -229,7 +229,8 @@ def main():
     shown = axes[3].imshow(np.maximum(image, 1e-6), origin="lower", extent=(0, 1, 0, 1),
                            norm=LogNorm(vmin=1e-5, vmax=CELL_TOLERANCE), cmap="viridis")
     centres = (np.arange(n) + 0.5) / n
-    axes[3].contour(centres, centres, size, levels=[1.5, 3], colors="w", linewidths=0.8)
+    if len(np.unique(size)) > 1:  # a layer of one level has no level change to outline
+        axes[3].contour(centres, centres, size, levels=[1.5, 3], colors="w", linewidths=0.8)
     fig.colorbar(shown, ax=axes[3], label="|u - reference mean| (u0)")
     axes[3].set_xlabel("x (m)")
     axes[3].set_ylabel("y (m)")
