@@ -24,10 +24,10 @@
 // mean over each of its cells. With --uniform no, the uniform runs are skipped and the reference is
 // read back from those files.
 //
-// --block-cells 4 (default 8) builds every grid from 4^3-cell blocks, 8^3 trees
-// of 1/8 m instead of 4^3 trees of 1/4 m: the same cells, refined and coarsened
-// in units of 4^3 cells instead of 8^3 (the criterion decides per block). The
-// adaptive run's name then ends in " (4^3 blocks)"; it needs --uniform no.
+// --block-cells 4 (default 8) builds the adaptive grid from 4^3-cell blocks, 8^3
+// trees of 1/8 m instead of 4^3 trees of 1/4 m: the same cells, refined and
+// coarsened in units of 4^3 cells instead of 8^3 (the criterion decides per
+// block). The run's name then ends in " (4^3 blocks)"; it needs --uniform no.
 //
 // Writes OUTDIR/taylor_green_adaptive.csv (one row per run: cells, cell
 // differences against the reference, wall time), OUTDIR/taylor_green_history.csv
@@ -296,6 +296,10 @@ int main(int argc, char** argv) {
   double zeta = 1e-2;
   bool uniform = true;
   int block_cells = 8;
+  if ((argc - 2) % 2 != 0) {  // an option without its value
+    std::cerr << "every option takes a value: " << argv[argc - 1] << " has none\n";
+    return 2;
+  }
   for (int a = 2; a + 1 < argc; a += 2) {
     const std::string key = argv[a];
     if (key == "--threads") {
@@ -304,8 +308,9 @@ int main(int argc, char** argv) {
       zeta = std::atof(argv[a + 1]);
     } else if (key == "--uniform") {  // yes (default) or no: read the reference back
       uniform = std::string(argv[a + 1]) != "no";
-    } else if (key == "--block-cells") {
-      block_cells = std::atoi(argv[a + 1]);
+    } else if (key == "--block-cells") {  // "4" or "8" exactly (checked below)
+      const std::string value = argv[a + 1];
+      block_cells = value == "4" ? 4 : value == "8" ? 8 : 0;
     } else {
       std::cerr << "unknown option " << key << "\n";
       return 2;
