@@ -34,7 +34,9 @@
 // (per run, every 8 steps: time, kinetic energy per unit mass, cells) and
 // OUTDIR/taylor_green_slice.csv (per run, the cells of the layer at z = 0
 // at t = 1.5: lower corner, size, |difference|). validation/flow/
-// taylor_green_adaptive.py checks and plots them.
+// taylor_green_adaptive.py checks and plots them. The summary line of each run
+// also names, per compared time, its worst cell: centre, level, and how many
+// cells lie between it and the nearest face of its block with a level jump.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -130,7 +132,28 @@ Snapshot read_snapshot(const std::filesystem::path& path) {
 
 struct Comparison {
   double max = 0.0, rms = 0.0;  ///< |u - mean of the reference over the cell|, largest component
+  /// The worst cell (one process): its centre, level, and its distance in its own
+  /// cells to the nearest face of its block with a coarser or finer block across
+  /// (-1: none; 0: the cell touches it).
+  Vec3 worst_at{};
+  int worst_level = 0;
+  int worst_from_level_jump = -1;
 };
+
+/// Cells between cell (i, j, k) of block `block` (b cells per edge) and the
+/// nearest of the block's faces with a level jump across, -1 if none.
+int cells_from_level_jump(const Block& block, int b, int i, int j, int k) {
+  const int n[3] = {i, j, k};
+  int nearest = -1;
+  for (int d = 0; d < 3; ++d)
+    for (int side = 0; side < 2; ++side) {
+      const Neighbour& nb = block.neighbours[face_neighbour_slot(d, side)];
+      if (nb.link == Link::Boundary || nb.jump == LevelJump::Same) continue;
+      const int distance = side == 0 ? n[d] : b - 1 - n[d];
+      if (nearest < 0 || distance < nearest) nearest = distance;
+    }
+  return nearest;
+}
 
 struct SliceCell {
   double x, y, h, difference;
@@ -163,7 +186,13 @@ Comparison compare(const Forest& forest, const NavierStokes& ns, const Snapshot&
             mean /= double(r) * r * r;
             worst = std::max(worst, std::abs(ns.velocity()[std::size_t(c)](blk, i, j, k) - mean));
           }
-          result.max = std::max(result.max, worst);
+          if (worst > result.max) {
+            result.max = worst;
+            result.worst_at = {block.lower.x + (i + 0.5) * h, block.lower.y + (j + 0.5) * h,
+                               block.lower.z + (k + 0.5) * h};
+            result.worst_level = block.level;
+            result.worst_from_level_jump = cells_from_level_jump(block, b, i, j, k);
+          }
           sum2 += worst * worst * h * h * h;
           volume += h * h * h;
           if (slice && fk == 0) {
@@ -370,6 +399,14 @@ int main(int argc, char** argv) {
     for (std::size_t n = 0; n < r.comparisons.size(); ++n) {
       std::printf(", step %d: max %.3e RMS %.3e", kCompareSteps[n], r.comparisons[n].max,
                   r.comparisons[n].rms);
+    }
+    for (std::size_t n = 0; n < r.comparisons.size(); ++n) {
+      const Comparison& c = r.comparisons[n];
+      std::printf(
+          "\n  step %d: worst cell at (%.4f, %.4f, %.4f), level %d, %d cells from a level jump "
+          "of its block's faces (-1: none)",
+          kCompareSteps[n], c.worst_at.x, c.worst_at.y, c.worst_at.z, c.worst_level,
+          c.worst_from_level_jump);
     }
     std::printf(", V-cycles per step %.2f + %.2f + %.2f, regrid %.1f s\n", r.pressure_cycles,
                 r.predictor_cycles, r.viscous_cycles, r.regrid_seconds);
