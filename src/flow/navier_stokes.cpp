@@ -1508,24 +1508,29 @@ StepReport NavierStokes::step(double dt) {
   return report;
 }
 
-void NavierStokes::reconcile_shared_faces(FaceField& uf, std::span<const int> gained) {
+void NavierStokes::reconcile_shared_faces(FaceField& uf, std::span<const int> gained,
+                                          BlockField& level_before) {
   // Fresh layers: send_faces relies on zeros outside the face layers.
   const int n = forest_.local_blocks();
   const int b = forest_.block_cells();
-  std::array<BlockField, 6> values, their_gain;
+  std::array<BlockField, 6> values;
   for (auto& layer : values) layer = BlockField(n, b);
-  for (auto& layer : their_gain) layer = BlockField(n, b);
   send_faces(forest_, values, LevelJump::Same,
              [&](int blk, int d, std::ptrdiff_t f) { return uf[D(d)].block(blk)[f]; });
-  send_faces(forest_, their_gain, LevelJump::Same,
-             [&](int blk, int, std::ptrdiff_t) { return static_cast<double>(gained[D(blk)]); });
+  // A same-level neighbour's ghost copy of its old level gives its gain.
+  forest_.exchange(level_before, 1, true);
+  const BlockLayout L = level_before.layout();
   forest_.for_each_block([&](int blk) {
-    // A block's gain is one number: the neighbour's, per block face.
+    // A block's gain is one number: the neighbour's, per block face (read
+    // only for faces with a neighbour of the same level).
+    const int level = forest_.block(blk).level;
     std::array<double, 6> gain_beside{};
-    for_received_faces(forest_, their_gain, blk, LevelJump::Same,
-                       [&](int d, int side, std::ptrdiff_t, double theirs) {
-                         gain_beside[D(face_index(d, side))] = theirs;
-                       });
+    for (int d = 0; d < 3; ++d) {
+      const std::ptrdiff_t lower = L.index(0, 0, 0) - L.stride(d);  // ghost beyond face (d, 0)
+      const std::ptrdiff_t upper = L.index(0, 0, 0) + b * L.stride(d);
+      gain_beside[D(face_index(d, 0))] = level - level_before.block(blk)[lower];
+      gain_beside[D(face_index(d, 1))] = level - level_before.block(blk)[upper];
+    }
     const auto mine_gained = static_cast<double>(gained[D(blk)]);
     for_received_faces(forest_, values, blk, LevelJump::Same,
                        [&](int d, int side, std::ptrdiff_t f, double theirs) {
@@ -1680,7 +1685,7 @@ RegridReport NavierStokes::regrid(Forest& forest, std::span<const AdaptFlag> fla
     gained[D(blk)] =
         forest.block(blk).level - static_cast<int>(std::lround(level_before(blk, 0, 0, 0)));
   });
-  reconcile_shared_faces(uf_, gained);
+  reconcile_shared_faces(uf_, gained, level_before);
   if (composite_) synchronise_coarse_faces(uf_);
   balance_refined_children(uf_, gained);
   // The potential in a scratch field, as set_velocity's (a new field would be fresh pages).

@@ -310,7 +310,9 @@ class NavierStokes {
   /// values. The copy of the block that gained fewer levels in the regrid
   /// (`gained`, per local block) holds the finer data and wins; equal gains
   /// came from the same data and take the mean (round-off apart, the same).
-  void reconcile_shared_faces(FaceField& uf, std::span<const int> gained);
+  /// `level_before`: each block's level before the regrid as a constant cell
+  /// field; its face ghosts are filled here and give the neighbours' gains.
+  void reconcile_shared_faces(FaceField& uf, std::span<const int> gained, BlockField& level_before);
   /// Then, in every refined block, each group of the 8 children of one old
   /// cell gets back its parent's divergence in every child (the residual the
   /// last projection left) from a local projection on its 12 inner faces:
