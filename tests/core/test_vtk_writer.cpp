@@ -29,6 +29,17 @@ namespace fs = std::filesystem;
 
 // --- Test fixtures and helpers ------------------------------------------------
 
+/// `call` throws an `Error` whose message contains `needle` (an array's name, a path).
+template <typename Error, typename Call>
+void expect_throw_naming(Call&& call, const std::string& needle) {
+  try {
+    call();
+    FAIL() << "expected an exception naming " << needle;
+  } catch (const Error& error) {
+    EXPECT_NE(std::string(error.what()).find(needle), std::string::npos) << error.what();
+  }
+}
+
 // A fresh directory per test under the system temp dir, removed afterwards.
 class VtkWriterTest : public ::testing::Test {
  protected:
@@ -311,12 +322,8 @@ TEST_F(VtkWriterTest, AtomicWriteKeepsOldFileWhenWriterThrows) {
 
 TEST_F(VtkWriterTest, AtomicWriteIntoMissingDirectoryThrowsNamingThePath) {
   const fs::path path = directory_ / "no_such_dir" / "frame.vtu";
-  try {
-    write_file_atomically(path, [](std::ostream& out) { out << "x"; });
-    FAIL() << "expected std::runtime_error";
-  } catch (const std::runtime_error& error) {
-    EXPECT_NE(std::string(error.what()).find(path.string()), std::string::npos) << error.what();
-  }
+  expect_throw_naming<std::runtime_error>(
+      [&] { write_file_atomically(path, [](std::ostream& out) { out << "x"; }); }, path.string());
 }
 
 // --- write_point_cloud_vtu ---------------------------------------------------------
@@ -418,22 +425,13 @@ TEST_F(VtkWriterTest, PointDataSizeMismatchThrowsNamingTheArray) {
   const fs::path path = directory_ / "bad.vtu";
   PointCloud cloud = make_three_particles();
   cloud.point_data[1].values.pop_back();  // velocity: 8 values for 3 x 3
-  try {
-    write_point_cloud_vtu(path, cloud);
-    FAIL() << "expected std::invalid_argument";
-  } catch (const std::invalid_argument& error) {
-    EXPECT_NE(std::string(error.what()).find("'velocity'"), std::string::npos) << error.what();
-  }
+  expect_throw_naming<std::invalid_argument>([&] { write_point_cloud_vtu(path, cloud); },
+                                             "'velocity'");
   EXPECT_FALSE(fs::exists(path)) << "nothing is written for invalid input";
 
   cloud = make_three_particles();
   cloud.int_point_data[0].values.push_back(1);
-  try {
-    write_point_cloud_vtu(path, cloud);
-    FAIL() << "expected std::invalid_argument";
-  } catch (const std::invalid_argument& error) {
-    EXPECT_NE(std::string(error.what()).find("'id'"), std::string::npos) << error.what();
-  }
+  expect_throw_naming<std::invalid_argument>([&] { write_point_cloud_vtu(path, cloud); }, "'id'");
 }
 
 TEST_F(VtkWriterTest, DuplicateOrEmptyArrayNamesThrow) {
@@ -516,12 +514,7 @@ TEST_F(VtkWriterTest, PolyMeshValidationThrows) {
   const fs::path path = directory_ / "bad.vtp";
   PolyMesh mesh = make_mesh();
   mesh.cell_data[0].values.resize(6);  // sized for the polygons only, forgetting the line
-  try {
-    write_polymesh_vtp(path, mesh);
-    FAIL() << "expected std::invalid_argument";
-  } catch (const std::invalid_argument& error) {
-    EXPECT_NE(std::string(error.what()).find("'normal'"), std::string::npos) << error.what();
-  }
+  expect_throw_naming<std::invalid_argument>([&] { write_polymesh_vtp(path, mesh); }, "'normal'");
 
   mesh = make_mesh();
   mesh.polygons[1][2] = 5;  // only 5 points
@@ -572,12 +565,8 @@ TEST_F(VtkWriterTest, ImageBlockValidationThrowsAndWritesNothing) {
   const fs::path path = directory_ / "bad.vti";
   ImageBlock block = make_block();
   block.cell_data[0].values.pop_back();  // 5 values for 6 cells
-  try {
-    write_image_block_vti(path, block);
-    FAIL() << "expected std::invalid_argument";
-  } catch (const std::invalid_argument& error) {
-    EXPECT_NE(std::string(error.what()).find("'pressure'"), std::string::npos) << error.what();
-  }
+  expect_throw_naming<std::invalid_argument>([&] { write_image_block_vti(path, block); },
+                                             "'pressure'");
   block = make_block();
   block.cells[1] = 0;
   EXPECT_THROW(write_image_block_vti(path, block), std::invalid_argument);
