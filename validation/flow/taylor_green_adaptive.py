@@ -40,10 +40,19 @@ box. 4^3 blocks refine in units 8x smaller. It is graded as a check of its own
 (one of its thresholds meeting all four tolerances), beside the 8^3 sweep's,
 which keeps its verdict: the script passes only if both do.
 
+The doubling sweep with 8^3 blocks again, bisected (fixed 2026-12-08 00:16, before its
+runs, after the doubling sweep missed by 2.5 % in cells at 4e-2 u0 with every accuracy
+tolerance met, and 8e-2 u0 missed the accuracy): zeta = 4e-2 u0 times 2^(1/8), 2^(2/8),
+2^(3/8), i.e. 4.36e-2, 4.76e-2 and 5.19e-2 u0, against the same reference and
+tolerances. It is graded as a check of its own, a threshold meeting all four tolerances;
+the two sweeps above keep their verdicts, and the script passes only if every graded
+check does.
+
 Writes validation/flow/results/taylor_green_adaptive.json (the driver's CSVs
 and the reference snapshots under results/runs/taylor_green/) and
 docs/validation/figures/flow_taylor_green_adaptive.png. Exits 1 if a check
-fails. About 20 min on 2 cores (the 128^3 reference most of it), and about 33 min
+fails. About 20 min on 2 cores (the 128^3 reference most of it), about 6 min for the
+bisection, and about 33 min
 more for the sweep with 4^3 blocks.
 
 Usage: /usr/bin/python3 validation/flow/taylor_green_adaptive.py [--build build] [--threads T]
@@ -74,6 +83,9 @@ AFTER_SWEEP = (0.08,)
 # The sweep again with 4^3-cell blocks; fixed 2026-12-07 21:47, before its runs.
 BLOCKS4_SWEEP = (0.01, 0.02, 0.04)
 BLOCKS4 = " (4^3 blocks)"
+# The 8^3 sweep bisected between 4e-2 and 8e-2 u0 in steps of 2^(1/8); fixed 2026-12-08
+# 00:16, before its runs.
+BISECTION = (0.0436, 0.0476, 0.0519)
 CELL_TOLERANCE = 1e-2  # u0
 ENERGY_TOLERANCE = 5e-3  # relative
 
@@ -90,6 +102,9 @@ def main():
         subprocess.run([str(exe), str(RUNS), "--threads", str(args.threads),
                         "--zeta", str(SWEEP[0])], check=True)
         for zeta in SWEEP[1:] + AFTER_SWEEP:  # against the snapshots of the reference just run
+            subprocess.run([str(exe), str(RUNS), "--threads", str(args.threads),
+                            "--zeta", str(zeta), "--uniform", "no"], check=True)
+        for zeta in BISECTION:
             subprocess.run([str(exe), str(RUNS), "--threads", str(args.threads),
                             "--zeta", str(zeta), "--uniform", "no"], check=True)
         for zeta in BLOCKS4_SWEEP:
@@ -135,7 +150,8 @@ def main():
                 if f"adaptive zeta {z:g}{suffix}" in runs]
 
     swept, after, blocks4 = on_disk(SWEEP), on_disk(AFTER_SWEEP), on_disk(BLOCKS4_SWEEP, BLOCKS4)
-    rows = {name: sweep_checks(name) for name in swept + after + blocks4}
+    bisected = on_disk(BISECTION)
+    rows = {name: sweep_checks(name) for name in swept + after + bisected + blocks4}
 
     def sweep_verdict(thresholds, names, blocks):
         """The graded check of one sweep: a threshold meeting all four tolerances at once;
@@ -151,9 +167,10 @@ def main():
 
     meeting, check8 = sweep_verdict(SWEEP, swept, "")
     meeting4, check4 = sweep_verdict(BLOCKS4_SWEEP, blocks4, "with 4^3 blocks ")
-    checks = [check8, check4]
+    meeting_bisected, check_bisected = sweep_verdict(BISECTION, bisected, "(the bisection) ")
+    checks = [check8, check4, check_bisected]
     # Each threshold's rows, with their verdicts, shown but not graded one by one.
-    for name in swept + after + blocks4:
+    for name in swept + after + bisected + blocks4:
         checks += [(n, v, t + ", reported", None, p) for n, v, t, p in rows[name]]
         checks.append((f"{name}: cells (largest grid of the run)",
                        fine["cells_mean"] / runs[name]["cells_max"], "reported", None))
@@ -179,7 +196,7 @@ def main():
     from matplotlib.colors import LogNorm
     fig, axes = plt.subplots(1, 4, figsize=(17, 5.2))
     styles = {"uniform 32^3": ":", "uniform 64^3": "--", REFERENCE: "-"}
-    markers = dict(zip(swept + after, "o^sd"))
+    markers = dict(zip(swept + after + bisected, "o^sdPXh"))
     markers.update(zip(blocks4, "v<>"))
     styles.update({name: m + ("-." if name in blocks4 else "") for name, m in markers.items()})
 
@@ -188,7 +205,8 @@ def main():
             return name.replace("^3", "$^3$")
         zeta = name.removeprefix("adaptive zeta ").removesuffix(BLOCKS4)
         return (f"{prefix}{zeta} u0" + (", 4$^3$ blocks" if name in blocks4 else "")
-                + (" (after the sweep)" if name in after else ""))
+                + (" (after the sweep)" if name in after else "")
+                + (" (bisection)" if name in bisected else ""))
 
     for name, style in styles.items():
         h = history[name]
@@ -216,13 +234,13 @@ def main():
     axes[2].set_xlabel("t (s)")
     axes[2].set_ylabel("cells")
     axes[2].set_title("grid: " + ", ".join(
-        f"{fine['cells_mean'] / runs[n]['cells_mean']:.3g}x" for n in swept + after + blocks4)
+        f"{fine['cells_mean'] / runs[n]['cells_mean']:.3g}x" for n in swept + after + bisected + blocks4)
         + " fewer cells", fontsize=9)
     # Below the panel: above it the legend would hide the curves.
     axes[2].legend(fontsize=7, ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.16))
     # The layer at z = 0 at t = 1.5 s of the coarsest run that meets the accuracy
     # tolerances (else the first threshold's): |difference| per cell, cell outlines.
-    accurate = [n for n in swept if all(c[3] for c in rows[n][1:])]
+    accurate = [n for n in swept + bisected if all(c[3] for c in rows[n][1:])]
     shown_run = accurate[-1] if accurate else CHECKED
     n = 128
     image = np.zeros((n, n))
@@ -252,6 +270,7 @@ def main():
                     **({"met": c[4]} if len(c) > 4 else {})} for c in checks],
         "sweep_meeting_every_tolerance": meeting,
         "sweep_with_4_cell_blocks_meeting_every_tolerance": meeting4,
+        "bisection_meeting_every_tolerance": meeting_bisected,
         "after_the_sweep_meeting_every_tolerance": [
             n for n in after if all(c[3] for c in rows[n])],
         "pass": ok,
