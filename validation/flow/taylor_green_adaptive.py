@@ -51,7 +51,7 @@ check does.
 Writes validation/flow/results/taylor_green_adaptive.json (the driver's CSVs
 and the reference snapshots under results/runs/taylor_green/) and
 docs/validation/figures/flow_taylor_green_adaptive.png. Exits 1 if a check
-fails. About 20 min on 2 cores (the 128^3 reference most of it), about 6 min for the
+fails. About 20 min on 2 cores (the 128^3 reference most of it), about 5 min for the
 bisection, and about 33 min
 more for the sweep with 4^3 blocks.
 
