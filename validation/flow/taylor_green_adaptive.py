@@ -90,6 +90,50 @@ CELL_TOLERANCE = 1e-2  # u0
 ENERGY_TOLERANCE = 5e-3  # relative
 
 
+def kinetic_energy_error(reference, run):
+    """Largest relative difference of the kinetic energy (column 1 of the history rows,
+    recorded at the same times in both runs)."""
+    return float(np.max(np.abs(run[:, 1] / reference[:, 1] - 1.0)))
+
+
+def sweep_checks(name, run, reference_cells, energy_error):
+    """(name, value, tolerance, pass) of one adaptive run against the four tolerances:
+    `run` its row of the driver's CSV, `reference_cells` the uniform 128^3 grid's cells,
+    `energy_error` its kinetic_energy_error."""
+    r = reference_cells / run["cells_mean"]
+    return [
+        (f"{name}: cells, uniform 128^3 / adaptive (mean over the steps)", r, ">= 5", r >= 5.0),
+        (f"{name}: every cell against the reference's mean over it, t = 0.75 s (u0)",
+         run["max_mid"], f"<= {CELL_TOLERANCE:g}", run["max_mid"] <= CELL_TOLERANCE),
+        (f"{name}: every cell against the reference's mean over it, t = 1.5 s (u0)",
+         run["max_end"], f"<= {CELL_TOLERANCE:g}", run["max_end"] <= CELL_TOLERANCE),
+        (f"{name}: kinetic energy against the reference, every 8 steps (relative)",
+         energy_error, f"<= {ENERGY_TOLERANCE:g}", energy_error <= ENERGY_TOLERANCE),
+        (f"{name}: max |div uf| over the steps (1/s)", run["max_divergence"], "< 1e-6",
+         run["max_divergence"] < 1e-6),
+    ]
+
+
+def graded_sweep(thresholds, names, rows, blocks=""):
+    """The graded check of one sweep: a threshold meeting all four tolerances at once
+    (`rows`: each run's sweep_checks, `names` the runs of the sweep found on disk); a
+    run missing from the disk fails it ("not run"), as a missed one does. Returns the
+    runs meeting every tolerance and the check (name, value, tolerance, pass)."""
+    meeting = [name for name in names if all(c[3] for c in rows[name])]
+    missing = len(thresholds) - len(names)
+    check = (f"thresholds of the sweep zeta = {', '.join(f'{z:g}' for z in thresholds)} u0 "
+             f"{blocks}meeting all four tolerances at once", len(meeting),
+             ">= 1 (" + (", ".join(meeting) if meeting else "none") + ")"
+             + (f"; {missing} not run" if missing else ""),
+             len(meeting) >= 1 and missing == 0)
+    return meeting, check
+
+
+def script_passes(checks):
+    """Every graded check passes; a check whose pass is None is reported, not graded."""
+    return all(c[3] for c in checks if c[3] is not None)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--build", default=str(ROOT / "build"))
@@ -124,26 +168,9 @@ def main():
             (float(r["x"]), float(r["y"]), float(r["h"]), float(r["difference"])))
 
     def energy_error(name):
-        ref, run = history[REFERENCE], history[name]
-        return float(np.max(np.abs(run[:, 1] / ref[:, 1] - 1.0)))
+        return kinetic_energy_error(history[REFERENCE], history[name])
 
     fine = runs[REFERENCE]
-
-    def sweep_checks(name):
-        """(name, value, tolerance, pass) of one adaptive run against the four tolerances."""
-        run = runs[name]
-        r = fine["cells_mean"] / run["cells_mean"]
-        return [
-            (f"{name}: cells, uniform 128^3 / adaptive (mean over the steps)", r, ">= 5", r >= 5.0),
-            (f"{name}: every cell against the reference's mean over it, t = 0.75 s (u0)",
-             run["max_mid"], f"<= {CELL_TOLERANCE:g}", run["max_mid"] <= CELL_TOLERANCE),
-            (f"{name}: every cell against the reference's mean over it, t = 1.5 s (u0)",
-             run["max_end"], f"<= {CELL_TOLERANCE:g}", run["max_end"] <= CELL_TOLERANCE),
-            (f"{name}: kinetic energy against the reference, every 8 steps (relative)",
-             energy_error(name), f"<= {ENERGY_TOLERANCE:g}", energy_error(name) <= ENERGY_TOLERANCE),
-            (f"{name}: max |div uf| over the steps (1/s)", run["max_divergence"], "< 1e-6",
-             run["max_divergence"] < 1e-6),
-        ]
 
     def on_disk(thresholds, suffix=""):
         return [f"adaptive zeta {z:g}{suffix}" for z in thresholds
@@ -151,19 +178,11 @@ def main():
 
     swept, after, blocks4 = on_disk(SWEEP), on_disk(AFTER_SWEEP), on_disk(BLOCKS4_SWEEP, BLOCKS4)
     bisected = on_disk(BISECTION)
-    rows = {name: sweep_checks(name) for name in swept + after + bisected + blocks4}
+    rows = {name: sweep_checks(name, runs[name], fine["cells_mean"], energy_error(name))
+            for name in swept + after + bisected + blocks4}
 
     def sweep_verdict(thresholds, names, blocks):
-        """The graded check of one sweep: a threshold meeting all four tolerances at once;
-        a run missing from the disk fails it ("not run"), as a missed one does."""
-        meeting = [name for name in names if all(c[3] for c in rows[name])]
-        missing = len(thresholds) - len(names)
-        check = (f"thresholds of the sweep zeta = {', '.join(f'{z:g}' for z in thresholds)} u0 "
-                 f"{blocks}meeting all four tolerances at once", len(meeting),
-                 ">= 1 (" + (", ".join(meeting) if meeting else "none") + ")"
-                 + (f"; {missing} not run" if missing else ""),
-                 len(meeting) >= 1 and missing == 0)
-        return meeting, check
+        return graded_sweep(thresholds, names, rows, blocks)
 
     meeting, check8 = sweep_verdict(SWEEP, swept, "")
     meeting4, check4 = sweep_verdict(BLOCKS4_SWEEP, blocks4, "with 4^3 blocks ")
@@ -182,7 +201,7 @@ def main():
              "reported", None),
             (f"{name}: kinetic energy (relative)", energy_error(name), "reported", None),
         ]
-    ok = all(c[3] for c in checks if c[3] is not None)  # None: reported, not graded
+    ok = script_passes(checks)
     for name, value, tol, passed, *met in checks:
         if passed is not None:
             verdict = "PASS" if passed else "FAIL"
