@@ -25,7 +25,7 @@ def verdicts(checks):
 
 
 class OneRun(unittest.TestCase):
-    def test_a_run_inside_every_tolerance_passes_all_four_and_the_divergence(self):
+    def test_a_run_inside_every_tolerance_passes_all_four_checks_and_the_cell_count(self):
         checks = tg.sweep_checks("adaptive zeta 0.04", run_row(), REFERENCE_CELLS, 1e-3)
         self.assertEqual(verdicts(checks), [True] * 5)
         self.assertAlmostEqual(checks[0][1], 6.0)
@@ -52,7 +52,8 @@ class OneRun(unittest.TestCase):
 
 class Sweeps(unittest.TestCase):
     def rows(self, **runs):
-        return {name: tg.sweep_checks(name, row, REFERENCE_CELLS, 1e-3) for name, row in runs.items()}
+        return {name: tg.sweep_checks(name, row, REFERENCE_CELLS, 1e-3)
+                for name, row in runs.items()}
 
     def test_one_threshold_meeting_every_tolerance_passes_the_sweep(self):
         rows = self.rows(a=run_row(ratio=4.0), b=run_row(ratio=5.1), c=run_row(max_mid=2e-2))
@@ -73,6 +74,19 @@ class Sweeps(unittest.TestCase):
         rows = self.rows(a=run_row())
         meeting, check = tg.graded_sweep((1, 2), ["a"], rows)
         self.assertEqual(meeting, ["a"])
+        self.assertFalse(check[3])
+        self.assertIn("1 not run", check[2])
+
+    def test_runs_on_disk_are_named_by_threshold_in_the_sweep_order(self):
+        runs = {"adaptive zeta 0.0436": {}, "adaptive zeta 0.04 (4^3 blocks)": {},
+                "adaptive zeta 0.0519": {}}
+        self.assertEqual(tg.on_disk(runs, tg.BISECTION),
+                         ["adaptive zeta 0.0436", "adaptive zeta 0.0519"])
+        self.assertEqual(tg.on_disk(runs, (0.04,), tg.BLOCKS4), ["adaptive zeta 0.04 (4^3 blocks)"])
+        # A bisection run missing from the disk fails its sweep ("1 not run").
+        rows = {name: tg.sweep_checks(name, run_row(), REFERENCE_CELLS, 1e-3)
+                for name in tg.on_disk(runs, tg.BISECTION)}
+        _, check = tg.graded_sweep(tg.BISECTION, tg.on_disk(runs, tg.BISECTION), rows)
         self.assertFalse(check[3])
         self.assertIn("1 not run", check[2])
 
