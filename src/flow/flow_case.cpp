@@ -133,6 +133,7 @@ void read_adaptivity(const ConfigTable& flow, const ConfigTable& t, FlowCase& c)
   const std::int64_t every = t.get_int("every_steps", 1);
   if (every < 1 || every > 1000000) t.fail("every_steps", "must be in 1..1000000");
   a.every_steps = static_cast<int>(every);
+  c.options.level_matched_advection = t.get_bool("level_matched_advection", false);
   // The estimate (4.11) restricts and prolongs inside a block: 4 cells at least.
   if (c.forest.block_cells < 4) {
     flow.table("grid").fail("block_cells",
@@ -437,7 +438,7 @@ std::string describe(const FlowCase& c) {
     s << ", every " << c.adapt.every_steps << " step(s); cells from "
       << (1 << (base - c.adapt.min_level)) << "x coarser to " << (1 << (c.adapt.max_level - base))
       << "x finer than the grid (p4est levels " << c.adapt.min_level << ".." << c.adapt.max_level
-      << ")\n";
+      << ")" << (c.options.level_matched_advection ? "; level-matched advection" : "") << "\n";
     for (const auto& r : c.adapt.regions) {
       s << "refinement region (" << r.min.x << ", " << r.min.y << ", " << r.min.z << ") - ("
         << r.max.x << ", " << r.max.y << ", " << r.max.z << ") m: at least " << r.refine_levels;

@@ -4,6 +4,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 #include <vector>
@@ -18,10 +19,35 @@ constexpr std::size_t D(int d) {
 using Strides = std::array<std::ptrdiff_t, 3>;
 
 /// The time step and the cell size of one block, for the BCG kernels.
+/// `finest_h` < h asks for the level-matched face value (below); h or more
+/// (the default) does not.
 struct StepScales {
   double dt = 0.0;
   double h = 0.0;
+  double finest_h = std::numeric_limits<double>::infinity();
 };
+
+/// A block's StepScales; `level_matched`: NavierStokesOptions::level_matched_advection.
+StepScales step_scales(const Forest& forest, bool level_matched, int blk, double dt) {
+  const Block& block = forest.block(blk);
+  const double h = block.length / forest.block_cells();
+  if (!level_matched || block.level >= forest.max_level()) return StepScales{dt, h, h};
+  return StepScales{dt, h, std::ldexp(h, block.level - forest.max_level())};
+}
+
+/// The term that gives a BCG face value of a block coarser than the finest
+/// the finest level's leading error (NavierStokesOptions::level_matched_advection).
+/// The linear value at the departure point is -(h - a)^2/8 f'' off, a = |un| dt
+/// the distance the departure point lies upwind (the same on every level: one
+/// dt for all), so adding ((h - a)^2 - (h_f - a)^2)/8 f'', f'' the second
+/// difference over h^2, leaves -(h_f - a)^2/8 f'' on every level: the error no
+/// longer jumps at a coarse-fine face, where the jump left an O(h) truncation
+/// error in the interface cells (docs/theory/flow.md, "Still open").
+/// `reach` = 1 - |un| dt / h, `curvature` the upwind cell's second difference.
+inline double level_matched_term(const StepScales& k, double un, double reach, double curvature) {
+  const double finest_reach = (k.finest_h - std::abs(un) * k.dt) / k.h;
+  return 0.125 * (reach * reach - finest_reach * finest_reach) * curvature;
+}
 
 /// Bell-Colella-Glaz upwind value at the lower d-face of cell c (between
 /// c - s_d and c) at t + dt/2 (Bell, Colella & Glaz 1989, as in Basilisk's
@@ -35,6 +61,10 @@ inline double bcg_face_value(const double* f, double source, double un, const St
   const std::ptrdiff_t up = un > 0.0 ? c - s[D(d)] : c;
   const double slope = 0.5 * (f[up + s[D(d)]] - f[up - s[D(d)]]);  // h df/dx
   double value = f[up] + source + 0.5 * sign * (1.0 - sign * courant) * slope;
+  if (k.finest_h < k.h) {
+    value += level_matched_term(k, un, 1.0 - sign * courant,
+                                f[up + s[D(d)]] - 2.0 * f[up] + f[up - s[D(d)]]);
+  }
   for (int e = 0; e < 3; ++e) {
     if (e == d) continue;
     const double vn = vt[D(e)];
@@ -51,7 +81,10 @@ inline double bcg_face_value(const double* f, double source, double un, const St
 /// order, as bcg_face_value (the same bits). `normal(c)` gives the face's
 /// normal velocity, `transverse(e, q)` the transverse velocity along e
 /// carried by cell q, `source(c)` the source term; `store(c, value, un)`.
-template <int Dir, typename Normal, typename Transverse, typename Source, typename Store>
+/// `LevelMatched`: the block is coarser than the finest and takes
+/// level_matched_term (chosen per block, so the finest blocks' loop is as before).
+template <int Dir, bool LevelMatched = false, typename Normal, typename Transverse, typename Source,
+          typename Store>
 inline void bcg_face_row(const double* f, std::ptrdiff_t row, int n, const Strides& s,
                          const StepScales& k, Normal&& normal, Transverse&& transverse,
                          Source&& source, Store&& store) {
@@ -77,6 +110,9 @@ inline void bcg_face_row(const double* f, std::ptrdiff_t row, int n, const Strid
     const double f_prev = positive ? f_lo2 : f_lo;
     const double slope = 0.5 * (f_next - f_prev);
     double value = f_up + source(c) + 0.5 * sign * (1.0 - sign * courant) * slope;
+    if constexpr (LevelMatched) {
+      value += level_matched_term(k, un, 1.0 - sign * courant, f_next - 2.0 * f_up + f_prev);
+    }
     const auto correct = [&](int e, std::ptrdiff_t se) {
       const double v_lo = transverse(e, lo), v_c = transverse(e, c);
       const double above_lo = f[lo + se], above_c = f[c + se];
@@ -788,7 +824,8 @@ void NavierStokes::predict_face_velocity(double dt) {
   const BlockLayout L = u_[0].layout();
   const Strides s{L.stride(0), L.stride(1), L.stride(2)};
   for_each_block_with_velocity_ghosts(u_, kGhost, &g_, [&](int blk) {
-    const StepScales scales{dt, forest_.block(blk).length / b};
+    const StepScales scales = step_scales(forest_, options_.level_matched_advection, blk, dt);
+    const bool matched = scales.finest_h < scales.h;
     const std::array<const double*, 3> u{u_[0].block(blk), u_[1].block(blk), u_[2].block(blk)};
     for (int d = 0; d < 3; ++d) {
       const double* f = u[D(d)];
@@ -799,14 +836,21 @@ void NavierStokes::predict_face_velocity(double dt) {
       // cells, the transverse velocities the upwind cell's.
       auto along = [&]<int Dir>(std::integral_constant<int, Dir>) {
         const int ni = Dir == 0 ? b + 1 : b, nj = Dir == 1 ? b + 1 : b, nk = Dir == 2 ? b + 1 : b;
-        for (int k = 0; k < nk; ++k)
-          for (int j = 0; j < nj; ++j)
-            bcg_face_row<Dir>(
-                f, L.index(0, j, k), ni, s, scales,
-                [&](std::ptrdiff_t c) { return 0.5 * (f[c] + f[c - sd]); },
-                [&](int e, std::ptrdiff_t q) { return u[D(e)][q]; },
-                [&](std::ptrdiff_t c) { return 0.25 * dt * (src[c] + src[c - sd]); },
-                [&](std::ptrdiff_t c, double value, double) { out[c] = value; });
+        auto rows = [&]<bool Matched>(std::bool_constant<Matched>) {
+          for (int k = 0; k < nk; ++k)
+            for (int j = 0; j < nj; ++j)
+              bcg_face_row<Dir, Matched>(
+                  f, L.index(0, j, k), ni, s, scales,
+                  [&](std::ptrdiff_t c) { return 0.5 * (f[c] + f[c - sd]); },
+                  [&](int e, std::ptrdiff_t q) { return u[D(e)][q]; },
+                  [&](std::ptrdiff_t c) { return 0.25 * dt * (src[c] + src[c - sd]); },
+                  [&](std::ptrdiff_t c, double value, double) { out[c] = value; });
+        };
+        if (matched) {
+          rows(std::true_type{});
+        } else {
+          rows(std::false_type{});
+        }
       };
       if (d == 0) along(std::integral_constant<int, 0>{});
       if (d == 1) along(std::integral_constant<int, 1>{});
@@ -909,7 +953,7 @@ void NavierStokes::advect_field(const BlockField& field, const BlockField* sourc
     return BlockView{field.block(blk),
                      source ? source->block(blk) : nullptr,
                      {uf_[0].block(blk), uf_[1].block(blk), uf_[2].block(blk)},
-                     StepScales{dt, forest_.block(blk).length / b}};
+                     step_scales(forest_, options_.level_matched_advection, blk, dt)};
   };
   // BCG value times the face velocity on face c (number n along d) of a
   // block; dirichlet_lo/hi: the block's d-faces 0/b carry a boundary value.
@@ -946,20 +990,28 @@ void NavierStokes::advect_field(const BlockField& field, const BlockField* sourc
     const bool has_source = v.src != nullptr;
     const double* src = has_source ? v.src : v.f;  // v.f: read, then not used
     const int ni = Dir == 0 ? b + 1 : b, nj = Dir == 1 ? b + 1 : b, nk = Dir == 2 ? b + 1 : b;
+    const bool matched = v.scales.finest_h < v.scales.h;
     for (int k = 0; k < nk; ++k)
       for (int j = 0; j < nj; ++j) {
         const std::ptrdiff_t row = L.index(0, j, k);
         // The interior faces in one branch-free pass (face_flux's last case)...
-        bcg_face_row<Dir>(
-            v.f, row, ni, s, v.scales, [&](std::ptrdiff_t c) { return un[c]; },
-            [&](int e, std::ptrdiff_t q) {
-              return 0.5 * (v.uf[D(e)][q] + v.uf[D(e)][q + s[D(e)]]);
-            },
-            [&](std::ptrdiff_t c) {
-              const double term = 0.25 * dt * (src[c] + src[c - sd]);  // loaded either way
-              return has_source ? term : 0.0;
-            },
-            [&](std::ptrdiff_t c, double value, double u) { fl[c] = value * u; });
+        auto interior = [&]<bool Matched>(std::bool_constant<Matched>) {
+          bcg_face_row<Dir, Matched>(
+              v.f, row, ni, s, v.scales, [&](std::ptrdiff_t c) { return un[c]; },
+              [&](int e, std::ptrdiff_t q) {
+                return 0.5 * (v.uf[D(e)][q] + v.uf[D(e)][q + s[D(e)]]);
+              },
+              [&](std::ptrdiff_t c) {
+                const double term = 0.25 * dt * (src[c] + src[c - sd]);  // loaded either way
+                return has_source ? term : 0.0;
+              },
+              [&](std::ptrdiff_t c, double value, double u) { fl[c] = value * u; });
+        };
+        if (matched) {
+          interior(std::true_type{});
+        } else {
+          interior(std::false_type{});
+        }
         // ... then the faces on a Dirichlet boundary again, by face_flux.
         const int n_row = Dir == 1 ? j : k;  // the face number along Dir, rows of y or z faces
         for (int side = 0; side < 2; ++side) {

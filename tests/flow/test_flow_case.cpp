@@ -448,6 +448,16 @@ TEST(FlowCaseErrors, AdaptivityKeysAreChecked) {
   expect_input_error(
       replaced(kAdaptiveChannel, "velocity_threshold_m_s = 7e-4", "velocity_threshold_m_s = -1.0"),
       "velocity_threshold_m_s");
+  // The level-matched advection: off by default, a boolean, named in the log when on.
+  EXPECT_FALSE(c.options.level_matched_advection);
+  const FlowCase matched = parse(replaced(kAdaptiveChannel, "every_steps = 2",
+                                          "every_steps = 2\nlevel_matched_advection = true"));
+  EXPECT_TRUE(matched.options.level_matched_advection);
+  EXPECT_NE(describe(matched).find("; level-matched advection"), std::string::npos);
+  EXPECT_EQ(describe(c).find("level-matched"), std::string::npos);
+  expect_input_error(
+      replaced(kAdaptiveChannel, "every_steps = 2", "every_steps = 2\nlevel_matched_advection = 1"),
+      "level_matched_advection");
 }
 
 /// The `cells` column of a diagnostics.csv, found by its name in the header.

@@ -5,7 +5,7 @@
 // criterion (thesis eq. 4.11) on the velocity.
 //
 //   validate_taylor_green_adaptive OUTDIR [--threads T] [--zeta Z] [--uniform yes|no]
-//                                  [--block-cells B]
+//                                  [--block-cells B] [--level-matched yes|no]
 //
 // The initial field, wave number k = 2 pi, u0 = 1 m/s,
 //
@@ -28,6 +28,10 @@
 // trees of 1/8 m instead of 4^3 trees of 1/4 m: the same cells, refined and
 // coarsened in units of 4^3 cells instead of 8^3 (the criterion decides per
 // block). The run's name then ends in " (4^3 blocks)"; it needs --uniform no.
+//
+// --level-matched yes runs the adaptive grid with
+// NavierStokesOptions::level_matched_advection (the uniform grids are the same
+// either way); the run's name then ends in " (level-matched)".
 //
 // Writes OUTDIR/taylor_green_adaptive.csv (one row per run: cells, cell
 // differences against the reference, wall time), OUTDIR/taylor_green_history.csv
@@ -246,7 +250,7 @@ struct RunResult {
 /// adaptive. The reference run (uniform at the finest level) fills
 /// `references`; the others are compared with them.
 RunResult run(const std::string& name, int min_level, int max_level, double zeta, int threads,
-              int block_cells, std::vector<Snapshot>& references,
+              int block_cells, bool level_matched, std::vector<Snapshot>& references,
               const std::filesystem::path& out_dir) {
   const int trees = kFinestCells / 4 / block_cells;  // 32^3 cells at level 0
   Forest forest(validation::periodic_box({trees, trees, trees}, min_level, threads, block_cells,
@@ -254,8 +258,9 @@ RunResult run(const std::string& name, int min_level, int max_level, double zeta
   if (forest.ranks() > 1) {
     throw std::runtime_error("one process only: the reference snapshot holds the local blocks");
   }
-  NavierStokes ns(forest, validation::periodic_boundaries(), Fluid{1.0, kViscosity},
-                  validation::tight_solves());
+  NavierStokesOptions options = validation::tight_solves();
+  options.level_matched_advection = level_matched;
+  NavierStokes ns(forest, validation::periodic_boundaries(), Fluid{1.0, kViscosity}, options);
   ns.set_velocity(initial_velocity);
   const bool adaptive = max_level > min_level;
   const bool reference = !adaptive && min_level == kFinestLevel;
@@ -316,7 +321,7 @@ RunResult run(const std::string& name, int min_level, int max_level, double zeta
 int main(int argc, char** argv) {
   if (argc < 2) {
     std::cerr << "usage: validate_taylor_green_adaptive OUTDIR [--threads T] [--zeta Z] "
-                 "[--uniform yes|no] [--block-cells B]\n";
+                 "[--uniform yes|no] [--block-cells B] [--level-matched yes|no]\n";
     return 2;
   }
   MpiSession::ensure();
@@ -325,6 +330,7 @@ int main(int argc, char** argv) {
   double zeta = 1e-2;
   bool uniform = true;
   int block_cells = 8;
+  std::string level_matched = "no";
   if ((argc - 2) % 2 != 0) {  // an option without its value
     std::cerr << "every option takes a value: " << argv[argc - 1] << " has none\n";
     return 2;
@@ -340,6 +346,8 @@ int main(int argc, char** argv) {
     } else if (key == "--block-cells") {  // "4" or "8" exactly (checked below)
       const std::string value = argv[a + 1];
       block_cells = value == "4" ? 4 : value == "8" ? 8 : 0;
+    } else if (key == "--level-matched") {  // "no" (default) or "yes" (checked below)
+      level_matched = argv[a + 1];
     } else {
       std::cerr << "unknown option " << key << "\n";
       return 2;
@@ -351,6 +359,10 @@ int main(int argc, char** argv) {
   }
   if (block_cells != 4 && block_cells != 8) {
     std::cerr << "--block-cells: 4 or 8 (cells per block edge)\n";
+    return 2;
+  }
+  if (level_matched != "yes" && level_matched != "no") {
+    std::cerr << "--level-matched: yes or no, not " << level_matched << "\n";
     return 2;
   }
   if (block_cells != 8 && uniform) {  // the uniform runs would take the reference's names
@@ -380,14 +392,15 @@ int main(int argc, char** argv) {
     }
   }
   char name[64];
-  std::snprintf(name, sizeof name, "adaptive zeta %g%s", zeta,
-                block_cells == 8 ? "" : " (4^3 blocks)");
+  std::snprintf(name, sizeof name, "adaptive zeta %g%s%s", zeta,
+                block_cells == 8 ? "" : " (4^3 blocks)",
+                level_matched == "yes" ? " (level-matched)" : "");
   runs.push_back({name, 0, kFinestLevel, zeta});
   std::vector<RunResult> results;
   for (const Spec& spec : runs) {
     try {
       results.push_back(run(spec.name, spec.min_level, spec.max_level, spec.zeta, threads,
-                            block_cells, references, out_dir));
+                            block_cells, level_matched == "yes", references, out_dir));
     } catch (const std::exception& e) {
       std::cerr << spec.name << ": " << e.what() << "\n";
       return 1;

@@ -4,7 +4,7 @@
 // the velocity), with a passive tracer in its core.
 //
 //   validate_vortex_adaptive OUTDIR [--threads T] [--zeta Z1,Z2,..] [--uniform yes|no]
-//                            [--geometry plane|tilted]
+//                            [--geometry plane|tilted] [--level-matched yes|no]
 //
 // The box is the unit square, periodic in x and y, one tree (1/4) thick and
 // periodic in z; blocks of 8^3 cells; levels 0, 1, 2 give 32^2, 64^2 and
@@ -59,7 +59,8 @@ const Vec3 kStream{1.0, 0.0, 0.0};
 const Vec3 kStart{0.5, 0.5, 0.0};
 constexpr double kEnd = 1.0;     // one crossing of the box
 constexpr int kFinestLevel = 2;  // every run steps at the CFL step of 128^2
-bool g_tilted = false;           // --geometry tilted: the 3D column along kAxis
+bool g_level_matched = false;  // --level-matched yes: NavierStokesOptions::level_matched_advection
+bool g_tilted = false;         // --geometry tilted: the 3D column along kAxis
 const Vec3 kAxis{1.0 / std::sqrt(2.0), 0.0, 1.0 / std::sqrt(2.0)};
 
 /// x - centre across the vortex axis, to the nearest periodic image: in the
@@ -131,8 +132,9 @@ Vec3 centre_of(const Block& block, int b, int i, int j, int k) {
 /// One run: uniform at `min_level` when min_level == max_level, else adaptive.
 RunResult run(const std::string& name, int min_level, int max_level, double zeta, int threads) {
   Forest forest(validation::periodic_box({4, 4, g_tilted ? 4 : 1}, min_level, threads));
-  NavierStokes ns(forest, validation::periodic_boundaries(), Fluid{1.0, 0.0},
-                  validation::tight_solves());
+  NavierStokesOptions options = validation::tight_solves();
+  options.level_matched_advection = g_level_matched;
+  NavierStokes ns(forest, validation::periodic_boundaries(), Fluid{1.0, 0.0}, options);
   const auto initial = [](const Vec3& x) { return exact(x, 0.0); };
   ns.set_velocity(initial);
   BlockField tracer(forest.local_blocks(), forest.block_cells());
@@ -213,7 +215,7 @@ RunResult run(const std::string& name, int min_level, int max_level, double zeta
 int main(int argc, char** argv) {
   if (argc < 2) {
     std::cerr << "usage: validate_vortex_adaptive OUTDIR [--threads T] [--zeta Z1,Z2,..] "
-                 "[--uniform yes|no] [--geometry plane|tilted]\n";
+                 "[--uniform yes|no] [--geometry plane|tilted] [--level-matched yes|no]\n";
     return 2;
   }
   MpiSession::ensure();
@@ -242,6 +244,13 @@ int main(int argc, char** argv) {
       g_tilted = geometry == "tilted";
     } else if (key == "--uniform") {  // yes (default) or no: skip the uniform runs
       uniform = std::string(argv[a + 1]) != "no";
+    } else if (key == "--level-matched") {  // no (default) or yes; the runs' names say it
+      const std::string value = argv[a + 1];
+      if (value != "yes" && value != "no") {
+        std::cerr << "--level-matched: yes or no, not " << value << "\n";
+        return 2;
+      }
+      g_level_matched = value == "yes";
     } else {
       std::cerr << "unknown option " << key << "\n";
       return 2;
@@ -262,7 +271,8 @@ int main(int argc, char** argv) {
   }
   for (const double zeta : zetas) {
     char name[64];
-    std::snprintf(name, sizeof name, "adaptive zeta %g", zeta);
+    std::snprintf(name, sizeof name, "adaptive zeta %g%s", zeta,
+                  g_level_matched ? " (level-matched)" : "");
     runs.push_back({name, 0, 2, zeta});
   }
   std::vector<RunResult> results;
