@@ -37,16 +37,33 @@ StepScales step_scales(const Forest& forest, bool level_matched, int blk, double
 
 /// The term that gives a BCG face value of a block coarser than the finest
 /// the finest level's leading error (NavierStokesOptions::level_matched_advection).
-/// The linear value at the departure point is -(h - a)^2/8 f'' off, a = |un| dt
-/// the distance the departure point lies upwind (the same on every level: one
-/// dt for all), so adding ((h - a)^2 - (h_f - a)^2)/8 f'', f'' the second
-/// difference over h^2, leaves -(h_f - a)^2/8 f'' on every level: the error no
-/// longer jumps at a coarse-fine face, where the jump left an O(h) truncation
-/// error in the interface cells (docs/theory/flow.md, "Still open").
-/// `reach` = 1 - |un| dt / h, `curvature` the upwind cell's second difference.
-inline double level_matched_term(const StepScales& k, double un, double reach, double curvature) {
-  const double finest_reach = (k.finest_h - std::abs(un) * k.dt) / k.h;
-  return 0.125 * (reach * reach - finest_reach * finest_reach) * curvature;
+/// BCG takes the value at t + dt/2 where the characteristic through the face
+/// starts at t, a/2 upwind of the face (a = |un| dt, the same on every level:
+/// one dt for all); the line through the upwind cell with its central slope
+/// misses it by -(h - a)^2/8 f''. Adding ((h - a)^2 - (h_f - a)^2)/8 f''
+/// leaves -(h_f - a)^2/8 f'' on every level, so the error no longer jumps at a
+/// coarse-fine face, where the jump leaves an O(h) truncation error in the
+/// interface cells (docs/theory/flow.md, "Still open", the paragraph "Then the
+/// same idea without touching uniform grids"). Where a >= h_f (a coarse block
+/// whose flow is faster than the finest blocks'; no finest cell has such an
+/// error) the target is zero, the full quadratic: unclamped, the term would
+/// anti-diffuse, unstable in 1D from a coarse Courant number of about 0.8.
+/// `reach` = 1 - a/h; `second_difference` the upwind cell's, h^2 f''.
+inline double level_matched_term(const StepScales& k, double un, double reach,
+                                 double second_difference) {
+  const double finest_reach = std::max(0.0, (k.finest_h - std::abs(un) * k.dt) / k.h);
+  return 0.125 * (reach * reach - finest_reach * finest_reach) * second_difference;
+}
+
+/// Calls body(std::true_type{}) where `level_matched` holds, else
+/// body(std::false_type{}): the BCG row kernel is chosen once per block.
+template <typename Body>
+inline void with_level_matching(bool level_matched, Body&& body) {
+  if (level_matched) {
+    body(std::true_type{});
+  } else {
+    body(std::false_type{});
+  }
 }
 
 /// Bell-Colella-Glaz upwind value at the lower d-face of cell c (between
@@ -836,7 +853,7 @@ void NavierStokes::predict_face_velocity(double dt) {
       // cells, the transverse velocities the upwind cell's.
       auto along = [&]<int Dir>(std::integral_constant<int, Dir>) {
         const int ni = Dir == 0 ? b + 1 : b, nj = Dir == 1 ? b + 1 : b, nk = Dir == 2 ? b + 1 : b;
-        auto rows = [&]<bool Matched>(std::bool_constant<Matched>) {
+        with_level_matching(matched, [&]<bool Matched>(std::bool_constant<Matched>) {
           for (int k = 0; k < nk; ++k)
             for (int j = 0; j < nj; ++j)
               bcg_face_row<Dir, Matched>(
@@ -845,12 +862,7 @@ void NavierStokes::predict_face_velocity(double dt) {
                   [&](int e, std::ptrdiff_t q) { return u[D(e)][q]; },
                   [&](std::ptrdiff_t c) { return 0.25 * dt * (src[c] + src[c - sd]); },
                   [&](std::ptrdiff_t c, double value, double) { out[c] = value; });
-        };
-        if (matched) {
-          rows(std::true_type{});
-        } else {
-          rows(std::false_type{});
-        }
+        });
       };
       if (d == 0) along(std::integral_constant<int, 0>{});
       if (d == 1) along(std::integral_constant<int, 1>{});
@@ -991,11 +1003,11 @@ void NavierStokes::advect_field(const BlockField& field, const BlockField* sourc
     const double* src = has_source ? v.src : v.f;  // v.f: read, then not used
     const int ni = Dir == 0 ? b + 1 : b, nj = Dir == 1 ? b + 1 : b, nk = Dir == 2 ? b + 1 : b;
     const bool matched = v.scales.finest_h < v.scales.h;
-    for (int k = 0; k < nk; ++k)
-      for (int j = 0; j < nj; ++j) {
-        const std::ptrdiff_t row = L.index(0, j, k);
-        // The interior faces in one branch-free pass (face_flux's last case)...
-        auto interior = [&]<bool Matched>(std::bool_constant<Matched>) {
+    with_level_matching(matched, [&]<bool Matched>(std::bool_constant<Matched>) {
+      for (int k = 0; k < nk; ++k)
+        for (int j = 0; j < nj; ++j) {
+          const std::ptrdiff_t row = L.index(0, j, k);
+          // The interior faces in one branch-free pass (face_flux's last case)...
           bcg_face_row<Dir, Matched>(
               v.f, row, ni, s, v.scales, [&](std::ptrdiff_t c) { return un[c]; },
               [&](int e, std::ptrdiff_t q) {
@@ -1006,25 +1018,20 @@ void NavierStokes::advect_field(const BlockField& field, const BlockField* sourc
                 return has_source ? term : 0.0;
               },
               [&](std::ptrdiff_t c, double value, double u) { fl[c] = value * u; });
-        };
-        if (matched) {
-          interior(std::true_type{});
-        } else {
-          interior(std::false_type{});
-        }
-        // ... then the faces on a Dirichlet boundary again, by face_flux.
-        const int n_row = Dir == 1 ? j : k;  // the face number along Dir, rows of y or z faces
-        for (int side = 0; side < 2; ++side) {
-          const int face = side == 0 ? 0 : b;
-          if (!(side == 0 ? dirichlet_lo : dirichlet_hi)) continue;
-          if (Dir == 0) {
-            fl[row + face] = face_flux(v, Dir, row + face, face, dirichlet_lo, dirichlet_hi);
-          } else if (n_row == face) {
-            for (int i = 0; i < b; ++i)
-              fl[row + i] = face_flux(v, Dir, row + i, face, dirichlet_lo, dirichlet_hi);
+          // ... then the faces on a Dirichlet boundary again, by face_flux.
+          const int n_row = Dir == 1 ? j : k;  // the face number along Dir, rows of y or z faces
+          for (int side = 0; side < 2; ++side) {
+            const int face = side == 0 ? 0 : b;
+            if (!(side == 0 ? dirichlet_lo : dirichlet_hi)) continue;
+            if (Dir == 0) {
+              fl[row + face] = face_flux(v, Dir, row + face, face, dirichlet_lo, dirichlet_hi);
+            } else if (n_row == face) {
+              for (int i = 0; i < b; ++i)
+                fl[row + i] = face_flux(v, Dir, row + i, face, dirichlet_lo, dirichlet_hi);
+            }
           }
         }
-      }
+    });
   };
   auto block_fluxes = [&](int blk, int d, double* fl) {
     if (d == 0) fluxes_along(std::integral_constant<int, 0>{}, blk, fl);

@@ -99,9 +99,11 @@ struct NavierStokesOptions {
   /// On refined forests, give the BCG face values of every block coarser than
   /// the finest the finest level's leading error (a second-difference term;
   /// navier_stokes.cpp, level_matched_term), so that it does not jump at
-  /// coarse-fine faces. Uniform forests and the finest blocks are unchanged
+  /// coarse-fine faces: in the predictor, the momentum and passive tracers
+  /// (advect_scalar) alike. Uniform forests and the finest blocks are unchanged
   /// to the bit. Off by default until the adaptive validations are rerun with
-  /// it (docs/theory/flow.md, "Still open": the refined 2D Taylor-Green error
+  /// it (docs/theory/flow.md, "Still open", the paragraph "Then the same idea
+  /// without touching uniform grids": the refined 2D Taylor-Green error
   /// 1.395e-3 -> 9.29e-4, the adaptive vortex's far field 1.79x -> 1.29x the
   /// uniform run's).
   bool level_matched_advection = false;
